@@ -1,0 +1,35 @@
+# Two commands for a fresh machine (Python 3.11 + a C compiler):
+#   make demo   -- creates .venv, installs implgen, runs the main job
+#   make test   -- same venv, the whole test suite
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.implgen-installed
+SOURCES := pyproject.toml $(shell find generator templates runtime_c -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' \) 2>/dev/null)
+
+.PHONY: demo test install regen gallery bench clean
+
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --upgrade pip
+
+# Dependencies once, then the package itself (non-editable, as a user gets it) whenever a source changes.
+$(STAMP): $(BIN)/python $(SOURCES)
+	$(BIN)/python -m pip install -q ".[test]"
+	$(BIN)/python -m pip install -q --no-deps --force-reinstall .
+	@touch $@
+
+install: $(STAMP)
+
+demo: install
+	$(BIN)/implgen demo
+
+test: install
+	$(BIN)/python -m pytest -q tests
+
+# Regenerate the checked-in generated/ folder from examples/shapes/.
+regen: install
+	$(BIN)/implgen examples/shapes/*.yaml --lang all -o generated
+
+clean:
+	rm -rf $(VENV) build *.egg-info

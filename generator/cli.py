@@ -1,0 +1,58 @@
+"""Command line: only orchestrates the modules that do the work.
+
+    implgen SPEC.yaml [SPEC.yaml ...] --lang c|python|all [-o DIR]   generate intersectors
+    implgen render SCENE.yaml -o OUT.png [...]                       render a scene
+    implgen bench solvers|gen|render [...]                           measure
+    implgen demo                                                     the main job of `make demo`
+
+Bad input (UserError) becomes one line on stderr and exit status 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from typing import Callable, Sequence
+
+from .errors import UserError
+
+# Subcommands live in their own modules; imported lazily so `implgen SPEC` stays quick.
+_COMMANDS: dict[str, str] = {
+    "render": "implgen.render:main",
+    "demo": "implgen.demo:main",
+}
+_BENCHES: dict[str, str] = {
+    "solvers": "implgen.bench_solvers:main",
+    "gen": "implgen.bench_gen:main",
+    "render": "implgen.bench_render:main",
+}
+
+
+def _resolve(target: str) -> Callable[[Sequence[str]], int]:
+    module, func = target.split(":")
+    return getattr(importlib.import_module(module), func)
+
+
+def run(argv: Sequence[str]) -> int:
+    argv = list(argv)
+    if argv and argv[0] in _COMMANDS:
+        return _resolve(_COMMANDS[argv[0]])(argv[1:])
+    if argv and argv[0] == "bench":
+        if len(argv) < 2 or argv[1] not in _BENCHES:
+            raise UserError("bench", f"choose one of: {', '.join(_BENCHES)}")
+        return _resolve(_BENCHES[argv[1]])(argv[2:])
+    return _resolve("implgen.generate_cli:main")(argv)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    try:
+        code = run(sys.argv[1:] if argv is None else argv)
+    except UserError as err:
+        print(f"implgen: error: {err}", file=sys.stderr)
+        code = 2
+    except KeyboardInterrupt:
+        print("implgen: interrupted", file=sys.stderr)
+        code = 130
+    if argv is None:
+        sys.exit(code)
+    return code

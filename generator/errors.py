@@ -1,0 +1,20 @@
+"""The one exception type for bad user input: the CLI turns it into a one-line message and exit status 2."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+class UserError(Exception):
+    """Bad input from a user file or the command line.
+
+    `source` names the file (or option) at fault; `message` says what is wrong, in one line.
+    """
+
+    def __init__(self, source: str | Path | None, message: str) -> None:
+        self.source = str(source) if source is not None else None
+        self.message = " ".join(str(message).split())  # always one line
+        super().__init__(str(self))
+
+    def __str__(self) -> str:
+        return f"{self.source}: {self.message}" if self.source else self.message

@@ -1,0 +1,1 @@
+"""Package marker: lets setuptools ship the Jinja2 templates as package data."""
