@@ -1,0 +1,195 @@
+"""Equation text -> SymPy expression, without eval.
+
+The text is read by Python's own parser (`ast.parse`, which only builds a syntax tree and runs nothing);
+we then walk that tree and accept a small whitelist: numbers, declared symbols, `+ - * /`, `^`/`**` with a
+constant non-negative integer exponent, and parentheses. Division is by non-zero constants only. Anything
+else (calls, attribute access, lambdas, comprehensions, names we do not know) is refused with a message.
+
+While walking we track an upper bound of the degree, so `x^100000` or `(x+1)^(10^10)` is refused before any
+algebra is attempted.
+"""
+
+from __future__ import annotations
+
+import ast
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import Mapping
+
+import sympy
+
+MAX_TEXT_LENGTH = 20_000
+MAX_NESTING = 100          # parentheses / operator nesting a user could mean
+MAX_CONST_BITS = 4_096     # size of a constant computed from powers of constants
+
+
+class ParseError(ValueError):
+    """The text is not an acceptable polynomial expression; the message says why."""
+
+
+@dataclass(frozen=True)
+class Parsed:
+    expr: sympy.Expr
+    degree_bound: int      # upper bound of the total degree in the "variables"
+    param_degree_bound: int
+
+
+def _paren_depth(text: str) -> int:
+    depth = deepest = 0
+    for ch in text:
+        if ch == "(":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif ch == ")":
+            depth -= 1
+    return deepest
+
+
+class _Builder:
+    def __init__(self, text: str, variables: Mapping[str, sympy.Symbol], params: Mapping[str, sympy.Symbol],
+                 max_degree: int, max_param_degree: int) -> None:
+        self.text = text
+        self.variables = variables
+        self.params = params
+        self.max_degree = max_degree
+        self.max_param_degree = max_param_degree
+
+    def build(self, node: ast.AST, depth: int = 0) -> Parsed:
+        if depth > 4 * MAX_NESTING:
+            raise ParseError("expression is nested too deeply")
+        if isinstance(node, ast.Expression):
+            return self.build(node.body, depth + 1)
+        if isinstance(node, ast.Constant):
+            return Parsed(self._number(node), 0, 0)
+        if isinstance(node, ast.Name):
+            return self._name(node.id)
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
+            inner = self.build(node.operand, depth + 1)
+            expr = -inner.expr if isinstance(node.op, ast.USub) else inner.expr
+            return Parsed(expr, inner.degree_bound, inner.param_degree_bound)
+        if isinstance(node, ast.BinOp):
+            return self._binop(node, depth)
+        raise ParseError(self._refusal(node))
+
+    def _refusal(self, node: ast.AST) -> str:
+        segment = ast.get_source_segment(self.text, node) or type(node).__name__
+        if isinstance(node, ast.Call):
+            what = "function calls are not allowed"
+        elif isinstance(node, ast.Attribute):
+            what = "attribute access is not allowed"
+        elif isinstance(node, (ast.Lambda, ast.ListComp, ast.SetComp, ast.DictComp, ast.GeneratorExp)):
+            what = "lambdas and comprehensions are not allowed"
+        elif isinstance(node, ast.BinOp):
+            what = "only + - * / and ^ (or **) are allowed"
+        else:
+            what = "not a polynomial expression"
+        return f"{what}: {segment[:60]!r}"
+
+    def _number(self, node: ast.Constant) -> sympy.Rational:
+        value = node.value
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ParseError(f"not a number: {value!r}"[:80])
+        if isinstance(value, float):
+            if value != value or value in (float("inf"), float("-inf")):
+                raise ParseError("number is not finite")
+            # The literal as written ("0.1") is exact as a decimal fraction: keep it exact.
+            segment = ast.get_source_segment(self.text, node) or repr(value)
+            try:
+                frac = Fraction(segment.replace("_", ""))
+            except ValueError:
+                frac = Fraction(value)
+            return sympy.Rational(frac.numerator, frac.denominator)
+        return sympy.Integer(value)
+
+    def _name(self, name: str) -> Parsed:
+        if name in self.variables:
+            return Parsed(self.variables[name], 1, 0)
+        if name in self.params:
+            return Parsed(self.params[name], 0, 1)
+        known = ", ".join([*self.variables, *self.params]) or "none"
+        raise ParseError(f"unknown symbol {name!r} (known: {known})")
+
+    def _binop(self, node: ast.BinOp, depth: int) -> Parsed:
+        op = node.op
+        if isinstance(op, ast.Pow):
+            return self._power(node, depth)
+        if not isinstance(op, (ast.Add, ast.Sub, ast.Mult, ast.Div)):
+            raise ParseError(self._refusal(node))
+        left = self.build(node.left, depth + 1)
+        right = self.build(node.right, depth + 1)
+        if isinstance(op, ast.Add):
+            return Parsed(left.expr + right.expr, max(left.degree_bound, right.degree_bound),
+                          max(left.param_degree_bound, right.param_degree_bound))
+        if isinstance(op, ast.Sub):
+            return Parsed(left.expr - right.expr, max(left.degree_bound, right.degree_bound),
+                          max(left.param_degree_bound, right.param_degree_bound))
+        if isinstance(op, ast.Mult):
+            return self._checked(left.expr * right.expr, left.degree_bound + right.degree_bound,
+                                 left.param_degree_bound + right.param_degree_bound)
+        # Division: by a non-zero constant only.
+        if right.degree_bound or right.param_degree_bound or not right.expr.is_Rational:
+            segment = ast.get_source_segment(self.text, node.right) or "?"
+            raise ParseError(f"division by a non-constant ({segment[:40]}) is not polynomial")
+        if right.expr == 0:
+            raise ParseError("division by zero")
+        return Parsed(left.expr / right.expr, left.degree_bound, left.param_degree_bound)
+
+    def _power(self, node: ast.BinOp, depth: int) -> Parsed:
+        base = self.build(node.left, depth + 1)
+        exponent = self.build(node.right, depth + 1)
+        segment = (ast.get_source_segment(self.text, node.right) or "?")[:40]
+        if exponent.degree_bound or exponent.param_degree_bound or not exponent.expr.is_Rational:
+            raise ParseError(f"exponent must be a constant non-negative integer, not {segment!r}")
+        if not exponent.expr.is_integer or exponent.expr < 0:
+            raise ParseError(f"exponent must be a non-negative integer, not {exponent.expr}")
+        k = int(exponent.expr)
+        if base.degree_bound == 0 and base.param_degree_bound == 0:
+            bits = max(abs(base.expr.p).bit_length(), abs(base.expr.q).bit_length(), 1)
+            if k > 1 and bits * k > MAX_CONST_BITS:
+                raise ParseError(f"constant power too large: exponent {k}")
+            return Parsed(base.expr ** k, 0, 0)
+        return self._checked(base.expr ** k, base.degree_bound * k, base.param_degree_bound * k)
+
+    def _checked(self, expr: sympy.Expr, degree: int, param_degree: int) -> Parsed:
+        if degree > self.max_degree:
+            raise ParseError(f"degree would exceed {self.max_degree} (the highest supported)")
+        if param_degree > self.max_param_degree:
+            raise ParseError(f"parameters raised to a degree above {self.max_param_degree}")
+        return Parsed(expr, degree, param_degree)
+
+
+def parse_expression(text: str, variables: Mapping[str, sympy.Symbol], params: Mapping[str, sympy.Symbol],
+                     max_degree: int, max_param_degree: int = 64) -> Parsed:
+    """Parse one side of an equation. `variables` count towards the degree; `params` do not."""
+    if not isinstance(text, str):
+        raise ParseError("expression must be text")
+    if len(text) > MAX_TEXT_LENGTH:
+        raise ParseError(f"expression longer than {MAX_TEXT_LENGTH} characters")
+    if not text.strip():
+        raise ParseError("expression is empty")
+    if _paren_depth(text) > MAX_NESTING:
+        raise ParseError(f"parentheses nested deeper than {MAX_NESTING}")
+    source = text.replace("^", "**").strip()
+    try:
+        tree = ast.parse(source, mode="eval")
+    except (SyntaxError, ValueError) as err:
+        raise ParseError(f"syntax error in {text.strip()[:60]!r}") from err
+    except (RecursionError, MemoryError) as err:
+        raise ParseError("expression is nested too deeply") from err
+    builder = _Builder(source, variables, params, max_degree, max_param_degree)
+    try:
+        return builder.build(tree)
+    except RecursionError as err:
+        raise ParseError("expression is nested too deeply") from err
+
+
+def split_equation(text: str) -> tuple[str, str]:
+    """`lhs = rhs` -> (lhs, rhs); a bare `expr` means `expr = 0`."""
+    if not isinstance(text, str):
+        raise ParseError("equation must be text")
+    parts = text.split("=")
+    if len(parts) == 1:
+        return parts[0], "0"
+    if len(parts) == 2 and parts[0].strip() and parts[1].strip():
+        return parts[0], parts[1]
+    raise ParseError("equation must be 'expr' or 'lhs = rhs' with a single '='")
