@@ -84,13 +84,13 @@ double chmutov8_value(const double p[3], const double *params)
     const double px = p[0];
     const double py = p[1];
     const double pz = p[2];
-    const double q18 = pz*pz;
+    const double q18 = px*px;
     const double q19 = q18*q18;
     const double q20 = q19*q19;
-    const double q21 = py*py;
+    const double q21 = pz*pz;
     const double q22 = q21*q21;
     const double q23 = q22*q22;
-    const double q24 = px*px;
+    const double q24 = py*py;
     const double q25 = q24*q24;
     const double q26 = q25*q25;
 
@@ -103,16 +103,16 @@ void chmutov8_gradient(const double p[3], const double *params, double g[3])
     const double px = p[0];
     const double py = p[1];
     const double pz = p[2];
-    const double q18 = pz*pz;
+    const double q18 = px*px;
     const double q19 = q18*q18;
-    const double q21 = py*py;
+    const double q21 = pz*pz;
     const double q22 = q21*q21;
-    const double q24 = px*px;
+    const double q24 = py*py;
     const double q25 = q24*q24;
 
-    g[0] = 1024*px*q24*q25 - 1536*px*q25 - 64*px + 640*(px*px*px);
-    g[1] = 1024*py*q21*q22 - 1536*py*q22 - 64*py + 640*(py*py*py);
-    g[2] = 1024*pz*q18*q19 - 1536*pz*q19 - 64*pz + 640*(pz*pz*pz);
+    g[0] = 1024*px*q18*q19 - 1536*px*q19 - 64*px + 640*(px*px*px);
+    g[1] = 1024*py*q24*q25 - 1536*py*q25 - 64*py + 640*(py*py*py);
+    g[2] = 1024*pz*q21*q22 - 1536*pz*q22 - 64*pz + 640*(pz*pz*pz);
 }
 
 int chmutov8_bounds(const double *params, double box[6])

@@ -106,13 +106,13 @@ def value(p, /, **params):
     px = p[..., 0]
     py = p[..., 1]
     pz = p[..., 2]
-    q18 = pz*pz
+    q18 = px*px
     q19 = q18*q18
     q20 = q19*q19
-    q21 = py*py
+    q21 = pz*pz
     q22 = q21*q21
     q23 = q22*q22
-    q24 = px*px
+    q24 = py*py
     q25 = q24*q24
     q26 = q25*q25
 
@@ -127,14 +127,14 @@ def gradient(p, /, **params):
     px = p[..., 0]
     py = p[..., 1]
     pz = p[..., 2]
-    q18 = pz*pz
+    q18 = px*px
     q19 = q18*q18
-    q21 = py*py
+    q21 = pz*pz
     q22 = q21*q21
-    q24 = px*px
+    q24 = py*py
     q25 = q24*q24
 
-    return _stack([1024*px*q24*q25 - 1536*px*q25 - 64*px + 640*(px*px*px), 1024*py*q21*q22 - 1536*py*q22 - 64*py + 640*(py*py*py), 1024*pz*q18*q19 - 1536*pz*q19 - 64*pz + 640*(pz*pz*pz)], shape)
+    return _stack([1024*px*q18*q19 - 1536*px*q19 - 64*px + 640*(px*px*px), 1024*py*q24*q25 - 1536*py*q25 - 64*py + 640*(py*py*py), 1024*pz*q21*q22 - 1536*pz*q22 - 64*pz + 640*(pz*pz*pz)], shape)
 
 
 def bounds(**params):

@@ -1,0 +1,102 @@
+"""Shared test helpers: where things are, and loading generated C and Python shapes."""
+
+from __future__ import annotations
+
+import ctypes
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SHAPES_DIR = ROOT / "examples" / "shapes"
+GENERATED = ROOT / "generated"
+RUNTIME = ROOT / "runtime_c"
+SHAPE_FILES = sorted(SHAPES_DIR.glob("*.yaml"))
+SHAPE_NAMES = [p.stem for p in SHAPE_FILES]
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+def load_python_shape(name: str, folder: Path = GENERATED) -> ModuleType:
+    """Import generated/<name>.py under a private module name."""
+    spec = importlib.util.spec_from_file_location(f"_generated_{folder.name}_{name}", folder / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    assert spec.loader is not None
+    spec.loader.exec_module(module)
+    return module
+
+
+def runtime_solver_sources() -> list[Path]:
+    """The runtime's solver and shape sources (what a generated intersector links against)."""
+    return sorted([*RUNTIME.glob("roots*.c"), *RUNTIME.glob("shape*.c")])
+
+
+class CShapes:
+    """Generated C shapes compiled into one shared library (through the package's build cache)."""
+
+    def __init__(self, names: list[str], folder: Path = GENERATED, with_runtime: bool = True) -> None:
+        from implgen.cbuild import build_shared, load
+
+        sources = [folder / f"{n}.c" for n in names]
+        if with_runtime:
+            sources += runtime_solver_sources()
+        self.lib = load(build_shared(sources, include_dirs=[folder, RUNTIME], tag="test-shapes"))
+        self.names = names
+
+    def _fn(self, name: str, what: str):
+        return getattr(self.lib, f"{name}_{what}")
+
+    @staticmethod
+    def _arr(values) -> ctypes.Array:
+        values = [float(v) for v in values]
+        return (ctypes.c_double * max(len(values), 1))(*values)
+
+    def coeffs(self, name: str, degree: int, o, d, params=()) -> np.ndarray:
+        out = (ctypes.c_double * (degree + 1))()
+        self._fn(name, "coeffs")(self._arr(o), self._arr(d), self._arr(params), out)
+        return np.array(out[:])
+
+    def value(self, name: str, p, params=()) -> float:
+        fn = self._fn(name, "value")
+        fn.restype = ctypes.c_double
+        return fn(self._arr(p), self._arr(params))
+
+    def gradient(self, name: str, p, params=()) -> np.ndarray:
+        out = (ctypes.c_double * 3)()
+        self._fn(name, "gradient")(self._arr(p), self._arr(params), out)
+        return np.array(out[:])
+
+    def bounds(self, name: str, params=()) -> tuple[int, np.ndarray]:
+        out = (ctypes.c_double * 6)()
+        flag = self._fn(name, "bounds")(self._arr(params), out)
+        return flag, np.array(out[:])
+
+    def intersect(self, name: str, o, d, tmin, tmax, params=()) -> np.ndarray:
+        out = (ctypes.c_double * 32)()
+        fn = self._fn(name, "intersect")
+        fn.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_void_p,
+                       ctypes.c_void_p]
+        count = fn(self._arr(o), self._arr(d), tmin, tmax, self._arr(params), out)
+        return np.array(out[:count])
+
+    def normal(self, name: str, p, params=()) -> tuple[int, np.ndarray]:
+        out = (ctypes.c_double * 3)()
+        flag = self._fn(name, "normal")(self._arr(p), self._arr(params), out)
+        return flag, np.array(out[:])
+
+
+def random_rays(rng: np.random.Generator, n: int, spread: float = 2.0) -> tuple[np.ndarray, np.ndarray]:
+    """Origins in a box, directions of random (non-unit) length 0.1 .. 10."""
+    o = rng.uniform(-spread, spread, (n, 3))
+    d = rng.normal(size=(n, 3))
+    d *= (10.0 ** rng.uniform(-1, 1, (n, 1))) / np.linalg.norm(d, axis=1, keepdims=True)
+    return o, d
+
+
+@pytest.fixture(scope="session")
+def rng() -> np.random.Generator:
+    return np.random.default_rng(20261121)
