@@ -18,22 +18,22 @@ void blobs10_coeffs(const double o[3], const double d[3], const double *params, 
     const double dx = d[0];
     const double dy = d[1];
     const double dz = d[2];
-    const double q0 = ox*ox;
+    const double q0 = dx*dx;
     const double q1 = q0*q0;
     const double q2 = q1*q1;
-    const double q3 = oy*oy;
+    const double q3 = dy*dy;
     const double q4 = q3*q3;
     const double q5 = q4*q4;
-    const double q6 = oz*oz;
+    const double q6 = dz*dz;
     const double q7 = q6*q6;
     const double q8 = q7*q7;
-    const double q9 = dx*dx;
+    const double q9 = ox*ox;
     const double q10 = q9*q9;
     const double q11 = q10*q10;
-    const double q12 = dz*dz;
+    const double q12 = oy*oy;
     const double q13 = q12*q12;
     const double q14 = q13*q13;
-    const double q15 = dy*dy;
+    const double q15 = oz*oz;
     const double q16 = q15*q15;
     const double q17 = q16*q16;
     const double w0 = ox*ox;
@@ -49,17 +49,17 @@ void blobs10_coeffs(const double o[3], const double d[3], const double *params, 
     const double w10 = dz*dz;
     const double w11 = w10 + w8 + w9;
 
-    c[0] = q0*q2 + q3*q5 + q6*q8 - 3.0/10.0*w0 - 3.0/10.0*w1 - 1 + (3.0/10.0)*(w3*w3);
-    c[1] = 10*dx*ox*q2 + 10*dy*oy*q5 + 10*dz*oz*q8 - 3.0/5.0*w4 - 3.0/5.0*w5 + w6*w7;
-    c[2] = 45*q2*w8 + 45*q5*w9 + 45*q8*w10 + w11*w7 - 3.0/10.0*w8 - 3.0/10.0*w9 + (3.0/10.0)*(w6*w6);
-    c[3] = 120*ox*q0*q1*(dx*dx*dx) + 120*oy*q3*q4*(dy*dy*dy) + 120*oz*q6*q7*(dz*dz*dz) + (3.0/5.0)*w11*w6;
-    c[4] = 210*q0*q1*q10 + 210*q13*q6*q7 + 210*q16*q3*q4 + (3.0/10.0)*(w11*w11);
-    c[5] = 252*dx*ox*q1*q10 + 252*dy*oy*q16*q4 + 252*dz*oz*q13*q7;
-    c[6] = 210*q1*q10*q9 + 210*q12*q13*q7 + 210*q15*q16*q4;
-    c[7] = 120*dx*q10*q9*(ox*ox*ox) + 120*dy*q15*q16*(oy*oy*oy) + 120*dz*q12*q13*(oz*oz*oz);
-    c[8] = 45*q11*w0 + 45*q14*w2 + 45*q17*w1;
-    c[9] = 10*dx*ox*q11 + 10*dy*oy*q17 + 10*dz*oz*q14;
-    c[10] = q11*q9 + q12*q14 + q15*q17;
+    c[0] = q11*q9 + q12*q14 + q15*q17 - 3.0/10.0*w0 - 3.0/10.0*w1 - 1 + (3.0/10.0)*(w3*w3);
+    c[1] = 10*dx*ox*q11 + 10*dy*oy*q14 + 10*dz*oz*q17 - 3.0/5.0*w4 - 3.0/5.0*w5 + w6*w7;
+    c[2] = 45*q11*w8 + 45*q14*w9 + 45*q17*w10 + w11*w7 - 3.0/10.0*w8 - 3.0/10.0*w9 + (3.0/10.0)*(w6*w6);
+    c[3] = 120*ox*q10*q9*(dx*dx*dx) + 120*oy*q12*q13*(dy*dy*dy) + 120*oz*q15*q16*(dz*dz*dz) + (3.0/5.0)*w11*w6;
+    c[4] = 210*q1*q10*q9 + 210*q12*q13*q4 + 210*q15*q16*q7 + (3.0/10.0)*(w11*w11);
+    c[5] = 252*dx*ox*q1*q10 + 252*dy*oy*q13*q4 + 252*dz*oz*q16*q7;
+    c[6] = 210*q0*q1*q10 + 210*q13*q3*q4 + 210*q16*q6*q7;
+    c[7] = 120*dx*q0*q1*(ox*ox*ox) + 120*dy*q3*q4*(oy*oy*oy) + 120*dz*q6*q7*(oz*oz*oz);
+    c[8] = 45*q2*w0 + 45*q5*w1 + 45*q8*w2;
+    c[9] = 10*dx*ox*q2 + 10*dy*oy*q5 + 10*dz*oz*q8;
+    c[10] = q0*q2 + q3*q5 + q6*q8;
 }
 
 double blobs10_value(const double p[3], const double *params)
@@ -71,10 +71,10 @@ double blobs10_value(const double p[3], const double *params)
     const double q18 = px*px;
     const double q19 = q18*q18;
     const double q20 = q19*q19;
-    const double q21 = pz*pz;
+    const double q21 = py*py;
     const double q22 = q21*q21;
     const double q23 = q22*q22;
-    const double q24 = py*py;
+    const double q24 = pz*pz;
     const double q25 = q24*q24;
     const double q26 = q25*q25;
     const double w12 = px*px;
@@ -93,10 +93,10 @@ void blobs10_gradient(const double p[3], const double *params, double g[3])
     const double q18 = px*px;
     const double q19 = q18*q18;
     const double q20 = q19*q19;
-    const double q21 = pz*pz;
+    const double q21 = py*py;
     const double q22 = q21*q21;
     const double q23 = q22*q22;
-    const double q24 = py*py;
+    const double q24 = pz*pz;
     const double q25 = q24*q24;
     const double q26 = q25*q25;
     const double w12 = px*px;
@@ -105,8 +105,8 @@ void blobs10_gradient(const double p[3], const double *params, double g[3])
     const double w15 = (6.0/5.0)*w14;
 
     g[0] = 10*px*q20 + px*w15 - 3.0/5.0*px;
-    g[1] = 10*py*q26 + py*w15 - 3.0/5.0*py;
-    g[2] = 10*pz*q23 + pz*w15;
+    g[1] = 10*py*q23 + py*w15 - 3.0/5.0*py;
+    g[2] = 10*pz*q26 + pz*w15;
 }
 
 int blobs10_bounds(const double *params, double box[6])

@@ -46,22 +46,22 @@ def coeffs(o, d, /, **params):
     dx = d[..., 0]
     dy = d[..., 1]
     dz = d[..., 2]
-    q0 = ox*ox
+    q0 = dx*dx
     q1 = q0*q0
     q2 = q1*q1
-    q3 = oy*oy
+    q3 = dy*dy
     q4 = q3*q3
     q5 = q4*q4
-    q6 = oz*oz
+    q6 = dz*dz
     q7 = q6*q6
     q8 = q7*q7
-    q9 = dx*dx
+    q9 = ox*ox
     q10 = q9*q9
     q11 = q10*q10
-    q12 = dz*dz
+    q12 = oy*oy
     q13 = q12*q12
     q14 = q13*q13
-    q15 = dy*dy
+    q15 = oz*oz
     q16 = q15*q15
     q17 = q16*q16
     w0 = ox*ox
@@ -77,7 +77,7 @@ def coeffs(o, d, /, **params):
     w10 = dz*dz
     w11 = w10 + w8 + w9
 
-    return _stack([q0*q2 + q3*q5 + q6*q8 - 3/10*w0 - 3/10*w1 - 1 + (3/10)*(w3*w3), 10*dx*ox*q2 + 10*dy*oy*q5 + 10*dz*oz*q8 - 3/5*w4 - 3/5*w5 + w6*w7, 45*q2*w8 + 45*q5*w9 + 45*q8*w10 + w11*w7 - 3/10*w8 - 3/10*w9 + (3/10)*(w6*w6), 120*ox*q0*q1*(dx*dx*dx) + 120*oy*q3*q4*(dy*dy*dy) + 120*oz*q6*q7*(dz*dz*dz) + (3/5)*w11*w6, 210*q0*q1*q10 + 210*q13*q6*q7 + 210*q16*q3*q4 + (3/10)*(w11*w11), 252*dx*ox*q1*q10 + 252*dy*oy*q16*q4 + 252*dz*oz*q13*q7, 210*q1*q10*q9 + 210*q12*q13*q7 + 210*q15*q16*q4, 120*dx*q10*q9*(ox*ox*ox) + 120*dy*q15*q16*(oy*oy*oy) + 120*dz*q12*q13*(oz*oz*oz), 45*q11*w0 + 45*q14*w2 + 45*q17*w1, 10*dx*ox*q11 + 10*dy*oy*q17 + 10*dz*oz*q14, q11*q9 + q12*q14 + q15*q17], shape)
+    return _stack([q11*q9 + q12*q14 + q15*q17 - 3/10*w0 - 3/10*w1 - 1 + (3/10)*(w3*w3), 10*dx*ox*q11 + 10*dy*oy*q14 + 10*dz*oz*q17 - 3/5*w4 - 3/5*w5 + w6*w7, 45*q11*w8 + 45*q14*w9 + 45*q17*w10 + w11*w7 - 3/10*w8 - 3/10*w9 + (3/10)*(w6*w6), 120*ox*q10*q9*(dx*dx*dx) + 120*oy*q12*q13*(dy*dy*dy) + 120*oz*q15*q16*(dz*dz*dz) + (3/5)*w11*w6, 210*q1*q10*q9 + 210*q12*q13*q4 + 210*q15*q16*q7 + (3/10)*(w11*w11), 252*dx*ox*q1*q10 + 252*dy*oy*q13*q4 + 252*dz*oz*q16*q7, 210*q0*q1*q10 + 210*q13*q3*q4 + 210*q16*q6*q7, 120*dx*q0*q1*(ox*ox*ox) + 120*dy*q3*q4*(oy*oy*oy) + 120*dz*q6*q7*(oz*oz*oz), 45*q2*w0 + 45*q5*w1 + 45*q8*w2, 10*dx*ox*q2 + 10*dy*oy*q5 + 10*dz*oz*q8, q0*q2 + q3*q5 + q6*q8], shape)
 
 
 def value(p, /, **params):
@@ -91,10 +91,10 @@ def value(p, /, **params):
     q18 = px*px
     q19 = q18*q18
     q20 = q19*q19
-    q21 = pz*pz
+    q21 = py*py
     q22 = q21*q21
     q23 = q22*q22
-    q24 = py*py
+    q24 = pz*pz
     q25 = q24*q24
     q26 = q25*q25
     w12 = px*px
@@ -115,10 +115,10 @@ def gradient(p, /, **params):
     q18 = px*px
     q19 = q18*q18
     q20 = q19*q19
-    q21 = pz*pz
+    q21 = py*py
     q22 = q21*q21
     q23 = q22*q22
-    q24 = py*py
+    q24 = pz*pz
     q25 = q24*q24
     q26 = q25*q25
     w12 = px*px
@@ -126,7 +126,7 @@ def gradient(p, /, **params):
     w14 = w12 + w13 + 3/16 + pz*pz
     w15 = (6/5)*w14
 
-    return _stack([10*px*q20 + px*w15 - 3/5*px, 10*py*q26 + py*w15 - 3/5*py, 10*pz*q23 + pz*w15], shape)
+    return _stack([10*px*q20 + px*w15 - 3/5*px, 10*py*q23 + py*w15 - 3/5*py, 10*pz*q26 + pz*w15], shape)
 
 
 def bounds(**params):

@@ -18,36 +18,36 @@ void chmutov8_coeffs(const double o[3], const double d[3], const double *params,
     const double dx = d[0];
     const double dy = d[1];
     const double dz = d[2];
-    const double q0 = ox*ox;
+    const double q0 = dx*dx;
     const double q1 = q0*q0;
     const double q2 = q1*q1;
-    const double q3 = oy*oy;
+    const double q3 = dy*dy;
     const double q4 = q3*q3;
     const double q5 = q4*q4;
-    const double q6 = oz*oz;
+    const double q6 = dz*dz;
     const double q7 = q6*q6;
     const double q8 = q7*q7;
-    const double q9 = dx*dx;
+    const double q9 = ox*ox;
     const double q10 = q9*q9;
     const double q11 = q10*q10;
-    const double q12 = dy*dy;
+    const double q12 = oy*oy;
     const double q13 = q12*q12;
     const double q14 = q13*q13;
-    const double q15 = dz*dz;
+    const double q15 = oz*oz;
     const double q16 = q15*q15;
     const double q17 = q16*q16;
-    const double w0 = q0*q1;
-    const double w1 = q3*q4;
-    const double w2 = q6*q7;
+    const double w0 = q10*q9;
+    const double w1 = q12*q13;
+    const double w2 = q15*q16;
     const double w3 = ox*ox;
     const double w4 = oy*oy;
     const double w5 = oz*oz;
-    const double w6 = q1;
-    const double w7 = q4;
-    const double w8 = q7;
-    const double w9 = ox*q1;
-    const double w10 = oy*q4;
-    const double w11 = oz*q7;
+    const double w6 = q10;
+    const double w7 = q13;
+    const double w8 = q16;
+    const double w9 = ox*q10;
+    const double w10 = oy*q13;
+    const double w11 = oz*q16;
     const double w12 = ox*ox*ox;
     const double w13 = oy*oy*oy;
     const double w14 = oz*oz*oz;
@@ -57,25 +57,25 @@ void chmutov8_coeffs(const double o[3], const double d[3], const double *params,
     const double w18 = dx*dx*dx;
     const double w19 = dy*dy*dy;
     const double w20 = dz*dz*dz;
-    const double w21 = q10;
-    const double w22 = q13;
-    const double w23 = q16;
-    const double w24 = dx*q10;
-    const double w25 = dy*q13;
-    const double w26 = dz*q16;
-    const double w27 = q10*q9;
-    const double w28 = q12*q13;
-    const double w29 = q15*q16;
+    const double w21 = q1;
+    const double w22 = q4;
+    const double w23 = q7;
+    const double w24 = dx*q1;
+    const double w25 = dy*q4;
+    const double w26 = dz*q7;
+    const double w27 = q0*q1;
+    const double w28 = q3*q4;
+    const double w29 = q6*q7;
 
-    c[0] = 128*q2 + 128*q5 + 128*q8 - 256*w0 - 256*w1 - 256*w2 - 32*w3 - 32*w4 - 32*w5 + 160*w6 + 160*w7 + 160*w8 + 3;
-    c[1] = 1024*dx*ox*q0*q1 - 64*dx*ox + 640*dx*w12 - 1536*dx*w9 + 1024*dy*oy*q3*q4 - 64*dy*oy - 1536*dy*w10 + 640*dy*w13 + 1024*dz*oz*q6*q7 - 64*dz*oz - 1536*dz*w11 + 640*dz*w14;
+    c[0] = 128*q11 + 128*q14 + 128*q17 - 256*w0 - 256*w1 - 256*w2 - 32*w3 - 32*w4 - 32*w5 + 160*w6 + 160*w7 + 160*w8 + 3;
+    c[1] = 1024*dx*ox*q10*q9 - 64*dx*ox + 640*dx*w12 - 1536*dx*w9 + 1024*dy*oy*q12*q13 - 64*dy*oy - 1536*dy*w10 + 640*dy*w13 + 1024*dz*oz*q15*q16 - 64*dz*oz - 1536*dz*w11 + 640*dz*w14;
     c[2] = 3584*w0*w15 + 3584*w1*w16 + 960*w15*w3 - 3840*w15*w6 - 32*w15 + 960*w16*w4 - 3840*w16*w7 - 32*w16 + 3584*w17*w2 + 960*w17*w5 - 3840*w17*w8 - 32*w17;
     c[3] = 640*ox*w18 + 640*oy*w19 + 640*oz*w20 + 7168*w10*w19 + 7168*w11*w20 - 5120*w12*w18 - 5120*w13*w19 - 5120*w14*w20 + 7168*w18*w9;
     c[4] = -3840*w21*w3 + 8960*w21*w6 + 160*w21 - 3840*w22*w4 + 8960*w22*w7 + 160*w22 - 3840*w23*w5 + 8960*w23*w8 + 160*w23;
     c[5] = -1536*ox*w24 - 1536*oy*w25 - 1536*oz*w26 + 7168*w12*w24 + 7168*w13*w25 + 7168*w14*w26;
     c[6] = 3584*w27*w3 - 256*w27 + 3584*w28*w4 - 256*w28 + 3584*w29*w5 - 256*w29;
-    c[7] = 1024*dx*ox*q10*q9 + 1024*dy*oy*q12*q13 + 1024*dz*oz*q15*q16;
-    c[8] = 128*q11 + 128*q14 + 128*q17;
+    c[7] = 1024*dx*ox*q0*q1 + 1024*dy*oy*q3*q4 + 1024*dz*oz*q6*q7;
+    c[8] = 128*q2 + 128*q5 + 128*q8;
 }
 
 double chmutov8_value(const double p[3], const double *params)
@@ -87,10 +87,10 @@ double chmutov8_value(const double p[3], const double *params)
     const double q18 = px*px;
     const double q19 = q18*q18;
     const double q20 = q19*q19;
-    const double q21 = pz*pz;
+    const double q21 = py*py;
     const double q22 = q21*q21;
     const double q23 = q22*q22;
-    const double q24 = py*py;
+    const double q24 = pz*pz;
     const double q25 = q24*q24;
     const double q26 = q25*q25;
 
@@ -105,14 +105,14 @@ void chmutov8_gradient(const double p[3], const double *params, double g[3])
     const double pz = p[2];
     const double q18 = px*px;
     const double q19 = q18*q18;
-    const double q21 = pz*pz;
+    const double q21 = py*py;
     const double q22 = q21*q21;
-    const double q24 = py*py;
+    const double q24 = pz*pz;
     const double q25 = q24*q24;
 
     g[0] = 1024*px*q18*q19 - 1536*px*q19 - 64*px + 640*(px*px*px);
-    g[1] = 1024*py*q24*q25 - 1536*py*q25 - 64*py + 640*(py*py*py);
-    g[2] = 1024*pz*q21*q22 - 1536*pz*q22 - 64*pz + 640*(pz*pz*pz);
+    g[1] = 1024*py*q21*q22 - 1536*py*q22 - 64*py + 640*(py*py*py);
+    g[2] = 1024*pz*q24*q25 - 1536*pz*q25 - 64*pz + 640*(pz*pz*pz);
 }
 
 int chmutov8_bounds(const double *params, double box[6])

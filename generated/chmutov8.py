@@ -46,36 +46,36 @@ def coeffs(o, d, /, **params):
     dx = d[..., 0]
     dy = d[..., 1]
     dz = d[..., 2]
-    q0 = ox*ox
+    q0 = dx*dx
     q1 = q0*q0
     q2 = q1*q1
-    q3 = oy*oy
+    q3 = dy*dy
     q4 = q3*q3
     q5 = q4*q4
-    q6 = oz*oz
+    q6 = dz*dz
     q7 = q6*q6
     q8 = q7*q7
-    q9 = dx*dx
+    q9 = ox*ox
     q10 = q9*q9
     q11 = q10*q10
-    q12 = dy*dy
+    q12 = oy*oy
     q13 = q12*q12
     q14 = q13*q13
-    q15 = dz*dz
+    q15 = oz*oz
     q16 = q15*q15
     q17 = q16*q16
-    w0 = q0*q1
-    w1 = q3*q4
-    w2 = q6*q7
+    w0 = q10*q9
+    w1 = q12*q13
+    w2 = q15*q16
     w3 = ox*ox
     w4 = oy*oy
     w5 = oz*oz
-    w6 = q1
-    w7 = q4
-    w8 = q7
-    w9 = ox*q1
-    w10 = oy*q4
-    w11 = oz*q7
+    w6 = q10
+    w7 = q13
+    w8 = q16
+    w9 = ox*q10
+    w10 = oy*q13
+    w11 = oz*q16
     w12 = ox*ox*ox
     w13 = oy*oy*oy
     w14 = oz*oz*oz
@@ -85,17 +85,17 @@ def coeffs(o, d, /, **params):
     w18 = dx*dx*dx
     w19 = dy*dy*dy
     w20 = dz*dz*dz
-    w21 = q10
-    w22 = q13
-    w23 = q16
-    w24 = dx*q10
-    w25 = dy*q13
-    w26 = dz*q16
-    w27 = q10*q9
-    w28 = q12*q13
-    w29 = q15*q16
+    w21 = q1
+    w22 = q4
+    w23 = q7
+    w24 = dx*q1
+    w25 = dy*q4
+    w26 = dz*q7
+    w27 = q0*q1
+    w28 = q3*q4
+    w29 = q6*q7
 
-    return _stack([128*q2 + 128*q5 + 128*q8 - 256*w0 - 256*w1 - 256*w2 - 32*w3 - 32*w4 - 32*w5 + 160*w6 + 160*w7 + 160*w8 + 3, 1024*dx*ox*q0*q1 - 64*dx*ox + 640*dx*w12 - 1536*dx*w9 + 1024*dy*oy*q3*q4 - 64*dy*oy - 1536*dy*w10 + 640*dy*w13 + 1024*dz*oz*q6*q7 - 64*dz*oz - 1536*dz*w11 + 640*dz*w14, 3584*w0*w15 + 3584*w1*w16 + 960*w15*w3 - 3840*w15*w6 - 32*w15 + 960*w16*w4 - 3840*w16*w7 - 32*w16 + 3584*w17*w2 + 960*w17*w5 - 3840*w17*w8 - 32*w17, 640*ox*w18 + 640*oy*w19 + 640*oz*w20 + 7168*w10*w19 + 7168*w11*w20 - 5120*w12*w18 - 5120*w13*w19 - 5120*w14*w20 + 7168*w18*w9, -3840*w21*w3 + 8960*w21*w6 + 160*w21 - 3840*w22*w4 + 8960*w22*w7 + 160*w22 - 3840*w23*w5 + 8960*w23*w8 + 160*w23, -1536*ox*w24 - 1536*oy*w25 - 1536*oz*w26 + 7168*w12*w24 + 7168*w13*w25 + 7168*w14*w26, 3584*w27*w3 - 256*w27 + 3584*w28*w4 - 256*w28 + 3584*w29*w5 - 256*w29, 1024*dx*ox*q10*q9 + 1024*dy*oy*q12*q13 + 1024*dz*oz*q15*q16, 128*q11 + 128*q14 + 128*q17], shape)
+    return _stack([128*q11 + 128*q14 + 128*q17 - 256*w0 - 256*w1 - 256*w2 - 32*w3 - 32*w4 - 32*w5 + 160*w6 + 160*w7 + 160*w8 + 3, 1024*dx*ox*q10*q9 - 64*dx*ox + 640*dx*w12 - 1536*dx*w9 + 1024*dy*oy*q12*q13 - 64*dy*oy - 1536*dy*w10 + 640*dy*w13 + 1024*dz*oz*q15*q16 - 64*dz*oz - 1536*dz*w11 + 640*dz*w14, 3584*w0*w15 + 3584*w1*w16 + 960*w15*w3 - 3840*w15*w6 - 32*w15 + 960*w16*w4 - 3840*w16*w7 - 32*w16 + 3584*w17*w2 + 960*w17*w5 - 3840*w17*w8 - 32*w17, 640*ox*w18 + 640*oy*w19 + 640*oz*w20 + 7168*w10*w19 + 7168*w11*w20 - 5120*w12*w18 - 5120*w13*w19 - 5120*w14*w20 + 7168*w18*w9, -3840*w21*w3 + 8960*w21*w6 + 160*w21 - 3840*w22*w4 + 8960*w22*w7 + 160*w22 - 3840*w23*w5 + 8960*w23*w8 + 160*w23, -1536*ox*w24 - 1536*oy*w25 - 1536*oz*w26 + 7168*w12*w24 + 7168*w13*w25 + 7168*w14*w26, 3584*w27*w3 - 256*w27 + 3584*w28*w4 - 256*w28 + 3584*w29*w5 - 256*w29, 1024*dx*ox*q0*q1 + 1024*dy*oy*q3*q4 + 1024*dz*oz*q6*q7, 128*q2 + 128*q5 + 128*q8], shape)
 
 
 def value(p, /, **params):
@@ -109,10 +109,10 @@ def value(p, /, **params):
     q18 = px*px
     q19 = q18*q18
     q20 = q19*q19
-    q21 = pz*pz
+    q21 = py*py
     q22 = q21*q21
     q23 = q22*q22
-    q24 = py*py
+    q24 = pz*pz
     q25 = q24*q24
     q26 = q25*q25
 
@@ -129,12 +129,12 @@ def gradient(p, /, **params):
     pz = p[..., 2]
     q18 = px*px
     q19 = q18*q18
-    q21 = pz*pz
+    q21 = py*py
     q22 = q21*q21
-    q24 = py*py
+    q24 = pz*pz
     q25 = q24*q24
 
-    return _stack([1024*px*q18*q19 - 1536*px*q19 - 64*px + 640*(px*px*px), 1024*py*q24*q25 - 1536*py*q25 - 64*py + 640*(py*py*py), 1024*pz*q21*q22 - 1536*pz*q22 - 64*pz + 640*(pz*pz*pz)], shape)
+    return _stack([1024*px*q18*q19 - 1536*px*q19 - 64*px + 640*(px*px*px), 1024*py*q21*q22 - 1536*py*q22 - 64*py + 640*(py*py*py), 1024*pz*q24*q25 - 1536*pz*q25 - 64*pz + 640*(pz*pz*pz)], shape)
 
 
 def bounds(**params):

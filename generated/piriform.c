@@ -18,20 +18,20 @@ void piriform_coeffs(const double o[3], const double d[3], const double *params,
     const double dx = d[0];
     const double dy = d[1];
     const double dz = d[2];
-    const double q0 = ox*ox;
+    const double q0 = dx*dx;
     const double q1 = q0*q0;
-    const double q2 = dx*dx;
+    const double q2 = ox*ox;
     const double q3 = q2*q2;
     const double w0 = ox*ox*ox;
     const double w1 = ox*ox;
     const double w2 = dx*dx;
     const double w3 = dx*dx*dx;
 
-    c[0] = q1 - w0 + oy*oy + oz*oz;
+    c[0] = q3 - w0 + oy*oy + oz*oz;
     c[1] = 4*dx*w0 - 3*dx*w1 + 2*dy*oy + 2*dz*oz;
     c[2] = -3*ox*w2 + 6*w1*w2 + dy*dy + dz*dz;
     c[3] = 4*ox*w3 - w3;
-    c[4] = q3;
+    c[4] = q1;
 }
 
 double piriform_value(const double p[3], const double *params)

@@ -46,16 +46,16 @@ def coeffs(o, d, /, **params):
     dx = d[..., 0]
     dy = d[..., 1]
     dz = d[..., 2]
-    q0 = ox*ox
+    q0 = dx*dx
     q1 = q0*q0
-    q2 = dx*dx
+    q2 = ox*ox
     q3 = q2*q2
     w0 = ox*ox*ox
     w1 = ox*ox
     w2 = dx*dx
     w3 = dx*dx*dx
 
-    return _stack([q1 - w0 + oy*oy + oz*oz, 4*dx*w0 - 3*dx*w1 + 2*dy*oy + 2*dz*oz, -3*ox*w2 + 6*w1*w2 + dy*dy + dz*dz, 4*ox*w3 - w3, q3], shape)
+    return _stack([q3 - w0 + oy*oy + oz*oz, 4*dx*w0 - 3*dx*w1 + 2*dy*oy + 2*dz*oz, -3*ox*w2 + 6*w1*w2 + dy*dy + dz*dz, 4*ox*w3 - w3, q1], shape)
 
 
 def value(p, /, **params):

@@ -166,6 +166,7 @@ def _chain_powers(temps: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sy
                 need[p.base] = max(need.get(p.base, 0), int(p.exp))
     if not need:
         return temps, outputs
+    need = {b: need[b] for b in sorted(need, key=sympy.default_sort_key)}  # stable across hash seeds
     names = sympy.numbered_symbols("q", real=True)
     squares: dict[sympy.Expr, list[sympy.Expr]] = {}
     new_defs: dict[sympy.Expr, list[tuple[sympy.Symbol, sympy.Expr]]] = {}
