@@ -1,0 +1,216 @@
+/* Ray/object intersection: algebraic leaves and CSG trees.
+ *
+ * A CSG leaf is the solid {f < 0} cut by its bounds box. Along a ray it is a list of inside-intervals
+ * ("spans"): the roots of f(o + t d) split the clipped ray range into pieces, and the sign of f at each
+ * piece's midpoint says inside or outside. Deciding by sign rather than by counting roots makes tangent and
+ * double roots (a grazing ray) harmless: the pieces on both sides are both outside (or both inside) and
+ * merge. Operators combine span lists of their children with one sweep over the sorted endpoints.
+ */
+#include "tracer_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Spans of one leaf solid over [a, b]. */
+static int leaf_spans(const rt_scene *s, int k, const double o[3], const double d[3], double a, double b,
+                      rt_span *out, int max)
+{
+    const rt_node *n = &s->nodes[k];
+    double oo[3], od[3], r[IG_MAX_DEGREE + 2], x[IG_MAX_DEGREE + 2];
+    int f0 = 0, f1 = 0, nr, nx, i, cnt = 0, inside_prev = 0;
+    rt_end start;
+
+    rt_xform_point(n->minv, o, oo);
+    rt_xform_vector(n->minv, d, od);
+    if (!rt_clip_box(n->obox, oo, od, &a, &b, &f0, &f1)) return 0;
+    if (!(b > a)) return 0;
+    nr = ig_shape_roots(n->shape, n->params, oo, od, a, b, IG_ROOTS_AUTO, r);
+    /* Breakpoints a = x[0] <= roots <= x[nx - 1] = b. */
+    nx = 0;
+    x[nx++] = a;
+    for (i = 0; i < nr; ++i)
+        if (r[i] > x[nx - 1] && r[i] < b) x[nx++] = r[i];
+    x[nx++] = b;
+    start.t = a;
+    start.leaf = -1;
+    start.face = 0;
+    for (i = 0; i + 1 < nx; ++i) {
+        double tm = 0.5 * (x[i] + x[i + 1]), q[3], f;
+        int inside;
+        q[0] = oo[0] + tm * od[0];
+        q[1] = oo[1] + tm * od[1];
+        q[2] = oo[2] + tm * od[2];
+        f = n->shape->value(q, n->params);
+        inside = f < 0.0; /* NaN counts as outside */
+        if (inside && !inside_prev) {
+            start.t = x[i];
+            if (i == 0) {
+                start.leaf = f0 ? k : -1; /* a box face, or open where the ray's range starts inside */
+                start.face = f0;
+            } else {
+                start.leaf = k;
+                start.face = 0;
+            }
+        } else if (!inside && inside_prev) {
+            if (cnt < max) {
+                out[cnt].in = start;
+                out[cnt].out.t = x[i];
+                out[cnt].out.leaf = k;
+                out[cnt].out.face = 0;
+                ++cnt;
+            }
+        }
+        inside_prev = inside;
+    }
+    if (inside_prev && cnt < max) {
+        out[cnt].in = start;
+        out[cnt].out.t = b;
+        out[cnt].out.leaf = f1 ? k : -1;
+        out[cnt].out.face = f1;
+        ++cnt;
+    }
+    return cnt;
+}
+
+static int op_state(int op, int in_a, int in_b)
+{
+    switch (op) {
+    case RT_UNION: return in_a || in_b;
+    case RT_INTERSECTION: return in_a && in_b;
+    default: return in_a && !in_b; /* difference: A and not B */
+    }
+}
+
+/* One sweep over the endpoints of two sorted, disjoint span lists. Where the result's state changes the
+ * endpoint that caused it is kept, so each result boundary remembers its surface. Spans that touch are
+ * merged (no phantom boundary inside a union). */
+static int combine(int op, const rt_span *A, int na, const rt_span *B, int nb, rt_span *out, int max)
+{
+    int ia = 0, ib = 0, in_a = 0, in_b = 0, in_o = 0, n = 0;
+    rt_end start = {0.0, -1, 0};
+    while (ia < 2 * na || ib < 2 * nb) {
+        const rt_end *ea = ia < 2 * na ? ((ia & 1) ? &A[ia >> 1].out : &A[ia >> 1].in) : NULL;
+        const rt_end *eb = ib < 2 * nb ? ((ib & 1) ? &B[ib >> 1].out : &B[ib >> 1].in) : NULL;
+        const rt_end *e;
+        int now;
+        if (!eb || (ea && ea->t <= eb->t)) {
+            e = ea;
+            ++ia;
+            in_a = !in_a;
+        } else {
+            e = eb;
+            ++ib;
+            in_b = !in_b;
+        }
+        now = op_state(op, in_a, in_b);
+        if (now && !in_o) {
+            if (n > 0 && out[n - 1].out.t >= e->t) {
+                start = out[--n].in; /* touches the previous span: reopen it */
+            } else {
+                start = *e;
+            }
+        } else if (!now && in_o) {
+            if (e->t > start.t && n < max) {
+                out[n].in = start;
+                out[n].out = *e;
+                ++n;
+            }
+        }
+        in_o = now;
+    }
+    return n;
+}
+
+int rt_spans(const rt_scene *s, int k, const double o[3], const double d[3], double a, double b, rt_span *out,
+             int max)
+{
+    const rt_node *n = &s->nodes[k];
+    rt_span L[RT_MAX_SPANS], R[RT_MAX_SPANS];
+    int nl, nr;
+    if (n->kind == RT_LEAF) return leaf_spans(s, k, o, d, a, b, out, max);
+    /* The node's box bounds everything below it (an unbounded leaf inside an intersection included). */
+    if (n->wbounded && !rt_clip_box(n->wbox, o, d, &a, &b, NULL, NULL)) return 0;
+    nl = rt_spans(s, n->left, o, d, a, b, L, RT_MAX_SPANS);
+    if (nl == 0 && n->kind != RT_UNION) return 0;
+    nr = rt_spans(s, n->right, o, d, a, b, R, RT_MAX_SPANS);
+    if (nr == 0) {
+        if (n->kind == RT_INTERSECTION) return 0;
+        if (nl > max) nl = max;
+        memcpy(out, L, (size_t)nl * sizeof *L);
+        return nl;
+    }
+    return combine(n->kind, L, nl, R, nr, out, max);
+}
+
+int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d[3], double tmin, double tmax,
+                  double *t_in, double *t_out, int *leaf_in, int *leaf_out, int max)
+{
+    rt_span sp[RT_MAX_SPANS];
+    int n, i;
+    if (!s->committed || node < 0 || node >= s->nnodes) return 0;
+    if (tmax > s->far) tmax = s->far;
+    n = rt_spans(s, node, o, d, tmin, tmax, sp, RT_MAX_SPANS);
+    if (n > max) n = max;
+    for (i = 0; i < n; ++i) {
+        t_in[i] = sp[i].in.t;
+        t_out[i] = sp[i].out.t;
+        if (leaf_in) leaf_in[i] = sp[i].in.leaf;
+        if (leaf_out) leaf_out[i] = sp[i].out.leaf;
+    }
+    return n;
+}
+
+int rt_object_hit(const rt_scene *s, int object, const double o[3], const double d[3], double tmin,
+                  double tmax, double *t, int *leaf, int *face, int *entering, int *entering_known)
+{
+    int k = s->objects[object];
+    const rt_node *n = &s->nodes[k];
+    double lo = tmin, hi = tmax;
+    if (n->wbounded) {
+        if (!rt_clip_box(n->wbox, o, d, &lo, &hi, NULL, NULL)) return 0;
+    } else {
+        double dl = sqrt(rt_dot(d, d));
+        if (dl > 0.0 && hi > s->far / dl) hi = s->far / dl;
+        if (!(hi > lo)) return 0;
+    }
+    if (n->kind == RT_LEAF) {
+        /* A top-level leaf is a surface: its nearest root after tmin. */
+        double oo[3], od[3], r[IG_MAX_DEGREE + 2];
+        int nr, i;
+        rt_xform_point(n->minv, o, oo);
+        rt_xform_vector(n->minv, d, od);
+        nr = ig_shape_roots(n->shape, n->params, oo, od, lo, hi, IG_ROOTS_AUTO, r);
+        for (i = 0; i < nr; ++i)
+            if (r[i] > tmin && r[i] < tmax) {
+                *t = r[i];
+                *leaf = k;
+                *face = 0;
+                *entering = 0;
+                *entering_known = 0;
+                return 1;
+            }
+        return 0;
+    } else {
+        rt_span sp[RT_MAX_SPANS];
+        int ns = rt_spans(s, k, o, d, lo, hi, sp, RT_MAX_SPANS), i;
+        for (i = 0; i < ns; ++i) {
+            if (sp[i].in.t > tmin && sp[i].in.t < tmax && sp[i].in.leaf >= 0) {
+                *t = sp[i].in.t;
+                *leaf = sp[i].in.leaf;
+                *face = sp[i].in.face;
+                *entering = 1;
+                *entering_known = 1;
+                return 1;
+            }
+            if (sp[i].out.t > tmin && sp[i].out.t < tmax && sp[i].out.leaf >= 0) {
+                *t = sp[i].out.t;
+                *leaf = sp[i].out.leaf;
+                *face = sp[i].out.face;
+                *entering = 0;
+                *entering_known = 1;
+                return 1;
+            }
+        }
+        return 0;
+    }
+}

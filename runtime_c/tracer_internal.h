@@ -1,0 +1,83 @@
+/* Data structures shared by the tracer_*.c files; not part of the public interface (see tracer.h). */
+#ifndef IMPLGEN_TRACER_INTERNAL_H
+#define IMPLGEN_TRACER_INTERNAL_H
+
+#include "tracer.h"
+
+typedef struct rt_node {
+    int kind;            /* RT_LEAF, RT_UNION, RT_INTERSECTION, RT_DIFFERENCE */
+    int left, right;     /* children (CSG) */
+    int material;        /* -1: none given (the Python side resolves inheritance before it gets here) */
+    int depth;           /* CSG nesting depth below this node */
+    /* leaf */
+    const ig_shape *shape;
+    double *params;      /* owned copy, shape->nparams entries */
+    double m[12];        /* object -> world */
+    double minv[12];     /* world -> object */
+    double mnorm;        /* Frobenius norm of M's linear part: bounds how much M stretches a distance */
+    double obox[6];      /* object-space bounds box */
+    int obounded;        /* the spec gives bounds (some sides may still be infinite) */
+    /* any node */
+    double wbox[6];      /* world-space box, slightly padded; valid when wbounded */
+    int wbounded;
+} rt_node;
+
+typedef struct rt_bvh_node {
+    double box[6];
+    int left, right;     /* children; -1 for a leaf */
+    int first, count;    /* leaf: bounded objects order[first .. first + count) */
+} rt_bvh_node;
+
+struct rt_scene {
+    rt_node *nodes;
+    int nnodes, cap_nodes;
+    int *objects;        /* node index of each top-level object */
+    int nobjects, cap_objects;
+    rt_material *materials;
+    int nmaterials, cap_materials;
+    double *lights;      /* 6 per light: position, colour x intensity */
+    int nlights, cap_lights;
+    double eye[3], look_at[3], up[3], vfov;
+    double background[3];
+    /* after commit */
+    int committed;
+    double far;          /* stands in for t = infinity on unbounded shapes: 1e5 x the scene's size */
+    int *unbounded;      /* objects outside the BVH */
+    int nunbounded;
+    int *order;          /* bounded objects in BVH leaf order */
+    rt_bvh_node *bvh;
+    int nbvh;
+    char error[256];
+};
+
+/* One end of an inside-interval: where it is and which surface makes it. */
+typedef struct rt_end {
+    double t;
+    int leaf;            /* node index of the leaf, -1: open (the ray's range starts/ends inside) */
+    int face;            /* 0: the surface f = 0; +-(axis + 1): outward face of the leaf's bounds box */
+} rt_end;
+
+typedef struct rt_span {
+    rt_end in, out;
+} rt_span;
+
+/* tracer_scene.c */
+void rt_xform_point(const double m[12], const double p[3], double out[3]);
+void rt_xform_vector(const double m[12], const double v[3], double out[3]);
+int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0,
+                int *f1);
+/* Fills hit (normal, error bound, object-space point) for a hit at t on `leaf` with the given face. */
+void rt_finish_hit(const rt_scene *s, int object, int leaf, int face, int entering_known, int entering,
+                   const double o[3], const double d[3], double t, rt_hit *hit);
+
+/* tracer_csg.c */
+int rt_spans(const rt_scene *s, int node, const double o[3], const double d[3], double a, double b,
+             rt_span *out, int max);
+/* Closest hit of one top-level object with tmin < t < tmax; fills leaf/face/entering. */
+int rt_object_hit(const rt_scene *s, int object, const double o[3], const double d[3], double tmin,
+                  double tmax, double *t, int *leaf, int *face, int *entering, int *entering_known);
+
+/* small vector helpers */
+static inline double rt_dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+#endif

@@ -1,0 +1,261 @@
+/* Optics and shading: reflection, refraction (Snell), exact Fresnel, Beer-Lambert absorption, shadow rays
+ * that pass through glass attenuated by its transparency and absorption, and the Whitted recursion.
+ *
+ * Light model (deliberately the classic one, documented in docs/tracer.md):
+ *   colour = (1 - transparency) * [ambient * base + sum over lights of T_shadow * light *
+ *                                   (diffuse * base * max(0, n.l) + specular * max(0, n.h)^shininess)]
+ *          + (reflectivity + transparency * F) * reflected + transparency * (1 - F) * refracted
+ * with F the Fresnel reflectance (1 under total internal reflection), base the material colour or checker.
+ * Everything a ray sees while inside a transparent solid is attenuated by exp(-absorption * distance).
+ */
+#include "tracer_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+#define RT_MIN_WEIGHT 1e-3 /* secondary rays contributing less than this to the pixel are not cast */
+#define RT_MAX_SHADOW_CROSSINGS 32
+
+static void normalize3(double v[3])
+{
+    double l = sqrt(rt_dot(v, v));
+    if (l > 0.0) {
+        v[0] /= l;
+        v[1] /= l;
+        v[2] /= l;
+    }
+}
+
+void rt_reflect(const double d[3], const double n[3], double r[3])
+{
+    double u[3], k;
+    int a;
+    memcpy(u, d, sizeof u);
+    normalize3(u);
+    k = 2.0 * rt_dot(u, n);
+    for (a = 0; a < 3; ++a) r[a] = u[a] - k * n[a];
+    normalize3(r);
+}
+
+int rt_refract(const double d[3], const double n[3], double eta, double t[3])
+{
+    double u[3], ci, k;
+    int a;
+    memcpy(u, d, sizeof u);
+    normalize3(u);
+    ci = -rt_dot(u, n);
+    k = 1.0 - eta * eta * (1.0 - ci * ci);
+    if (k < 0.0) return 0;
+    for (a = 0; a < 3; ++a) t[a] = eta * u[a] + (eta * ci - sqrt(k)) * n[a];
+    normalize3(t);
+    return 1;
+}
+
+double rt_fresnel(double ci, double eta)
+{
+    double st2, ct, rs, rp;
+    if (ci < 0.0) ci = -ci;
+    if (ci > 1.0) ci = 1.0;
+    st2 = eta * eta * (1.0 - ci * ci);
+    if (st2 >= 1.0) return 1.0;
+    ct = sqrt(1.0 - st2);
+    rs = (eta * ci - ct) / (eta * ci + ct);
+    rp = (ci - eta * ct) / (ci + eta * ct);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+void rt_spawn_origin(const rt_hit *h, const double d[3], double origin[3])
+{
+    double side = rt_dot(d, h->n) >= 0.0 ? h->err : -h->err;
+    int a;
+    for (a = 0; a < 3; ++a) origin[a] = h->p[a] + side * h->n[a];
+}
+
+/* ------------------------------------------------------------------ shading */
+
+typedef struct rt_media {
+    int n;
+    int mat[RT_MAX_MEDIA];
+} rt_media;
+
+typedef struct rt_tracer {
+    const rt_scene *s;
+    int max_depth;
+    double *stats;
+} rt_tracer;
+
+static double media_ior(const rt_scene *s, const rt_media *m)
+{
+    return m->n > 0 ? s->materials[m->mat[m->n - 1]].ior : 1.0;
+}
+
+static void media_remove(rt_media *m, int mat)
+{
+    int i;
+    for (i = m->n - 1; i >= 0; --i)
+        if (m->mat[i] == mat) {
+            memmove(m->mat + i, m->mat + i + 1, (size_t)(m->n - 1 - i) * sizeof(int));
+            m->n--;
+            return;
+        }
+}
+
+static void base_colour(const rt_material *m, const rt_hit *h, double c[3])
+{
+    if (m->checker_scale > 0.0) {
+        /* A 3-D checker in object space, evaluated a little below the surface (a fraction of a cell) so a
+         * surface lying exactly on a cell boundary, like the plane y = 0, does not speckle. */
+        double q, sum = 0.0;
+        int a;
+        for (a = 0; a < 3; ++a) {
+            q = (h->po[a] - 1e-3 * m->checker_scale * h->no[a]) / m->checker_scale;
+            sum += fmod(fabs(floor(q)), 2.0);
+        }
+        memcpy(c, fmod(sum, 2.0) < 0.5 ? m->color : m->color2, 3 * sizeof(double));
+    } else {
+        memcpy(c, m->color, 3 * sizeof(double));
+    }
+}
+
+/* Fraction of a light's colour that reaches p through the scene (0 behind an opaque object). Transparent
+ * objects let transparency through at each entry and absorb inside; refraction does not bend shadow rays. */
+static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const double light[3], double T[3])
+{
+    const rt_scene *s = tr->s;
+    double q[3], dd[3];
+    rt_hit h;
+    int i, a;
+    T[0] = T[1] = T[2] = 1.0;
+    for (a = 0; a < 3; ++a) dd[a] = light[a] - from->p[a];
+    rt_spawn_origin(from, dd, q);
+    for (i = 0; i < RT_MAX_SHADOW_CROSSINGS; ++i) {
+        const rt_material *m;
+        for (a = 0; a < 3; ++a) dd[a] = light[a] - q[a];
+        if (tr->stats) tr->stats[RT_RAYS_SHADOW] += 1.0;
+        if (!rt_scene_intersect(s, q, dd, 0.0, 1.0, &h)) return;
+        m = &s->materials[h.material];
+        if (m->transparency <= 0.0) {
+            T[0] = T[1] = T[2] = 0.0;
+            return;
+        }
+        if (h.entering) {
+            for (a = 0; a < 3; ++a) T[a] *= m->transparency;
+        } else {
+            double len = h.t * sqrt(rt_dot(dd, dd));
+            for (a = 0; a < 3; ++a) T[a] *= exp(-m->absorption[a] * len);
+        }
+        if (T[0] + T[1] + T[2] < 1e-4) {
+            T[0] = T[1] = T[2] = 0.0;
+            return;
+        }
+        rt_spawn_origin(&h, dd, q);
+    }
+}
+
+static void trace(const rt_tracer *tr, const double o[3], const double d[3], int depth, const rt_media *media,
+                  double weight, double rgb[3])
+{
+    const rt_scene *s = tr->s;
+    const rt_material *m;
+    rt_hit h;
+    double u[3], nf[3], base[3], local[3], col[3], dl;
+    int a, l;
+
+    if (!rt_scene_intersect(s, o, d, 0.0, INFINITY, &h)) {
+        memcpy(rgb, s->background, 3 * sizeof(double));
+        return;
+    }
+    m = &s->materials[h.material];
+    dl = sqrt(rt_dot(d, d));
+    for (a = 0; a < 3; ++a) u[a] = d[a] / dl;
+    if (rt_dot(h.n, u) < 0.0) memcpy(nf, h.n, sizeof nf);
+    else
+        for (a = 0; a < 3; ++a) nf[a] = -h.n[a];
+
+    base_colour(m, &h, base);
+    for (a = 0; a < 3; ++a) local[a] = m->ambient * base[a];
+    if (m->transparency < 1.0) {
+        for (l = 0; l < s->nlights; ++l) {
+            const double *lp = s->lights + 6 * l, *lc = lp + 3;
+            double L[3], ll, ndl, T[3], spec = 0.0;
+            for (a = 0; a < 3; ++a) L[a] = lp[a] - h.p[a];
+            ll = sqrt(rt_dot(L, L));
+            if (!(ll > 0.0)) continue;
+            ndl = rt_dot(nf, L) / ll;
+            if (ndl <= 0.0) continue; /* the light is behind the surface as seen from the ray */
+            shadow_transmittance(tr, &h, lp, T);
+            if (T[0] + T[1] + T[2] <= 0.0) continue;
+            if (m->specular > 0.0) {
+                double hv[3], ndh;
+                for (a = 0; a < 3; ++a) hv[a] = L[a] / ll - u[a];
+                normalize3(hv);
+                ndh = rt_dot(nf, hv);
+                if (ndh > 0.0) spec = m->specular * pow(ndh, m->shininess);
+            }
+            for (a = 0; a < 3; ++a) local[a] += T[a] * lc[a] * (m->diffuse * base[a] * ndl + spec);
+        }
+    }
+    for (a = 0; a < 3; ++a) col[a] = (1.0 - m->transparency) * local[a];
+
+    if (depth < tr->max_depth) {
+        double ci = -rt_dot(u, nf), F = 0.0, kr, kt, tdir[3];
+        rt_media next = *media;
+        int can_refract = 0;
+        if (m->transparency > 0.0) {
+            double n1, n2;
+            if (h.entering) {
+                n1 = media_ior(s, media);
+                n2 = m->ior;
+                if (next.n < RT_MAX_MEDIA) next.mat[next.n++] = h.material;
+            } else {
+                n1 = m->ior;
+                media_remove(&next, h.material);
+                n2 = media_ior(s, &next);
+            }
+            can_refract = rt_refract(u, nf, n1 / n2, tdir);
+            F = can_refract ? rt_fresnel(ci, n1 / n2) : 1.0;
+        }
+        kr = m->reflectivity + m->transparency * F;
+        if (kr > 1.0) kr = 1.0;
+        kt = can_refract ? m->transparency * (1.0 - F) : 0.0;
+        if (kr * weight > RT_MIN_WEIGHT) {
+            double r[3], q[3], c[3];
+            rt_reflect(u, nf, r);
+            rt_spawn_origin(&h, r, q);
+            if (tr->stats) tr->stats[RT_RAYS_SECONDARY] += 1.0;
+            trace(tr, q, r, depth + 1, media, weight * kr, c);
+            for (a = 0; a < 3; ++a) col[a] += kr * c[a];
+        }
+        if (kt * weight > RT_MIN_WEIGHT) {
+            double q[3], c[3];
+            rt_spawn_origin(&h, tdir, q);
+            if (tr->stats) tr->stats[RT_RAYS_SECONDARY] += 1.0;
+            trace(tr, q, tdir, depth + 1, &next, weight * kt, c);
+            for (a = 0; a < 3; ++a) col[a] += kt * c[a];
+        }
+    }
+    /* Beer-Lambert over the segment just travelled, if it ran inside an absorbing medium. */
+    if (media->n > 0) {
+        const rt_material *mm = &s->materials[media->mat[media->n - 1]];
+        double len = h.t * dl;
+        for (a = 0; a < 3; ++a) col[a] *= exp(-mm->absorption[a] * len);
+    }
+    memcpy(rgb, col, 3 * sizeof(double));
+}
+
+void rt_trace_ray(const rt_scene *s, const double o[3], const double d[3], int max_depth, double rgb[3],
+                  double stats[RT_NSTATS])
+{
+    rt_tracer tr;
+    rt_media media;
+    tr.s = s;
+    tr.max_depth = max_depth < 0 ? 0 : (max_depth > RT_MAX_DEPTH ? RT_MAX_DEPTH : max_depth);
+    tr.stats = stats;
+    media.n = 0;
+    if (stats) stats[RT_RAYS_PRIMARY] += 1.0;
+    if (!s->committed) {
+        rgb[0] = rgb[1] = rgb[2] = 0.0;
+        return;
+    }
+    trace(&tr, o, d, 0, &media, 1.0, rgb);
+}
