@@ -2,7 +2,7 @@
  *
  *   f(x, y, z) = x^10 + y^10 + z^10 - 1 + 0.3*((x^2 + y^2 + z^2 + 0.5^2 - 0.25^2)^2 - 4*0.5^2*(x^2 + y^2))
  *   degree 10; inside is f < 0, outside f > 0; outward normal = grad f / |grad f|
- *   arithmetic operations: coeffs 203, value 32, gradient 36
+ *   arithmetic operations: coeffs 191, value 29, gradient 33
  */
 #include "blobs10.h"
 
@@ -36,27 +36,27 @@ void blobs10_coeffs(const double o[3], const double d[3], const double *params, 
     const double q15 = oz*oz;
     const double q16 = q15*q15;
     const double q17 = q16*q16;
-    const double w0 = ox*ox;
-    const double w1 = oy*oy;
-    const double w2 = oz*oz;
+    const double w0 = q9;
+    const double w1 = q12;
+    const double w2 = q15;
     const double w3 = w0 + w1 + w2 + 3.0/16.0;
     const double w4 = dx*ox;
     const double w5 = dy*oy;
     const double w6 = 2*dz*oz + 2*w4 + 2*w5;
     const double w7 = (3.0/5.0)*w3;
-    const double w8 = dx*dx;
-    const double w9 = dy*dy;
-    const double w10 = dz*dz;
+    const double w8 = q0;
+    const double w9 = q3;
+    const double w10 = q6;
     const double w11 = w10 + w8 + w9;
 
     c[0] = q11*q9 + q12*q14 + q15*q17 - 3.0/10.0*w0 - 3.0/10.0*w1 - 1 + (3.0/10.0)*(w3*w3);
     c[1] = 10*dx*ox*q11 + 10*dy*oy*q14 + 10*dz*oz*q17 - 3.0/5.0*w4 - 3.0/5.0*w5 + w6*w7;
     c[2] = 45*q11*w8 + 45*q14*w9 + 45*q17*w10 + w11*w7 - 3.0/10.0*w8 - 3.0/10.0*w9 + (3.0/10.0)*(w6*w6);
-    c[3] = 120*ox*q10*q9*(dx*dx*dx) + 120*oy*q12*q13*(dy*dy*dy) + 120*oz*q15*q16*(dz*dz*dz) + (3.0/5.0)*w11*w6;
+    c[3] = 120*dx*ox*q0*q10*q9 + 120*dy*oy*q12*q13*q3 + 120*dz*oz*q15*q16*q6 + (3.0/5.0)*w11*w6;
     c[4] = 210*q1*q10*q9 + 210*q12*q13*q4 + 210*q15*q16*q7 + (3.0/10.0)*(w11*w11);
     c[5] = 252*dx*ox*q1*q10 + 252*dy*oy*q13*q4 + 252*dz*oz*q16*q7;
     c[6] = 210*q0*q1*q10 + 210*q13*q3*q4 + 210*q16*q6*q7;
-    c[7] = 120*dx*q0*q1*(ox*ox*ox) + 120*dy*q3*q4*(oy*oy*oy) + 120*dz*q6*q7*(oz*oz*oz);
+    c[7] = 120*dx*ox*q0*q1*q9 + 120*dy*oy*q12*q3*q4 + 120*dz*oz*q15*q6*q7;
     c[8] = 45*q2*w0 + 45*q5*w1 + 45*q8*w2;
     c[9] = 10*dx*ox*q2 + 10*dy*oy*q5 + 10*dz*oz*q8;
     c[10] = q0*q2 + q3*q5 + q6*q8;
@@ -77,9 +77,9 @@ double blobs10_value(const double p[3], const double *params)
     const double q24 = pz*pz;
     const double q25 = q24*q24;
     const double q26 = q25*q25;
-    const double w12 = px*px;
-    const double w13 = py*py;
-    const double w14 = w12 + w13 + 3.0/16.0 + pz*pz;
+    const double w12 = q18;
+    const double w13 = q21;
+    const double w14 = q24 + w12 + w13 + 3.0/16.0;
 
     return q18*q20 + q21*q23 + q24*q26 - 3.0/10.0*w12 - 3.0/10.0*w13 - 1 + (3.0/10.0)*(w14*w14);
 }
@@ -99,9 +99,9 @@ void blobs10_gradient(const double p[3], const double *params, double g[3])
     const double q24 = pz*pz;
     const double q25 = q24*q24;
     const double q26 = q25*q25;
-    const double w12 = px*px;
-    const double w13 = py*py;
-    const double w14 = w12 + w13 + 3.0/16.0 + pz*pz;
+    const double w12 = q18;
+    const double w13 = q21;
+    const double w14 = q24 + w12 + w13 + 3.0/16.0;
     const double w15 = (6.0/5.0)*w14;
 
     g[0] = 10*px*q20 + px*w15 - 3.0/5.0*px;

@@ -2,7 +2,7 @@
  *
  *   f(x, y, z) = x^10 + y^10 + z^10 - 1 + 0.3*((x^2 + y^2 + z^2 + 0.5^2 - 0.25^2)^2 - 4*0.5^2*(x^2 + y^2))
  *   degree 10; inside is f < 0, outside f > 0; outward normal = grad f / |grad f|
- *   arithmetic operations: coeffs 203, value 32, gradient 36
+ *   arithmetic operations: coeffs 191, value 29, gradient 33
  */
 #ifndef IMPLGEN_GENERATED_BLOBS10_H
 #define IMPLGEN_GENERATED_BLOBS10_H

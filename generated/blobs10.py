@@ -2,7 +2,7 @@
 
     f(x, y, z) = x^10 + y^10 + z^10 - 1 + 0.3*((x^2 + y^2 + z^2 + 0.5^2 - 0.25^2)^2 - 4*0.5^2*(x^2 + y^2))
     degree 10; inside is f < 0, outside f > 0; outward normal = grad f / |grad f|
-    arithmetic operations: coeffs 203, value 32, gradient 36
+    arithmetic operations: coeffs 191, value 29, gradient 33
 
 Every function broadcasts over NumPy arrays whose last axis has length 3 (plain sequences work too).
 `intersect` solves with implgen's C root solvers (`implgen.raycast`), so it needs implgen installed.
@@ -64,20 +64,20 @@ def coeffs(o, d, /, **params):
     q15 = oz*oz
     q16 = q15*q15
     q17 = q16*q16
-    w0 = ox*ox
-    w1 = oy*oy
-    w2 = oz*oz
+    w0 = q9
+    w1 = q12
+    w2 = q15
     w3 = w0 + w1 + w2 + 3/16
     w4 = dx*ox
     w5 = dy*oy
     w6 = 2*dz*oz + 2*w4 + 2*w5
     w7 = (3/5)*w3
-    w8 = dx*dx
-    w9 = dy*dy
-    w10 = dz*dz
+    w8 = q0
+    w9 = q3
+    w10 = q6
     w11 = w10 + w8 + w9
 
-    return _stack([q11*q9 + q12*q14 + q15*q17 - 3/10*w0 - 3/10*w1 - 1 + (3/10)*(w3*w3), 10*dx*ox*q11 + 10*dy*oy*q14 + 10*dz*oz*q17 - 3/5*w4 - 3/5*w5 + w6*w7, 45*q11*w8 + 45*q14*w9 + 45*q17*w10 + w11*w7 - 3/10*w8 - 3/10*w9 + (3/10)*(w6*w6), 120*ox*q10*q9*(dx*dx*dx) + 120*oy*q12*q13*(dy*dy*dy) + 120*oz*q15*q16*(dz*dz*dz) + (3/5)*w11*w6, 210*q1*q10*q9 + 210*q12*q13*q4 + 210*q15*q16*q7 + (3/10)*(w11*w11), 252*dx*ox*q1*q10 + 252*dy*oy*q13*q4 + 252*dz*oz*q16*q7, 210*q0*q1*q10 + 210*q13*q3*q4 + 210*q16*q6*q7, 120*dx*q0*q1*(ox*ox*ox) + 120*dy*q3*q4*(oy*oy*oy) + 120*dz*q6*q7*(oz*oz*oz), 45*q2*w0 + 45*q5*w1 + 45*q8*w2, 10*dx*ox*q2 + 10*dy*oy*q5 + 10*dz*oz*q8, q0*q2 + q3*q5 + q6*q8], shape)
+    return _stack([q11*q9 + q12*q14 + q15*q17 - 3/10*w0 - 3/10*w1 - 1 + (3/10)*(w3*w3), 10*dx*ox*q11 + 10*dy*oy*q14 + 10*dz*oz*q17 - 3/5*w4 - 3/5*w5 + w6*w7, 45*q11*w8 + 45*q14*w9 + 45*q17*w10 + w11*w7 - 3/10*w8 - 3/10*w9 + (3/10)*(w6*w6), 120*dx*ox*q0*q10*q9 + 120*dy*oy*q12*q13*q3 + 120*dz*oz*q15*q16*q6 + (3/5)*w11*w6, 210*q1*q10*q9 + 210*q12*q13*q4 + 210*q15*q16*q7 + (3/10)*(w11*w11), 252*dx*ox*q1*q10 + 252*dy*oy*q13*q4 + 252*dz*oz*q16*q7, 210*q0*q1*q10 + 210*q13*q3*q4 + 210*q16*q6*q7, 120*dx*ox*q0*q1*q9 + 120*dy*oy*q12*q3*q4 + 120*dz*oz*q15*q6*q7, 45*q2*w0 + 45*q5*w1 + 45*q8*w2, 10*dx*ox*q2 + 10*dy*oy*q5 + 10*dz*oz*q8, q0*q2 + q3*q5 + q6*q8], shape)
 
 
 def value(p, /, **params):
@@ -97,9 +97,9 @@ def value(p, /, **params):
     q24 = pz*pz
     q25 = q24*q24
     q26 = q25*q25
-    w12 = px*px
-    w13 = py*py
-    w14 = w12 + w13 + 3/16 + pz*pz
+    w12 = q18
+    w13 = q21
+    w14 = q24 + w12 + w13 + 3/16
 
     return np.broadcast_to(np.asarray(q18*q20 + q21*q23 + q24*q26 - 3/10*w12 - 3/10*w13 - 1 + (3/10)*(w14*w14), dtype=float), shape).copy()
 
@@ -121,9 +121,9 @@ def gradient(p, /, **params):
     q24 = pz*pz
     q25 = q24*q24
     q26 = q25*q25
-    w12 = px*px
-    w13 = py*py
-    w14 = w12 + w13 + 3/16 + pz*pz
+    w12 = q18
+    w13 = q21
+    w14 = q24 + w12 + w13 + 3/16
     w15 = (6/5)*w14
 
     return _stack([10*px*q20 + px*w15 - 3/5*px, 10*py*q23 + py*w15 - 3/5*py, 10*pz*q26 + pz*w15], shape)

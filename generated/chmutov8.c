@@ -2,7 +2,7 @@
  *
  *   f(x, y, z) = 3 + 128*(x^8 + y^8 + z^8) - 256*(x^6 + y^6 + z^6) + 160*(x^4 + y^4 + z^4) - 32*(x^2 + y^2 + z^2)
  *   degree 8; inside is f < 0, outside f > 0; outward normal = grad f / |grad f|
- *   arithmetic operations: coeffs 244, value 39, gradient 42
+ *   arithmetic operations: coeffs 232, value 36, gradient 39
  */
 #include "chmutov8.h"
 
@@ -39,24 +39,24 @@ void chmutov8_coeffs(const double o[3], const double d[3], const double *params,
     const double w0 = q10*q9;
     const double w1 = q12*q13;
     const double w2 = q15*q16;
-    const double w3 = ox*ox;
-    const double w4 = oy*oy;
-    const double w5 = oz*oz;
+    const double w3 = q9;
+    const double w4 = q12;
+    const double w5 = q15;
     const double w6 = q10;
     const double w7 = q13;
     const double w8 = q16;
     const double w9 = ox*q10;
     const double w10 = oy*q13;
     const double w11 = oz*q16;
-    const double w12 = ox*ox*ox;
-    const double w13 = oy*oy*oy;
-    const double w14 = oz*oz*oz;
-    const double w15 = dx*dx;
-    const double w16 = dy*dy;
-    const double w17 = dz*dz;
-    const double w18 = dx*dx*dx;
-    const double w19 = dy*dy*dy;
-    const double w20 = dz*dz*dz;
+    const double w12 = ox*q9;
+    const double w13 = oy*q12;
+    const double w14 = oz*q15;
+    const double w15 = q0;
+    const double w16 = q3;
+    const double w17 = q6;
+    const double w18 = dx*q0;
+    const double w19 = dy*q3;
+    const double w20 = dz*q6;
     const double w21 = q1;
     const double w22 = q4;
     const double w23 = q7;
@@ -94,7 +94,7 @@ double chmutov8_value(const double p[3], const double *params)
     const double q25 = q24*q24;
     const double q26 = q25*q25;
 
-    return -256*q18*q19 + 160*q19 + 128*q20 - 256*q21*q22 + 160*q22 + 128*q23 - 256*q24*q25 + 160*q25 + 128*q26 + 3 - 32*px*px - 32*py*py - 32*pz*pz;
+    return -256*q18*q19 - 32*q18 + 160*q19 + 128*q20 - 256*q21*q22 - 32*q21 + 160*q22 + 128*q23 - 256*q24*q25 - 32*q24 + 160*q25 + 128*q26 + 3;
 }
 
 void chmutov8_gradient(const double p[3], const double *params, double g[3])
@@ -110,9 +110,9 @@ void chmutov8_gradient(const double p[3], const double *params, double g[3])
     const double q24 = pz*pz;
     const double q25 = q24*q24;
 
-    g[0] = 1024*px*q18*q19 - 1536*px*q19 - 64*px + 640*(px*px*px);
-    g[1] = 1024*py*q21*q22 - 1536*py*q22 - 64*py + 640*(py*py*py);
-    g[2] = 1024*pz*q24*q25 - 1536*pz*q25 - 64*pz + 640*(pz*pz*pz);
+    g[0] = 1024*px*q18*q19 + 640*px*q18 - 1536*px*q19 - 64*px;
+    g[1] = 1024*py*q21*q22 + 640*py*q21 - 1536*py*q22 - 64*py;
+    g[2] = 1024*pz*q24*q25 + 640*pz*q24 - 1536*pz*q25 - 64*pz;
 }
 
 int chmutov8_bounds(const double *params, double box[6])

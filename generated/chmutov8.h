@@ -2,7 +2,7 @@
  *
  *   f(x, y, z) = 3 + 128*(x^8 + y^8 + z^8) - 256*(x^6 + y^6 + z^6) + 160*(x^4 + y^4 + z^4) - 32*(x^2 + y^2 + z^2)
  *   degree 8; inside is f < 0, outside f > 0; outward normal = grad f / |grad f|
- *   arithmetic operations: coeffs 244, value 39, gradient 42
+ *   arithmetic operations: coeffs 232, value 36, gradient 39
  */
 #ifndef IMPLGEN_GENERATED_CHMUTOV8_H
 #define IMPLGEN_GENERATED_CHMUTOV8_H

@@ -2,7 +2,7 @@
 
     f(x, y, z) = 3 + 128*(x^8 + y^8 + z^8) - 256*(x^6 + y^6 + z^6) + 160*(x^4 + y^4 + z^4) - 32*(x^2 + y^2 + z^2)
     degree 8; inside is f < 0, outside f > 0; outward normal = grad f / |grad f|
-    arithmetic operations: coeffs 244, value 39, gradient 42
+    arithmetic operations: coeffs 232, value 36, gradient 39
 
 Every function broadcasts over NumPy arrays whose last axis has length 3 (plain sequences work too).
 `intersect` solves with implgen's C root solvers (`implgen.raycast`), so it needs implgen installed.
@@ -67,24 +67,24 @@ def coeffs(o, d, /, **params):
     w0 = q10*q9
     w1 = q12*q13
     w2 = q15*q16
-    w3 = ox*ox
-    w4 = oy*oy
-    w5 = oz*oz
+    w3 = q9
+    w4 = q12
+    w5 = q15
     w6 = q10
     w7 = q13
     w8 = q16
     w9 = ox*q10
     w10 = oy*q13
     w11 = oz*q16
-    w12 = ox*ox*ox
-    w13 = oy*oy*oy
-    w14 = oz*oz*oz
-    w15 = dx*dx
-    w16 = dy*dy
-    w17 = dz*dz
-    w18 = dx*dx*dx
-    w19 = dy*dy*dy
-    w20 = dz*dz*dz
+    w12 = ox*q9
+    w13 = oy*q12
+    w14 = oz*q15
+    w15 = q0
+    w16 = q3
+    w17 = q6
+    w18 = dx*q0
+    w19 = dy*q3
+    w20 = dz*q6
     w21 = q1
     w22 = q4
     w23 = q7
@@ -116,7 +116,7 @@ def value(p, /, **params):
     q25 = q24*q24
     q26 = q25*q25
 
-    return np.broadcast_to(np.asarray(-256*q18*q19 + 160*q19 + 128*q20 - 256*q21*q22 + 160*q22 + 128*q23 - 256*q24*q25 + 160*q25 + 128*q26 + 3 - 32*px*px - 32*py*py - 32*pz*pz, dtype=float), shape).copy()
+    return np.broadcast_to(np.asarray(-256*q18*q19 - 32*q18 + 160*q19 + 128*q20 - 256*q21*q22 - 32*q21 + 160*q22 + 128*q23 - 256*q24*q25 - 32*q24 + 160*q25 + 128*q26 + 3, dtype=float), shape).copy()
 
 
 def gradient(p, /, **params):
@@ -134,7 +134,7 @@ def gradient(p, /, **params):
     q24 = pz*pz
     q25 = q24*q24
 
-    return _stack([1024*px*q18*q19 - 1536*px*q19 - 64*px + 640*(px*px*px), 1024*py*q21*q22 - 1536*py*q22 - 64*py + 640*(py*py*py), 1024*pz*q24*q25 - 1536*pz*q25 - 64*pz + 640*(pz*pz*pz)], shape)
+    return _stack([1024*px*q18*q19 + 640*px*q18 - 1536*px*q19 - 64*px, 1024*py*q21*q22 + 640*py*q21 - 1536*py*q22 - 64*py, 1024*pz*q24*q25 + 640*pz*q24 - 1536*pz*q25 - 64*pz], shape)
 
 
 def bounds(**params):

@@ -2,7 +2,7 @@
  *
  *   f(x, y, z) = (x^4 - x^3) + y^2 + z^2
  *   degree 4; inside is f < 0, outside f > 0; outward normal = grad f / |grad f|
- *   arithmetic operations: coeffs 38, value 9, gradient 8
+ *   arithmetic operations: coeffs 34, value 8, gradient 7
  */
 #include "piriform.h"
 
@@ -22,10 +22,10 @@ void piriform_coeffs(const double o[3], const double d[3], const double *params,
     const double q1 = q0*q0;
     const double q2 = ox*ox;
     const double q3 = q2*q2;
-    const double w0 = ox*ox*ox;
-    const double w1 = ox*ox;
-    const double w2 = dx*dx;
-    const double w3 = dx*dx*dx;
+    const double w0 = ox*q2;
+    const double w1 = q2;
+    const double w2 = q0;
+    const double w3 = dx*q0;
 
     c[0] = q3 - w0 + oy*oy + oz*oz;
     c[1] = 4*dx*w0 - 3*dx*w1 + 2*dy*oy + 2*dz*oz;
@@ -42,7 +42,7 @@ double piriform_value(const double p[3], const double *params)
     const double pz = p[2];
     const double q4 = px*px;
     const double q5 = q4*q4;
-    const double w4 = px*px*px;
+    const double w4 = px*q4;
 
     return q5 - w4 + py*py + pz*pz;
 }
@@ -53,9 +53,10 @@ void piriform_gradient(const double p[3], const double *params, double g[3])
     const double px = p[0];
     const double py = p[1];
     const double pz = p[2];
-    const double w4 = px*px*px;
+    const double q4 = px*px;
+    const double w4 = px*q4;
 
-    g[0] = 4*w4 - 3*px*px;
+    g[0] = -3*q4 + 4*w4;
     g[1] = 2*py;
     g[2] = 2*pz;
 }

@@ -2,7 +2,7 @@
  *
  *   f(x, y, z) = (x^4 - x^3) + y^2 + z^2
  *   degree 4; inside is f < 0, outside f > 0; outward normal = grad f / |grad f|
- *   arithmetic operations: coeffs 38, value 9, gradient 8
+ *   arithmetic operations: coeffs 34, value 8, gradient 7
  */
 #ifndef IMPLGEN_GENERATED_PIRIFORM_H
 #define IMPLGEN_GENERATED_PIRIFORM_H

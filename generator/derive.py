@@ -153,7 +153,7 @@ def _split(temps: Sequence[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sympy
 
 
 def _chain_powers(temps: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sympy.Expr]):
-    """Rewrite b**k (k >= 4) as products of shared squares b2 = b*b, b4 = b2*b2, ...
+    """Rewrite b**k as products of shared squares b2 = b*b, b4 = b2*b2, ... wherever b**4 or higher occurs.
 
     SymPy folds repeated products into powers (the series of x^20 has ox**20), and printing those as
     k - 1 multiplications wastes work; square-and-multiply over shared temporaries needs about log2(k).
@@ -162,8 +162,9 @@ def _chain_powers(temps: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sy
     need: dict[sympy.Expr, int] = {}
     for e in exprs:
         for p in e.atoms(sympy.Pow):
-            if p.exp.is_Integer and p.exp >= 4:
+            if p.exp.is_Integer and p.exp >= 2:
                 need[p.base] = max(need.get(p.base, 0), int(p.exp))
+    need = {b: k for b, k in need.items() if k >= 4}  # squares and cubes alone print fine as b*b, b*b*b
     if not need:
         return temps, outputs
     need = {b: need[b] for b in sorted(need, key=sympy.default_sort_key)}  # stable across hash seeds
@@ -184,7 +185,7 @@ def _chain_powers(temps: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sy
         return sympy.Mul(*factors, evaluate=False) if len(factors) > 1 else factors[0]
 
     def rewrite(e: sympy.Expr) -> sympy.Expr:
-        return e.replace(lambda a: a.is_Pow and a.base in squares and a.exp.is_Integer and a.exp >= 4,
+        return e.replace(lambda a: a.is_Pow and a.base in squares and a.exp.is_Integer and a.exp >= 2,
                          lambda a: product(a.base, int(a.exp)))
 
     defined: set[sympy.Expr] = set()
