@@ -1,0 +1,119 @@
+"""Real roots of polynomials through the C solvers of the runtime (`runtime_c/roots*.c`).
+
+    real_roots(coeffs, lo=-inf, hi=inf, method="auto") -> sorted np.ndarray
+    real_roots_batch(coeffs_2d, lo, hi, method) -> (roots padded with NaN, counts)
+
+Coefficients are lowest power first. The C library is compiled on first use into the content-hash build
+cache (`implgen.cbuild`), so a plain `pip install` needs no build step.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import cbuild
+from .errors import UserError
+from .resources import runtime_dir
+
+MAX_DEGREE = 24
+METHODS: dict[str, int] = {"auto": 0, "closed": 1, "sturm": 2, "bracket": 3}
+#: bench-only: the classic unpolished closed forms (Schwarze-style), the speed baseline of the report
+BENCH_METHODS: dict[str, int] = {**METHODS, "closed_plain": 10}
+
+_DP = ctypes.POINTER(ctypes.c_double)
+_IP = ctypes.POINTER(ctypes.c_int)
+
+
+def solver_sources() -> list:
+    """The C sources of the root solvers (everything `roots*.c` in the installed runtime)."""
+    return sorted(runtime_dir().glob("roots*.c"))
+
+
+@lru_cache(maxsize=1)
+def library() -> ctypes.CDLL:
+    """The compiled solver library (built once, then loaded from the cache)."""
+    path = cbuild.build_shared(solver_sources(), include_dirs=[runtime_dir()], tag="roots")
+    lib = cbuild.load(path)
+    lib.ig_real_roots_any.restype = ctypes.c_int
+    lib.ig_real_roots_any.argtypes = [_DP, ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_int, _DP]
+    lib.ig_real_roots_batch.restype = None
+    lib.ig_real_roots_batch.argtypes = [_DP, ctypes.c_int, ctypes.c_long, _DP, _DP, ctypes.c_int, _DP, _IP]
+    lib.ig_bench_solve_batch.restype = ctypes.c_double
+    lib.ig_bench_solve_batch.argtypes = [_DP, ctypes.c_int, ctypes.c_long, _DP, _DP, ctypes.c_int, _DP, _IP, _DP]
+    return lib
+
+
+def method_id(method: str, bench: bool = False) -> int:
+    """The C id of a method name; UserError naming the choices otherwise."""
+    table = BENCH_METHODS if bench else METHODS
+    if not isinstance(method, str) or method not in table:
+        raise UserError("method", f"unknown root method {method!r}; choose one of: {', '.join(table)}")
+    return table[method]
+
+
+def _coeff_matrix(coeffs: ArrayLike) -> np.ndarray:
+    c = np.ascontiguousarray(np.asarray(coeffs, dtype=np.float64))
+    if c.ndim != 2 or c.shape[1] < 1:
+        raise ValueError(f"coefficients must be a 2-d array (polynomials x (degree+1)), got shape {c.shape}")
+    if c.shape[1] - 1 > MAX_DEGREE:
+        raise ValueError(f"degree {c.shape[1] - 1} is above the solvers' maximum {MAX_DEGREE}")
+    return c
+
+
+def _bounds(value: ArrayLike, count: int) -> np.ndarray:
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(value, dtype=np.float64), (count,)))
+
+
+def real_roots(coeffs: ArrayLike, lo: float = -np.inf, hi: float = np.inf, method: str = "auto") -> np.ndarray:
+    """All distinct real roots of c[0] + c[1] t + ... in [lo, hi], ascending (tangent roots once)."""
+    c = np.asarray(coeffs, dtype=np.float64)
+    if c.ndim != 1:
+        raise ValueError(f"coeffs must be 1-d (lowest power first), got shape {c.shape}")
+    roots, counts = real_roots_batch(c[None, :], lo, hi, method)
+    return roots[0, : counts[0]].copy()
+
+
+def real_roots_batch(
+    coeffs: ArrayLike, lo: ArrayLike = -np.inf, hi: ArrayLike = np.inf, method: str = "auto"
+) -> tuple[np.ndarray, np.ndarray]:
+    """Roots of many polynomials of one degree at once (the loop runs in C).
+
+    coeffs: shape (count, degree+1), lowest power first; lo, hi: scalars or shape (count,).
+    Returns (roots, counts): roots has shape (count, degree), row i ascending in its first counts[i]
+    entries and NaN after.
+    """
+    mid = method_id(method, bench=True)
+    c = _coeff_matrix(coeffs)
+    count, n = c.shape[0], c.shape[1] - 1
+    lo_a, hi_a = _bounds(lo, count), _bounds(hi, count)
+    roots = np.empty((count, n), dtype=np.float64)
+    counts = np.empty(count, dtype=np.intc)
+    if count:
+        library().ig_real_roots_batch(
+            c.ctypes.data_as(_DP), n, count, lo_a.ctypes.data_as(_DP), hi_a.ctypes.data_as(_DP), mid,
+            roots.ctypes.data_as(_DP), counts.ctypes.data_as(_IP),
+        )
+    return roots, counts.astype(np.int64)
+
+
+def bench_solve_batch(
+    coeffs: np.ndarray, lo: ArrayLike, hi: ArrayLike, method: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """Like real_roots_batch, plus the time of every solve measured in C (ns) and the total time (ns) of an
+    untimed second pass (throughput)."""
+    mid = method_id(method, bench=True)
+    c = _coeff_matrix(coeffs)
+    count, n = c.shape[0], c.shape[1] - 1
+    lo_a, hi_a = _bounds(lo, count), _bounds(hi, count)
+    roots = np.empty((count, n), dtype=np.float64)
+    counts = np.empty(count, dtype=np.intc)
+    ns = np.empty(count, dtype=np.float64)
+    total = library().ig_bench_solve_batch(
+        c.ctypes.data_as(_DP), n, count, lo_a.ctypes.data_as(_DP), hi_a.ctypes.data_as(_DP), mid,
+        roots.ctypes.data_as(_DP), counts.ctypes.data_as(_IP), ns.ctypes.data_as(_DP),
+    )
+    return roots, counts.astype(np.int64), ns, float(total)

@@ -1,0 +1,454 @@
+/* Real roots of a polynomial on a closed interval: the dispatcher, the shared numerics (certified sign,
+ * safeguarded Newton, stable quadratic) and the derivative-bracketing method.
+ *
+ * Pipeline of ig_real_roots (every method goes through it):
+ *   1. reject bad input (NaN/Inf coefficients or bounds, lo > hi, degree out of range): no roots;
+ *   2. lower the degree while the leading coefficient is exactly zero, and take out exact zero roots
+ *      (trailing zero coefficients), so the solvers always see p(0) != 0 and p[n] != 0;
+ *   3. rescale the coefficients by a power of two (exact) when they are beyond 2^+-200, so nothing overflows;
+ *   4. degree 1 and 2 are solved in closed form by every method; above that the chosen method runs;
+ *   5. an infinite bound is replaced by a root bound; when |x|^n could overflow, the range |x| > 1 is solved
+ *      on the reversed polynomial x^n p(1/x) in y = 1/x, which keeps every evaluation in range;
+ *   6. the results are sorted, exact duplicates dropped, and only finite roots inside [lo, hi] kept.
+ *
+ * Derivative bracketing (in the spirit of Yuksel 2022): the roots of p^(n-2) (a quadratic) cut [lo, hi]
+ * into pieces where p^(n-3) is monotonic; each sign change there is one root, found by safeguarded Newton;
+ * those roots cut the interval for p^(n-4), and so on up to p. A piece end where p is zero within rounding
+ * (certified by a compensated evaluation) is reported as a root: that is how a tangent (even multiplicity)
+ * root, which has no sign change, is found, and why a tiny positive minimum is not.
+ */
+#include "roots_impl.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+/* ---------------------------------------------------------------- error-free transformations */
+
+static void two_sum(double a, double b, double *s, double *e)
+{
+    double x = a + b;
+    double z = x - a;
+    *e = (a - (x - z)) + (b - z);
+    *s = x;
+}
+
+/* Dekker's product without FMA (the library is built for baseline x86-64, where fma() is a slow call). */
+static void two_prod(double a, double b, double *p, double *e)
+{
+    const double split = 134217729.0; /* 2^27 + 1 */
+    double x = a * b;
+    double fa = split * a, fb = split * b;
+    double ah = fa - (fa - a), al = a - ah;
+    double bh = fb - (fb - b), bl = b - bh;
+    *e = al * bl - (((x - ah * bh) - al * bh) - ah * bl);
+    *p = x;
+}
+
+/* ---------------------------------------------------------------- evaluation */
+
+void ig_horner2(const double *c, int n, double x, double *p, double *dp)
+{
+    double v = c[n], d = 0.0;
+    for (int k = n - 1; k >= 0; --k) {
+        d = d * x + v;
+        v = v * x + c[k];
+    }
+    *p = v;
+    *dp = d;
+}
+
+static double horner(const double *c, int n, double x)
+{
+    double v = c[n];
+    for (int k = n - 1; k >= 0; --k)
+        v = v * x + c[k];
+    return v;
+}
+
+int ig_sign_certified(const double *c, int n, double x, double *val)
+{
+    double v = c[n], s = fabs(c[n]), ax = fabs(x);
+    for (int k = n - 1; k >= 0; --k) {
+        v = v * x + c[k];
+        s = s * ax + fabs(c[k]);
+    }
+    double g = 2.0 * n * IG_U;
+    g = g / (1.0 - g); /* gamma_2n: a priori bound of Horner's relative error against sum |c_k||x|^k */
+    double tiny = 2.0 * (n + 1) * DBL_MIN * IG_U; /* underflow allowance */
+    *val = v;
+    if (fabs(v) > g * s + tiny)
+        return v > 0.0 ? 1 : -1;
+    /* Compensated Horner (Graillat, Langlois, Louvet 2005): as accurate as Horner in twice the precision. */
+    double r = c[n], err = 0.0;
+    for (int k = n - 1; k >= 0; --k) {
+        double pr, pe, se;
+        two_prod(r, x, &pr, &pe);
+        two_sum(pr, c[k], &r, &se);
+        err = err * x + (pe + se);
+    }
+    double res = r + err;
+    *val = res;
+    if (fabs(res) > 2.0 * IG_U * fabs(res) + 2.0 * g * g * s + tiny)
+        return res > 0.0 ? 1 : -1;
+    return 0;
+}
+
+/* ---------------------------------------------------------------- safeguarded Newton */
+
+/* Doubles mapped to integers that keep their order (-0 and +0 both map to 0). */
+static int64_t ordered(double x)
+{
+    int64_t i;
+    memcpy(&i, &x, sizeof i);
+    return i >= 0 ? i : INT64_MIN - i;
+}
+
+static double unordered(int64_t i)
+{
+    double x;
+    if (i < 0)
+        i = INT64_MIN - i;
+    memcpy(&x, &i, sizeof x);
+    return x;
+}
+
+/* Midpoint in the ordering of doubles: halves the number of doubles in the bracket, so bisection alone
+ * reaches adjacent doubles in at most 64 steps whatever the magnitudes (a root at 1e-300 in [-1, 1]). */
+double ig_ordered_mid(double l, double r)
+{
+    int64_t a = ordered(l), b = ordered(r);
+    uint64_t diff = (uint64_t)b - (uint64_t)a;
+    return unordered(a + (int64_t)(diff / 2u));
+}
+
+double ig_refine(const double *c, int n, double l, double r, double vl, double vr)
+{
+    const int positive_left = vl > 0.0;
+    /* start from the false-position point: exact for a line, good for the monotone pieces we get */
+    double x = l - vl * ((r - l) / (vr - vl));
+    if (!(x > l && x < r))
+        x = ig_ordered_mid(l, r);
+    for (int it = 0; it < 100; ++it) {
+        double v, dv;
+        ig_horner2(c, n, x, &v, &dv);
+        if (v == 0.0)
+            return x;
+        if ((v > 0.0) == positive_left)
+            l = x;
+        else
+            r = x;
+        double xn = x - v / dv;
+        if (!(xn > l && xn < r)) { /* also catches dv == 0 and NaN */
+            xn = ig_ordered_mid(l, r);
+            if (!(xn > l && xn < r))
+                return x; /* l and r are adjacent doubles */
+        } else if (fabs(xn - x) <= 4.0 * IG_U * fabs(xn)) {
+            return xn;
+        }
+        x = xn;
+    }
+    return x;
+}
+
+/* ---------------------------------------------------------------- quadratic, sorting */
+
+int ig_quadratic(double c0, double c1, double c2, double *r)
+{
+    double b = -0.5 * c1; /* roots of c2 x^2 - 2 b x + c0 are (b +- sqrt(b^2 - c2 c0)) / c2 */
+    double bb = b * b, ac = c2 * c0;
+    double d = bb - ac;
+    if (fabs(d) <= 4.0 * IG_U * (bb + fabs(ac))) {
+        /* cancellation: redo the discriminant with exact products (Kahan), so its sign is right and a
+         * double root of the given coefficients comes out as d == 0 */
+        double pb, eb, pa, ea;
+        two_prod(b, b, &pb, &eb);
+        two_prod(c2, c0, &pa, &ea);
+        d = (pb - pa) + (eb - ea);
+    }
+    if (!(d >= 0.0))
+        return 0;
+    int k;
+    if (d == 0.0) {
+        r[0] = b / c2;
+        k = 1;
+    } else {
+        double q = b + copysign(sqrt(d), b); /* no cancellation; q != 0 because d > 0 */
+        double x1 = q / c2, x2 = c0 / q;
+        if (x1 > x2) {
+            double t = x1;
+            x1 = x2;
+            x2 = t;
+        }
+        r[0] = x1;
+        r[1] = x2;
+        k = (x1 == x2) ? 1 : 2;
+    }
+    int m = 0; /* a root beyond DBL_MAX is not representable: drop it */
+    for (int i = 0; i < k; ++i)
+        if (isfinite(r[i]))
+            r[m++] = r[i];
+    return m;
+}
+
+int ig_sort_unique(double *r, int k)
+{
+    for (int i = 1; i < k; ++i) {
+        double x = r[i];
+        int j = i - 1;
+        while (j >= 0 && r[j] > x) {
+            r[j + 1] = r[j];
+            --j;
+        }
+        r[j + 1] = x;
+    }
+    int m = 0;
+    for (int i = 0; i < k; ++i)
+        if (m == 0 || r[i] != r[m - 1])
+            r[m++] = r[i];
+    return m;
+}
+
+/* ---------------------------------------------------------------- derivative bracketing */
+
+/* Roots of q (degree m) on [a, b] given its critical points crit[] (ascending, inside (a, b)): q is
+ * monotonic between consecutive points. final != 0: q is the polynomial itself -- decide zeros with the
+ * certified sign and report roots at a and b; otherwise only roots strictly inside (a, b) matter, and a
+ * plain sign is enough (missing an even-multiplicity root of an intermediate derivative leaves the
+ * next polynomial monotonic across it). out[] needs room for nc + 2 entries. */
+static int monotone_level(const double *q, int m, double a, double b, const double *crit, int nc, int final,
+                          double *out)
+{
+    double xs[IG_MAX_DEGREE + 2], v[IG_MAX_DEGREE + 2];
+    int s[IG_MAX_DEGREE + 2];
+    int np = 0;
+    xs[np++] = a;
+    for (int i = 0; i < nc; ++i)
+        if (crit[i] > xs[np - 1] && crit[i] < b)
+            xs[np++] = crit[i];
+    if (b > a)
+        xs[np++] = b;
+    for (int i = 0; i < np; ++i) {
+        if (final) {
+            s[i] = ig_sign_certified(q, m, xs[i], &v[i]);
+        } else {
+            v[i] = horner(q, m, xs[i]);
+            s[i] = (v[i] > 0.0) - (v[i] < 0.0);
+        }
+    }
+    int cnt = 0;
+    for (int i = 0; i < np; ++i) {
+        if (s[i] == 0 && (final || (i > 0 && i < np - 1)))
+            out[cnt++] = xs[i];
+        if (i + 1 < np && s[i] * s[i + 1] < 0)
+            out[cnt++] = ig_refine(q, m, xs[i], xs[i + 1], v[i], v[i + 1]);
+    }
+    return cnt;
+}
+
+/* Derivative bracketing on a finite [a, b], exact degree n >= 3. */
+static int bracket_interval(const double *p, int n, double a, double b, double *out)
+{
+    /* chain[j] = p^(j) scaled to keep the leading coefficient of p: degree n - j */
+    double chain[IG_MAX_DEGREE - 1][IG_MAX_DEGREE + 1];
+    memcpy(chain[0], p, (size_t)(n + 1) * sizeof(double));
+    for (int j = 1; j <= n - 2; ++j) {
+        int m = n - j + 1; /* degree of chain[j - 1] */
+        double inv = 1.0 / m;
+        for (int k = 0; k < m; ++k)
+            chain[j][k] = chain[j - 1][k + 1] * ((k + 1) * inv);
+    }
+    double buf[2][IG_MAX_DEGREE + 2];
+    int cur = 0, nc = 0;
+    {
+        double q[2];
+        const double *c2 = chain[n - 2];
+        int k = ig_quadratic(c2[0], c2[1], c2[2], q);
+        for (int i = 0; i < k; ++i)
+            if (q[i] > a && q[i] < b)
+                buf[cur][nc++] = q[i];
+    }
+    for (int j = n - 3; j >= 0; --j) {
+        nc = monotone_level(chain[j], n - j, a, b, buf[cur], nc, j == 0, buf[1 - cur]);
+        cur = 1 - cur;
+    }
+    memcpy(out, buf[cur], (size_t)nc * sizeof(double));
+    return nc;
+}
+
+/* ---------------------------------------------------------------- interval handling */
+
+typedef int (*interval_solver)(const double *p, int n, double a, double b, double *out);
+
+/* Fujiwara's bound 2 max_k |p[n-k] / p[n]|^(1/k) (with p[0] / 2), rounded up to a power of two using only
+ * the binary exponents: cheap and never overflows (DBL_MAX when the bound is not representable). */
+static double root_bound(const double *p, int n)
+{
+    int en = ilogb(p[n]);
+    int best = INT32_MIN;
+    for (int k = 1; k <= n; ++k) {
+        double ck = p[n - k];
+        if (ck == 0.0)
+            continue;
+        /* |ck / p[n]| < 2^(ilogb(ck) - en + 1); its k-th root < 2^ceil((ilogb(ck) - en + 1) / k) */
+        int num = ilogb(ck) - en + 1 - (k == n ? 1 : 0);
+        int e = num >= 0 ? (num + k - 1) / k : -((-num) / k);
+        if (e > best)
+            best = e;
+    }
+    if (best == INT32_MIN)
+        return 0.0;
+    if (best + 1 > DBL_MAX_EXP - 1)
+        return DBL_MAX;
+    return ldexp(1.0, best + 1);
+}
+
+static int solve_general(const double *p, int n, double lo, double hi, interval_solver solver, double *out)
+{
+    double a = lo, b = hi;
+    if (isinf(a) || isinf(b)) {
+        double bound = root_bound(p, n);
+        if (a < -bound)
+            a = -bound;
+        if (b > bound)
+            b = bound;
+        if (a > b)
+            return 0;
+    }
+    double big = fmax(fabs(a), fabs(b));
+    /* coefficients are at most ~2^200 (see ig_real_roots_any); |x|^n below 2^524 keeps Horner and the
+     * splitting of Dekker's product (another 2^27) far from overflow */
+    if (big <= 1.0 || (double)n * ilogb(big) < 500.0)
+        return solver(p, n, a, b, out);
+
+    /* |x| > 1 on the reversed polynomial q(y) = y^n p(1/y), y = 1/x in [-1, 1] */
+    double q[IG_MAX_DEGREE + 1], tmp[IG_ROOT_BUF];
+    for (int k = 0; k <= n; ++k)
+        q[k] = p[n - k];
+    int cnt = 0;
+    if (a <= 1.0 && b >= -1.0)
+        cnt = solver(p, n, fmax(a, -1.0), fmin(b, 1.0), out);
+    if (b > 1.0) {
+        double xa = fmax(a, 1.0);
+        int k = solver(q, n, 1.0 / b, 1.0 / xa, tmp);
+        for (int i = 0; i < k; ++i) {
+            double x = 1.0 / tmp[i];
+            if (x >= a && x <= b && !(x == 1.0 && a <= 1.0))
+                out[cnt++] = x;
+        }
+    }
+    if (a < -1.0) {
+        double xb = fmin(b, -1.0);
+        int k = solver(q, n, 1.0 / xb, 1.0 / a, tmp);
+        for (int i = 0; i < k; ++i) {
+            double x = 1.0 / tmp[i];
+            if (x >= a && x <= b && !(x == -1.0 && b >= -1.0))
+                out[cnt++] = x;
+        }
+    }
+    return ig_sort_unique(out, cnt);
+}
+
+/* Which method `auto` uses per degree (after deflating zero roots); see docs/solvers.md for the report
+ * this choice comes from. */
+static int auto_method(int n)
+{
+    (void)n;
+    return IG_ROOTS_BRACKET;
+}
+
+static int solve_reduced(const double *p, int n, double lo, double hi, int method, double *out)
+{
+    if (n == 1) {
+        double x = -p[0] / p[1];
+        if (!isfinite(x))
+            return 0;
+        out[0] = x;
+        return 1;
+    }
+    if (n == 2)
+        return ig_quadratic(p[0], p[1], p[2], out);
+    if (method == IG_ROOTS_AUTO)
+        method = auto_method(n);
+    switch (method) {
+    case IG_ROOTS_CLOSED:
+    case IG_ROOTS_CLOSED_PLAIN: {
+        int polish = method == IG_ROOTS_CLOSED;
+        if (n == 3)
+            return ig_closed_cubic(p, lo, hi, polish, out);
+        if (n == 4)
+            return ig_closed_quartic(p, lo, hi, polish, out);
+        return solve_general(p, n, lo, hi, bracket_interval, out);
+    }
+    case IG_ROOTS_STURM:
+        return solve_general(p, n, lo, hi, ig_sturm_interval, out);
+    case IG_ROOTS_BRACKET:
+        return solve_general(p, n, lo, hi, bracket_interval, out);
+    default:
+        return 0;
+    }
+}
+
+int ig_real_roots_any(const double *c, int n, double lo, double hi, int method, double *roots)
+{
+    if (!c || !roots || n < 0 || n > IG_MAX_DEGREE)
+        return 0;
+    if (!(lo <= hi)) /* also NaN bounds */
+        return 0;
+    double cmax = 0.0;
+    for (int k = 0; k <= n; ++k) {
+        if (!isfinite(c[k]))
+            return 0;
+        if (fabs(c[k]) > cmax)
+            cmax = fabs(c[k]);
+    }
+    if (cmax == 0.0)
+        return 0; /* the zero polynomial: every t is a root; reported as none */
+    double p[IG_MAX_DEGREE + 1];
+    /* exact rescaling by a power of two when the coefficients are far from 1 */
+    int e = ilogb(cmax);
+    if (e > 200 || e < -200) {
+        double s1 = ldexp(1.0, -e / 2), s2 = ldexp(1.0, -e - (-e / 2));
+        for (int k = 0; k <= n; ++k)
+            p[k] = (c[k] * s1) * s2;
+    } else {
+        memcpy(p, c, (size_t)(n + 1) * sizeof(double));
+    }
+    int top = n;
+    while (top > 0 && p[top] == 0.0)
+        --top;
+    int m = 0; /* multiplicity of the root t = 0 */
+    while (m < top && p[m] == 0.0)
+        ++m;
+    int deg = top - m;
+    double r[IG_ROOT_BUF];
+    int k = 0;
+    if (deg > 0)
+        k = solve_reduced(p + m, deg, lo, hi, method, r);
+    if (m > 0)
+        r[k++] = 0.0;
+    k = ig_sort_unique(r, k);
+    int cnt = 0;
+    for (int i = 0; i < k && cnt < n; ++i)
+        if (r[i] >= lo && r[i] <= hi && isfinite(r[i]))
+            roots[cnt++] = r[i] == 0.0 ? 0.0 : r[i]; /* no -0 */
+    return cnt;
+}
+
+int ig_real_roots(const double *c, int n, double lo, double hi, ig_root_method method, double *roots)
+{
+    return ig_real_roots_any(c, n, lo, hi, (int)method, roots);
+}
+
+void ig_real_roots_batch(const double *c, int n, long count, const double *lo, const double *hi, int method,
+                         double *roots, int *counts)
+{
+    double r[IG_MAX_DEGREE];
+    for (long i = 0; i < count; ++i) {
+        int k = ig_real_roots_any(c + i * (n + 1), n, lo[i], hi[i], method, r);
+        counts[i] = k;
+        for (int j = 0; j < n; ++j)
+            roots[i * n + j] = j < k ? r[j] : NAN;
+    }
+}

@@ -1,0 +1,64 @@
+/* Internals shared by the root solvers (roots.c, roots_closed.c, roots_sturm.c, roots_bench.c).
+ * Not part of the public contract: only roots.h is. Every symbol carries the ig_ prefix because all
+ * runtime .c files are compiled into one library.
+ */
+#ifndef IMPLGEN_ROOTS_IMPL_H
+#define IMPLGEN_ROOTS_IMPL_H
+
+#include "roots.h"
+
+/* Room for intermediate root lists (a method returns at most n + 1 candidates per piece, three pieces). */
+#define IG_ROOT_BUF (3 * (IG_MAX_DEGREE + 2))
+
+/* Unit roundoff of IEEE double, 2^-53. */
+#define IG_U 1.1102230246251565e-16
+
+/* Bench-only method ids (beyond ig_root_method): the classic closed forms without any polishing,
+ * i.e. what Schwarze's Graphics Gems code does. Used by `implgen bench solvers` as the baseline. */
+#define IG_ROOTS_CLOSED_PLAIN 10
+
+/* Horner evaluation of c[0..n] at x: value and derivative. */
+void ig_horner2(const double *c, int n, double x, double *p, double *dp);
+
+/* Sign of p(x) that rounding cannot flip: -1 or +1, or 0 when |p(x)| is within the rounding error even of
+ * a compensated (twice-the-working-precision) evaluation -- then x is taken as a root. *val gets p(x). */
+int ig_sign_certified(const double *c, int n, double x, double *val);
+
+/* Safeguarded Newton on a bracket [l, r] where c changes sign (sl = sign at l, nonzero). Never leaves the
+ * bracket, bisects (in the ordering of doubles, so at most 64 halvings span the whole range) when a Newton
+ * step would, and stops after a bounded number of iterations. */
+double ig_refine(const double *c, int n, double l, double r, double vl, double vr);
+
+/* Midpoint of [l, r] in the ordering of doubles (halves the number of doubles between them). */
+double ig_ordered_mid(double l, double r);
+
+/* Real roots of c0 + c1 x + c2 x^2 (c2 != 0), distinct, ascending; a double root once. */
+int ig_quadratic(double c0, double c1, double c2, double *r);
+
+/* Sort ascending and drop exact duplicates; returns the new count. */
+int ig_sort_unique(double *r, int k);
+
+/* Closed forms on a polynomial of exact degree 3 or 4 (c[n] != 0, c[0] != 0, coefficients scaled to max 1):
+ * all real roots in [lo, hi], ascending. polish != 0: Newton-polished, factorisation refined; 0: classic. */
+int ig_closed_cubic(const double *c, double lo, double hi, int polish, double *r);
+int ig_closed_quartic(const double *c, double lo, double hi, int polish, double *r);
+
+/* Sturm isolation on a finite interval [a, b] for exact degree n >= 3 (c[n] != 0, c[0] != 0). */
+int ig_sturm_interval(const double *c, int n, double a, double b, double *r);
+
+/* The real-roots entry point with a bench-only method id allowed (see IG_ROOTS_CLOSED_PLAIN). */
+int ig_real_roots_any(const double *c, int n, double lo, double hi, int method, double *roots);
+
+/* Batch form for the Python binding: `count` polynomials of nominal degree n, coefficients at c + i*(n+1),
+ * bounds lo[i], hi[i]; roots of polynomial i go to roots + i*n (padded with NaN), its count to counts[i]. */
+void ig_real_roots_batch(const double *c, int n, long count, const double *lo, const double *hi, int method,
+                         double *roots, int *counts);
+
+/* Timing entry point for the solver report: solves each polynomial once, measures its time with
+ * clock_gettime(CLOCK_MONOTONIC) minus the calibrated cost of the clock reads, and writes ns per solve to
+ * ns[i]; roots/counts as in ig_real_roots_batch. Returns the total wall time of an untimed second pass
+ * over all polynomials in ns (throughput measure). */
+double ig_bench_solve_batch(const double *c, int n, long count, const double *lo, const double *hi, int method,
+                            double *roots, int *counts, double *ns);
+
+#endif
