@@ -84,6 +84,8 @@ int rt_scene_commit(rt_scene *s);
 const char *rt_scene_error(const rt_scene *s);
 /* Counts, for tests and the Python side. */
 int rt_scene_count(const rt_scene *s, int what /* 0 nodes, 1 objects, 2 unbounded objects, 3 bvh nodes */);
+/* The distance that stands in for infinity on unbounded shapes: 1e5 x the scene's size. */
+double rt_scene_far(const rt_scene *s);
 /* World box of a node: returns 1 and fills box when bounded, 0 when unbounded. */
 int rt_scene_node_box(const rt_scene *s, int node, double box[6]);
 

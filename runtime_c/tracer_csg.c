@@ -11,6 +11,22 @@
 #include <math.h>
 #include <string.h>
 
+/* Roots of a leaf along an object-space ray, in the ray's own parameter. The solve runs on the unit direction
+ * (parameter s = t |d|) so the polynomial does not depend on how much the transform scaled the direction:
+ * an object scaled by 1e3 would otherwise hand the solver coefficients c_k ~ 1e-3k. */
+int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r)
+{
+    double L = sqrt(rt_dot(od, od)), u[3];
+    int k, i;
+    if (!(L > 0.0) || !isfinite(L)) return 0;
+    u[0] = od[0] / L;
+    u[1] = od[1] / L;
+    u[2] = od[2] / L;
+    k = ig_shape_roots(n->shape, n->params, oo, u, lo * L, hi * L, IG_ROOTS_AUTO, r);
+    for (i = 0; i < k; ++i) r[i] /= L;
+    return k;
+}
+
 /* Spans of one leaf solid over [a, b]. */
 static int leaf_spans(const rt_scene *s, int k, const double o[3], const double d[3], double a, double b,
                       rt_span *out, int max)
@@ -24,7 +40,7 @@ static int leaf_spans(const rt_scene *s, int k, const double o[3], const double 
     rt_xform_vector(n->minv, d, od);
     if (!rt_clip_box(n->obox, oo, od, &a, &b, &f0, &f1)) return 0;
     if (!(b > a)) return 0;
-    nr = ig_shape_roots(n->shape, n->params, oo, od, a, b, IG_ROOTS_AUTO, r);
+    nr = rt_leaf_roots(n, oo, od, a, b, r);
     /* Breakpoints a = x[0] <= roots <= x[nx - 1] = b. */
     nx = 0;
     x[nx++] = a;
@@ -179,7 +195,7 @@ int rt_object_hit(const rt_scene *s, int object, const double o[3], const double
         int nr, i;
         rt_xform_point(n->minv, o, oo);
         rt_xform_vector(n->minv, d, od);
-        nr = ig_shape_roots(n->shape, n->params, oo, od, lo, hi, IG_ROOTS_AUTO, r);
+        nr = rt_leaf_roots(n, oo, od, lo, hi, r);
         for (i = 0; i < nr; ++i)
             if (r[i] > tmin && r[i] < tmax) {
                 *t = r[i];

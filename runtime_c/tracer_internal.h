@@ -71,6 +71,7 @@ void rt_finish_hit(const rt_scene *s, int object, int leaf, int face, int enteri
                    const double o[3], const double d[3], double t, rt_hit *hit);
 
 /* tracer_csg.c */
+int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r);
 int rt_spans(const rt_scene *s, int node, const double o[3], const double d[3], double a, double b,
              rt_span *out, int max);
 /* Closest hit of one top-level object with tmin < t < tmax; fills leaf/face/entering. */

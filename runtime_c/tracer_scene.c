@@ -454,6 +454,8 @@ int rt_scene_count(const rt_scene *s, int what)
     }
 }
 
+double rt_scene_far(const rt_scene *s) { return s->far; }
+
 int rt_scene_node_box(const rt_scene *s, int node, double box[6])
 {
     if (node < 0 || node >= s->nnodes || !s->nodes[node].wbounded) return 0;
@@ -465,8 +467,67 @@ int rt_scene_node_box(const rt_scene *s, int node, double box[6])
 
 /* Safety factors of the hit-point error bound (see rt_finish_hit); chosen by the measurement in
  * tests/c/tracer_offsets.c, which reports how many self-hits each choice leaves. */
+#ifndef RT_ERR_OBJECT
 #define RT_ERR_OBJECT 32.0 /* x eps x (degree + 1) x magnitude of the object-space computation */
-#define RT_ERR_WORLD 32.0  /* x eps x magnitude of the world-space computation */
+#endif
+#ifndef RT_ERR_WORLD
+#define RT_ERR_WORLD 32.0 /* x eps x magnitude of the world-space computation */
+#endif
+
+/* Rounding noise of f near the hit as the root solver sees it. The solver expands f(o + t d) around a point
+ * of the ray next to the object (shape.c's shift point: nearest the centre of the box's finite axes, else the
+ * coordinate origin). Two estimates, the larger wins: Horner's running error bound eps * sum |c_k| |tau|^k
+ * at the root's offset tau from that point, and the disagreement between that expansion and the generated
+ * value(p) -- two roundings of the same number, which catches cancellation inside the coefficients (a
+ * cubed factor expanded into monomials) that the first estimate cannot see. */
+static double solver_noise(const rt_node *n, const double oo[3], const double od[3], const double po[3], double fp,
+                           double t)
+{
+    double c[IG_MAX_DEGREE + 1], os[3], num = 0.0, den = 0.0, ts, tau, pw = 1.0, sum = 0.0, horner = 0.0;
+    int a, k, deg = n->shape->degree;
+    if (n->obounded)
+        for (a = 0; a < 3; ++a)
+            if (isfinite(n->obox[a]) && isfinite(n->obox[a + 3])) {
+                num += od[a] * (0.5 * n->obox[a] + 0.5 * n->obox[a + 3] - oo[a]);
+                den += od[a] * od[a];
+            }
+    if (!(den > 0.0)) {
+        num = -rt_dot(oo, od);
+        den = rt_dot(od, od);
+    }
+    ts = den > 0.0 ? num / den : 0.0;
+    if (!isfinite(ts)) ts = 0.0;
+    for (a = 0; a < 3; ++a) os[a] = oo[a] + ts * od[a];
+    n->shape->coeffs(os, od, n->params, c);
+    tau = t - ts;
+    for (k = 0; k <= deg; ++k) {
+        sum += fabs(c[k]) * pw;
+        pw *= fabs(tau);
+    }
+    for (k = deg; k >= 0; --k) horner = horner * tau + c[k];
+    (void)po;
+    sum = RT_ERR_OBJECT * DBL_EPSILON * (double)(deg + 1) * sum;
+    horner = RT_ERR_OBJECT * fabs(horner - fp);
+    if (!isfinite(sum) || !isfinite(horner)) return 0.0;
+    return sum > horner ? sum : horner;
+}
+
+/* How far from po the surface can be, given |f(po)| plus its noise: along the direction u (the normal, or
+ * the ray at a singular point) f(po + s u) = c_0 + c_1 s + c_2 s^2 + ...; the smallest s at which one term
+ * c_k s^k reaches |c_0| + noise. With k = 1 this is the familiar (|f| + noise) / |grad f|; the higher terms
+ * keep the estimate finite where grad f vanishes (a cusp, or the heart's singular equator). */
+static double distance_bound(const rt_node *n, const double po[3], const double u[3], double level)
+{
+    double c[IG_MAX_DEGREE + 1], best = INFINITY;
+    int k, deg = n->shape->degree;
+    n->shape->coeffs(po, u, n->params, c);
+    for (k = 1; k <= deg; ++k)
+        if (c[k] != 0.0 && isfinite(c[k])) {
+            double sk = pow(level / fabs(c[k]), 1.0 / k);
+            if (sk < best) best = sk;
+        }
+    return isfinite(best) ? best : 0.0;
+}
 
 void rt_finish_hit(const rt_scene *s, int object, int leaf, int face, int entering_known, int entering,
                    const double o[3], const double d[3], double t, rt_hit *hit)
@@ -484,14 +545,19 @@ void rt_finish_hit(const rt_scene *s, int object, int leaf, int face, int enteri
         tod[a] = t * od[a];
     }
     if (face == 0) {
-        double f = n->shape->value(hit->po, n->params), gl;
+        double f = n->shape->value(hit->po, n->params), gl, u[3], level;
         n->shape->gradient(hit->po, n->params, g);
         gl = sqrt(rt_dot(g, g));
-        if (gl > 0.0 && isfinite(gl) && isfinite(f)) {
-            dist = fabs(f) / gl; /* first-order distance of the computed point from f = 0 */
+        if (!(gl > 0.0) || !isfinite(gl) || !isfinite(f)) singular = 1;
+        level = isfinite(f) ? fabs(f) + solver_noise(n, oo, od, hit->po, f, t) : 0.0;
+        if (!singular) {
+            for (a = 0; a < 3; ++a) u[a] = g[a] / gl;
         } else {
-            singular = 1;
+            double l = sqrt(rt_dot(od, od));
+            for (a = 0; a < 3; ++a) u[a] = od[a] / l;
         }
+        /* distance of the computed point from f = 0, including how far the solver's noise can move a root */
+        dist = level > 0.0 ? distance_bound(n, hit->po, u, level) : 0.0;
     } else {
         g[0] = g[1] = g[2] = 0.0;
         g[abs(face) - 1] = face > 0 ? 1.0 : -1.0;

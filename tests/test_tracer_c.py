@@ -1,0 +1,138 @@
+"""The tracer's C tests: standalone drivers in tests/c/tracer_*.c, built with the sanitizers and run here.
+
+tracer_rays.c checks ray-level answers against analytic values (sphere distances, Snell, TIR, Fresnel, CSG
+event sequences, a transformed torus against the inverse-transformed ray, the piriform in the paper's basis
+form). tracer_offsets.c measures secondary-ray robustness on every example shape at scales 1e-3 .. 1e3.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+RUNTIME = ROOT / "runtime_c"
+GENERATED = ROOT / "generated"
+CDIR = ROOT / "tests" / "c"
+SAN = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all"]
+WARN = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-pthread"]
+
+
+def runtime_sources() -> list[Path]:
+    """The runtime's C files; the tracer tests' plain shape fixture stands in while shape.c is missing."""
+    srcs = sorted(RUNTIME.glob("*.c"))
+    if not (RUNTIME / "shape.c").exists():
+        srcs.append(CDIR / "tracer_fixture_shape.c")
+    return srcs
+
+
+def example_shapes() -> list[str]:
+    names = []
+    for spec in sorted((ROOT / "examples" / "shapes").glob("*.yaml")):
+        if (GENERATED / f"{spec.stem}.c").exists():
+            names.append(spec.stem)
+    return names
+
+
+def compile_driver(out: Path, sources: list[Path], flags: list[str]) -> Path:
+    cc = os.environ.get("CC", "cc")
+    cmd = [cc, *WARN, *flags, f"-I{RUNTIME}", f"-I{GENERATED}", f"-I{CDIR}", "-o", str(out)]
+    cmd += [str(s) for s in sources] + ["-lm"]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+def run(exe: Path, *args: str, timeout: float = 300) -> str:
+    env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1", UBSAN_OPTIONS="print_stacktrace=1")
+    proc = subprocess.run([str(exe), *args], capture_output=True, text=True, timeout=timeout, env=env)
+    print(proc.stdout)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    return proc.stdout
+
+
+def test_ray_level_analytic(tmp_path: Path) -> None:
+    shapes = [GENERATED / f"{n}.c" for n in ("sphere", "torus_z", "piriform")]
+    exe = compile_driver(tmp_path / "rays", [CDIR / "tracer_rays.c", *runtime_sources(), *shapes], ["-g", "-O1", *SAN])
+    out = run(exe)
+    assert "0 failures" in out
+    assert re.search(r"sphere: 20000 random rays, hit/miss disagreements 0", out)
+    assert re.search(r"transformed torus: 20000 rays \(\d+ hits\), hit/miss disagreements 0", out)
+
+
+def shape_table(path: Path, names: list[str]) -> Path:
+    """A glue file listing the example shapes with their default params (from the specs)."""
+    from implgen.spec import load_spec
+
+    lines = ['#include "shape.h"']
+    lines += [f'#include "{n}.h"' for n in names]
+    lines.append("const ig_shape *const rt_test_shapes[] = {" + ", ".join(f"&{n}_shape" for n in names) + "};")
+    rows = []
+    for n in names:
+        spec = load_spec(ROOT / "examples" / "shapes" / f"{n}.yaml")
+        vals = [repr(float(v)) for v in spec.params.values()] or ["0.0"]
+        rows.append("{" + ", ".join(vals) + "}")
+    lines.append("const double rt_test_params[][8] = {" + ", ".join(rows) + "};")
+    lines.append(f"const int rt_test_nshapes = {len(names)};")
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def parse_offsets(out: str) -> dict[str, dict[str, float]]:
+    rows = {}
+    pat = re.compile(
+        r"^(\S+)\s+hits\s+(\d+) rays\s+(\d+) match\s+(\d+) self-hits (\d+) misses (\d+) other (\d+) "
+        r"ambiguous (\d+) lost (\d+)",
+        re.M,
+    )
+    for m in pat.finditer(out):
+        keys = ("hits", "rays", "match", "self", "miss", "other", "ambiguous", "lost")
+        rows[m.group(1)] = dict(zip(keys, map(int, m.groups()[1:])))
+    return rows
+
+
+@pytest.fixture(scope="module")
+def offsets_exes(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, list[str]]:
+    names = example_shapes()
+    if not names:
+        pytest.skip("no generated example shapes")
+    tmp = tmp_path_factory.mktemp("offsets")
+    table = shape_table(tmp / "table.c", names)
+    srcs = [CDIR / "tracer_offsets.c", table, *runtime_sources(), *(GENERATED / f"{n}.c" for n in names)]
+    san = compile_driver(tmp / "offsets_san", srcs, ["-g", "-O1", *SAN])
+    fast = compile_driver(tmp / "offsets_fast", srcs, ["-O2"])
+    return san, fast, names
+
+
+def test_secondary_rays_sanitized(offsets_exes) -> None:
+    """Fewer points, but under ASan/UBSan: the same code paths must be memory- and UB-clean."""
+    san, _, names = offsets_exes
+    rows = parse_offsets(run(san, "2000", "7"))
+    assert set(rows) == set(names)
+    for name, r in rows.items():
+        assert r["self"] + r["miss"] <= (20 if name == "heart" else 0), (name, r)
+
+
+def test_secondary_rays_1e5_per_shape(offsets_exes) -> None:
+    """The issue's test: 1e5 hit points per example shape over scales 1e-3 .. 1e3, two rays leave each."""
+    _, fast, names = offsets_exes
+    out = run(fast, "100000", "12345", timeout=600)
+    rows = parse_offsets(out)
+    assert set(rows) == set(names)
+    for name, r in rows.items():
+        assert r["hits"] >= 99_000, (name, r)
+        if name == "heart":
+            # Taubin's heart vanishes to third order along its whole equator (grad f = 0 on the curve
+            # z = 0, x^2 + 9/4 y^2 = 1): there a root's position is uncertain by ~ noise^(1/3), and the
+            # measured count of self-hits is 5 in 200000 rays (seed 12345). Bounded, not zero.
+            assert r["self"] + r["miss"] <= 20, (name, r)
+            continue
+        assert r["self"] == 0, (name, r)
+        assert r["miss"] == 0, (name, r)
+        # what cannot be judged (grazing second hits inside the offset band, reference losing the root)
+        # must stay rare
+        assert r["ambiguous"] + r["lost"] + r["other"] <= 1e-3 * r["rays"], (name, r)
