@@ -50,6 +50,26 @@ static void two_prod(double a, double b, double *p, double *e)
 
 void ig_horner2(const double *c, int n, double x, double *p, double *dp)
 {
+    if (n == 4) { /* the torus case, unrolled: same operations, no loop overhead */
+        double v = c[4] * x + c[3], d = c[4];
+        d = d * x + v;
+        v = v * x + c[2];
+        d = d * x + v;
+        v = v * x + c[1];
+        d = d * x + v;
+        *p = v * x + c[0];
+        *dp = d;
+        return;
+    }
+    if (n == 3) {
+        double v = c[3] * x + c[2], d = c[3];
+        d = d * x + v;
+        v = v * x + c[1];
+        d = d * x + v;
+        *p = v * x + c[0];
+        *dp = d;
+        return;
+    }
     double v = c[n], d = 0.0;
     for (int k = n - 1; k >= 0; --k) {
         d = d * x + v;
@@ -123,13 +143,20 @@ double ig_ordered_mid(double l, double r)
     return unordered(a + (int64_t)(diff / 2u));
 }
 
-double ig_refine(const double *c, int n, double l, double r, double vl, double vr)
+double ig_refine(const double *c, int n, double l, double r, double vl, double vr, double tol, double x0)
 {
     const int positive_left = vl > 0.0;
-    /* start from the false-position point: exact for a line, good for the monotone pieces we get */
-    double x = l - vl * ((r - l) / (vr - vl));
+    /* start from the caller's guess, else the false-position point (exact for a line) */
+    double x = x0;
+    if (!(x > l && x < r))
+        x = l - vl * ((r - l) / (vr - vl));
     if (!(x > l && x < r))
         x = ig_ordered_mid(l, r);
+    /* As in rtsafe: a Newton step is taken only when it stays inside the bracket and is less than half the
+     * step before the last one; otherwise bisect. Far from the root (|x|^n growth on a wide piece) Newton
+     * crawls, and bisection in the ordering of doubles gets there in a few steps instead. */
+    double dx = INFINITY, dxold = INFINITY;
+    int newton_before = 0; /* was the last step a Newton step (so dx tells the convergence rate)? */
     for (int it = 0; it < 100; ++it) {
         double v, dv;
         ig_horner2(c, n, x, &v, &dv);
@@ -139,13 +166,29 @@ double ig_refine(const double *c, int n, double l, double r, double vl, double v
             l = x;
         else
             r = x;
-        double xn = x - v / dv;
-        if (!(xn > l && xn < r)) { /* also catches dv == 0 and NaN */
+        double step = v / dv, xn = x - step;
+        double as = fabs(step), ax = fabs(x);
+        if (as <= 4.0 * IG_U * ax) /* converged (the step may even round away) */
+            return (xn >= l && xn <= r) ? xn : x;
+        if (!(xn > l && xn < r) || !(as <= 0.5 * fabs(dxold))) { /* also catches dv == 0, NaN */
             xn = ig_ordered_mid(l, r);
             if (!(xn > l && xn < r))
                 return x; /* l and r are adjacent doubles */
-        } else if (fabs(xn - x) <= 4.0 * IG_U * fabs(xn)) {
-            return xn;
+            dxold = dx;
+            dx = xn - x;
+            newton_before = 0;
+        } else {
+            /* Newton's error after this step is about K step^2 with K = |step| / dx^2 estimated from the
+             * last two steps: stop when that is below the tolerance (saves the confirming evaluation) */
+            if (newton_before && as <= 1e-3 * fabs(dx) && (as / dx) * (as / dx) * as <= tol * fabs(xn))
+                return xn;
+            /* steps stopped shrinking while already tiny: they are rounding noise of p(x), which is as
+             * close as this root can be resolved (or a multiple root, converging linearly) */
+            if (newton_before && as > 0.5 * fabs(dx) && as <= 1e-9 * fabs(xn))
+                return xn;
+            dxold = dx;
+            dx = step;
+            newton_before = 1;
         }
         x = xn;
     }
@@ -212,14 +255,49 @@ int ig_sort_unique(double *r, int k)
 
 /* ---------------------------------------------------------------- derivative bracketing */
 
-/* Roots of q (degree m) on [a, b] given its critical points crit[] (ascending, inside (a, b)): q is
- * monotonic between consecutive points. final != 0: q is the polynomial itself -- decide zeros with the
- * certified sign and report roots at a and b; otherwise only roots strictly inside (a, b) matter, and a
- * plain sign is enough (missing an even-multiplicity root of an intermediate derivative leaves the
- * next polynomial monotonic across it). out[] needs room for nc + 2 entries. */
-static int monotone_level(const double *q, int m, double a, double b, const double *crit, int nc, int final,
-                          double *out)
+/* A critical point x of p (root of p') where p is zero within rounding: a tangent root of some
+ * multiplicity k >= 2. x came from p', whose root there has multiplicity k - 1, so it is only
+ * ~u^(1/(k-1)) accurate; p^(k-1) has a simple root there. Newton on each derivative p^(j), j = 1..5, from x
+ * (kept inside (l, r)) and the candidate where the compensated |p| is smallest wins; the certified sign
+ * then decides at an accurate point. Runs only in this rare case. */
+static double polish_multiple(const double (*chain)[IG_MAX_DEGREE + 1], int n, double x, double l, double r)
 {
+    double best = x, bv;
+    ig_sign_certified(chain[0], n, x, &bv);
+    bv = fabs(bv);
+    for (int j = 1; j <= 5 && j < n && bv > 0.0; ++j) {
+        const double *f = chain[j];
+        int deg = n - j;
+        double y = x;
+        for (int it = 0; it < 8; ++it) {
+            double v, dv;
+            ig_horner2(f, deg, y, &v, &dv);
+            double yn = y - v / dv;
+            if (v == 0.0 || !(yn > l && yn < r) || yn == y)
+                break;
+            y = yn;
+        }
+        double vy;
+        ig_sign_certified(chain[0], n, y, &vy);
+        if (fabs(vy) < bv) {
+            bv = fabs(vy);
+            best = y;
+        }
+    }
+    return best;
+}
+
+/* Roots of q (degree m) on [a, b] given its critical points crit[] (ascending, inside (a, b)): q is
+ * monotonic between consecutive points. final != 0: q is the polynomial itself -- refine to full accuracy,
+ * decide zeros with the certified sign (after polishing the critical point on dq = q' when q is small
+ * there) and report roots at a and b. Otherwise only roots strictly inside (a, b) matter, as cut points for
+ * the next level: a plain sign and a looser tolerance are enough (missing an even-multiplicity root of an
+ * intermediate derivative leaves the next polynomial monotonic across it). out[] needs nc + 2 entries. */
+static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n, double a, double b, const double *crit,
+                          int nc, int final, double *out)
+{
+    const double *q = chain[j], *ddq = chain[j + 2];
+    const int m = n - j;
     double xs[IG_MAX_DEGREE + 2], v[IG_MAX_DEGREE + 2];
     int s[IG_MAX_DEGREE + 2];
     int np = 0;
@@ -229,20 +307,45 @@ static int monotone_level(const double *q, int m, double a, double b, const doub
             xs[np++] = crit[i];
     if (b > a)
         xs[np++] = b;
+    /* one a-priori rounding bound for the whole interval: gamma_2m sum |q_k| max(|a|,|b|)^k */
+    double big = 0.0;
+    if (final) {
+        double M = fmax(fabs(a), fabs(b));
+        for (int k = m; k >= 0; --k)
+            big = big * M + fabs(q[k]);
+        double g = 2.0 * m * IG_U;
+        big *= g / (1.0 - g);
+    }
     for (int i = 0; i < np; ++i) {
-        if (final) {
+        v[i] = horner(q, m, xs[i]);
+        s[i] = (v[i] > 0.0) - (v[i] < 0.0);
+        if (final && !(fabs(v[i]) > big)) {
+            if (i > 0 && i < np - 1)
+                xs[i] = polish_multiple(chain, n, xs[i], xs[i - 1], xs[i + 1]);
             s[i] = ig_sign_certified(q, m, xs[i], &v[i]);
-        } else {
-            v[i] = horner(q, m, xs[i]);
-            s[i] = (v[i] > 0.0) - (v[i] < 0.0);
         }
     }
+    double tol = final ? 2.0 * IG_U : 1e-7;
     int cnt = 0;
     for (int i = 0; i < np; ++i) {
         if (s[i] == 0 && (final || (i > 0 && i < np - 1)))
             out[cnt++] = xs[i];
-        if (i + 1 < np && s[i] * s[i + 1] < 0)
-            out[cnt++] = ig_refine(q, m, xs[i], xs[i + 1], v[i], v[i + 1]);
+        if (i + 1 < np && s[i] * s[i + 1] < 0) {
+            /* Start guess from the quadratic Taylor model at the critical end with the smaller |q| (q' = 0
+             * there): q(xc) + q''(xc) (x - xc)^2 / 2 = 0. Near a tangent -- two roots either side of a
+             * shallow extremum -- Newton would otherwise converge only linearly towards them. */
+            int e = fabs(v[i]) <= fabs(v[i + 1]) ? i : i + 1;
+            if (e == 0 || e == np - 1)
+                e = (e == 0 && np > 2 && i + 1 < np - 1) ? i + 1 : (e == np - 1 && i > 0 ? i : -1);
+            double x0 = NAN;
+            if (e >= 0) {
+                double dd = horner(ddq, m - 2, xs[e]) * ((double)m * (m - 1));
+                double t = -2.0 * v[e] / dd;
+                if (t > 0.0)
+                    x0 = xs[e] + (e == i ? 1.0 : -1.0) * sqrt(t);
+            }
+            out[cnt++] = ig_refine(q, m, xs[i], xs[i + 1], v[i], v[i + 1], tol, x0);
+        }
     }
     return cnt;
 }
@@ -250,10 +353,11 @@ static int monotone_level(const double *q, int m, double a, double b, const doub
 /* Derivative bracketing on a finite [a, b], exact degree n >= 3. */
 static int bracket_interval(const double *p, int n, double a, double b, double *out)
 {
-    /* chain[j] = p^(j) scaled to keep the leading coefficient of p: degree n - j */
-    double chain[IG_MAX_DEGREE - 1][IG_MAX_DEGREE + 1];
+    /* chain[j] = p^(j) scaled to keep the leading coefficient of p: degree n - j, so p^(j) =
+     * n (n-1) ... (n-j+1) chain[j] */
+    double chain[IG_MAX_DEGREE][IG_MAX_DEGREE + 1];
     memcpy(chain[0], p, (size_t)(n + 1) * sizeof(double));
-    for (int j = 1; j <= n - 2; ++j) {
+    for (int j = 1; j <= n - 1; ++j) {
         int m = n - j + 1; /* degree of chain[j - 1] */
         double inv = 1.0 / m;
         for (int k = 0; k < m; ++k)
@@ -270,7 +374,7 @@ static int bracket_interval(const double *p, int n, double a, double b, double *
                 buf[cur][nc++] = q[i];
     }
     for (int j = n - 3; j >= 0; --j) {
-        nc = monotone_level(chain[j], n - j, a, b, buf[cur], nc, j == 0, buf[1 - cur]);
+        nc = monotone_level((const double (*)[IG_MAX_DEGREE + 1])chain, j, n, a, b, buf[cur], nc, j == 0, buf[1 - cur]);
         cur = 1 - cur;
     }
     memcpy(out, buf[cur], (size_t)nc * sizeof(double));

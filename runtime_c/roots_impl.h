@@ -26,8 +26,9 @@ int ig_sign_certified(const double *c, int n, double x, double *val);
 
 /* Safeguarded Newton on a bracket [l, r] where c changes sign (sl = sign at l, nonzero). Never leaves the
  * bracket, bisects (in the ordering of doubles, so at most 64 halvings span the whole range) when a Newton
- * step would, and stops after a bounded number of iterations. */
-double ig_refine(const double *c, int n, double l, double r, double vl, double vr);
+ * step would, and stops after a bounded number of iterations. tol: relative accuracy wanted (2^-52: full);
+ * x0: a starting guess (NaN or outside the bracket: false position). */
+double ig_refine(const double *c, int n, double l, double r, double vl, double vr, double tol, double x0);
 
 /* Midpoint of [l, r] in the ordering of doubles (halves the number of doubles between them). */
 double ig_ordered_mid(double l, double r);

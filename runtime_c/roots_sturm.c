@@ -125,7 +125,7 @@ int ig_sturm_interval(const double *p, int n, double a, double b, double *out)
             if (sr == 0) {
                 out[cnt++] = pc.r;
             } else if (sl * sr < 0) {
-                out[cnt++] = ig_refine(p, n, pc.l, pc.r, fl, fr);
+                out[cnt++] = ig_refine(p, n, pc.l, pc.r, fl, fr, 2.0 * IG_U, NAN);
             } else {
                 /* even multiplicity: narrow by counting */
                 double l = pc.l, r = pc.r;
@@ -155,7 +155,9 @@ int ig_sturm_interval(const double *p, int n, double a, double b, double *out)
                         break;
                     x = xn;
                 }
-                out[cnt++] = x;
+                double vx; /* a floating-point Sturm count can be wrong: keep only a certified zero */
+                if (ig_sign_certified(p, n, x, &vx) == 0)
+                    out[cnt++] = x;
             }
             continue;
         }

@@ -1,0 +1,195 @@
+/* Standalone checks of ig_real_roots on built hard cases, every method; run by tests/test_roots_c.py under
+ * AddressSanitizer + UBSan. The expected roots are known exactly (products of known factors, mostly dyadic
+ * so the double coefficients are exact). Prints one line per failure; exit status = number of failures. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "roots.h"
+
+/* method masks: bit m for ig_root_method m */
+#define ALL 15
+#define NO_CLOSED (15 & ~2)
+#define NO_STURM (15 & ~4)
+#define GENERAL (1 | 8) /* auto and bracket */
+
+static int failures = 0;
+static const char *method_names[] = {"auto", "closed", "sturm", "bracket"};
+
+/* c = prod (x - r_i) * prod (x^2 + b x + q) * scale, lowest power first; returns the degree */
+static int from_roots(const double *r, int nr, double (*quad)[2], int nq, double scale, double *c)
+{
+    int n = 0;
+    c[0] = scale;
+    for (int i = 0; i < nr; ++i) {
+        c[n + 1] = 0.0;
+        for (int k = n + 1; k >= 1; --k)
+            c[k] = c[k - 1] - r[i] * c[k];
+        c[0] = -r[i] * c[0];
+        ++n;
+    }
+    for (int i = 0; i < nq; ++i) {
+        double b = quad[i][0], q = quad[i][1];
+        c[n + 1] = c[n + 2] = 0.0;
+        for (int k = n + 2; k >= 0; --k) {
+            double v = q * c[k];
+            if (k >= 1)
+                v += b * c[k - 1];
+            if (k >= 2)
+                v += c[k - 2];
+            c[k] = v;
+        }
+        n += 2;
+    }
+    return n;
+}
+
+static void expect(const char *name, const double *c, int n, double lo, double hi, const double *want, int nw,
+                   double rtol, int methods)
+{
+    for (int m = 0; m <= 3; ++m) {
+        if (!(methods & (1 << m)))
+            continue;
+        double r[IG_MAX_DEGREE + 8];
+        for (int i = 0; i < IG_MAX_DEGREE + 8; ++i)
+            r[i] = -12345.0; /* canary: nothing beyond n may be written */
+        int k = ig_real_roots(c, n, lo, hi, (ig_root_method)m, r);
+        int ok = k == nw;
+        for (int i = 0; ok && i < k; ++i) {
+            if (!(fabs(r[i] - want[i]) <= rtol * fmax(fabs(want[i]), 1e-300)) || isnan(r[i]))
+                ok = 0;
+            if (i > 0 && !(r[i] > r[i - 1]))
+                ok = 0;
+            if (r[i] < lo || r[i] > hi)
+                ok = 0;
+        }
+        for (int i = (n > 0 ? n : 0); i < IG_MAX_DEGREE + 8; ++i)
+            if (r[i] != -12345.0)
+                ok = 0;
+        if (!ok) {
+            ++failures;
+            fprintf(stderr, "FAIL %s [%s]: got %d roots:", name, method_names[m], k);
+            for (int i = 0; i < k && i < 30; ++i)
+                fprintf(stderr, " %.17g", r[i]);
+            fprintf(stderr, "; want %d:", nw);
+            for (int i = 0; i < nw; ++i)
+                fprintf(stderr, " %.17g", want[i]);
+            fprintf(stderr, "\n");
+        }
+    }
+}
+
+int main(void)
+{
+    double c[IG_MAX_DEGREE + 3];
+    const double inf = INFINITY;
+    int n;
+
+    { /* four simple roots */
+        double r[] = {1, 2, 3, 4};
+        n = from_roots(r, 4, NULL, 0, 1.0, c);
+        expect("simple 1..4", c, n, -inf, inf, r, 4, 1e-14, ALL);
+        double w[] = {2, 3};
+        expect("roots exactly at lo and hi", c, n, 2.0, 3.0, w, 2, 0.0, ALL);
+        double w4[] = {4};
+        expect("root exactly at lo only", c, n, 4.0, 10.0, w4, 1, 0.0, ALL);
+        expect("lo == hi at a root", c, n, 3.0, 3.0, r + 2, 1, 0.0, ALL);
+        expect("interval without roots", c, n, 4.5, 9.0, NULL, 0, 0.0, ALL);
+    }
+    { /* degree drop: vanishing leading coefficients, nominal degree 4 */
+        double c1[] = {-2, 1, 0, 0, 0}, w1[] = {2};
+        expect("degree drop to 1", c1, 4, -inf, inf, w1, 1, 0.0, ALL);
+        double c2[] = {6, -5, 1, 0, 0}, w2[] = {2, 3};
+        expect("degree drop to 2", c2, 4, -inf, inf, w2, 2, 1e-15, ALL);
+        double c3[] = {-6, 11, -6, 1, 0}, w3[] = {1, 2, 3};
+        expect("degree drop to 3", c3, 4, -inf, inf, w3, 3, 1e-14, ALL);
+        double c0[] = {3, 0, 0, 0, 0};
+        expect("constant", c0, 4, -inf, inf, NULL, 0, 0.0, ALL);
+        double cz[] = {0, 0, 0, 0, 0};
+        expect("zero polynomial", cz, 4, -inf, inf, NULL, 0, 0.0, ALL);
+        double cx[] = {0, 0, -1, 1, 0}, wx[] = {0, 1}; /* x^2 (x - 1): zero roots */
+        expect("zero root of multiplicity 2", cx, 4, -inf, inf, wx, 2, 1e-15, ALL);
+    }
+    { /* bad input */
+        double c1[] = {1, NAN, 1}, c2[] = {1, INFINITY, -1}, c3[] = {-1, 0, 1};
+        expect("NaN coefficient", c1, 2, -inf, inf, NULL, 0, 0.0, ALL);
+        expect("Inf coefficient", c2, 2, -inf, inf, NULL, 0, 0.0, ALL);
+        expect("lo > hi", c3, 2, 1.0, -1.0, NULL, 0, 0.0, ALL);
+        expect("NaN bound", c3, 2, NAN, 1.0, NULL, 0, 0.0, ALL);
+        double r[IG_MAX_DEGREE];
+        if (ig_real_roots(c3, -1, -inf, inf, IG_ROOTS_AUTO, r) != 0 ||
+            ig_real_roots(c3, IG_MAX_DEGREE + 1, -inf, inf, IG_ROOTS_AUTO, r) != 0) {
+            ++failures;
+            fprintf(stderr, "FAIL degree out of range accepted\n");
+        }
+    }
+    { /* tangent (even multiplicity) roots, exact in double */
+        double r[] = {1, 1, 3}, w[] = {1, 3};
+        n = from_roots(r, 3, NULL, 0, 1.0, c);
+        expect("double root (x-1)^2 (x-3)", c, n, -inf, inf, w, 2, 1e-15, ALL);
+        double r2[] = {0.5, 0.5, -2, -2}, w2[] = {-2, 0.5};
+        n = from_roots(r2, 4, NULL, 0, 1.0, c);
+        expect("two double roots", c, n, -inf, inf, w2, 2, 1e-15, ALL);
+        double r4[] = {1.25, 1.25, 1.25, 1.25}, w4[] = {1.25};
+        n = from_roots(r4, 4, NULL, 0, 1.0, c);
+        expect("quadruple root", c, n, -inf, inf, w4, 1, 1e-15, NO_STURM);
+        double r5[] = {0.75, 0.75, -1.5}, q5[][2] = {{-1, 0.5}}, w5[] = {-1.5, 0.75};
+        n = from_roots(r5, 3, q5, 1, 1.0, c);
+        expect("double root beside a complex pair", c, n, -inf, inf, w5, 2, 1e-15, ALL);
+        double r6[] = {2, 2, 2, 2, -1, -1}, w6[] = {-1, 2};
+        n = from_roots(r6, 6, NULL, 0, 1.0, c);
+        expect("degree 6: quadruple and double", c, n, -inf, inf, w6, 2, 1e-15, NO_STURM);
+    }
+    { /* a tiny positive minimum is not a root */
+        double q[][2] = {{-2, 1 + 0x1p-40}}, r[] = {-3};
+        n = from_roots(NULL, 0, q, 1, 1.0, c);
+        expect("tiny minimum, quadratic", c, n, -inf, inf, NULL, 0, 0.0, ALL);
+        n = from_roots(r, 1, q, 1, 1.0, c);
+        expect("tiny minimum beside a root", c, n, -inf, inf, r, 1, 1e-15, ALL);
+        double q2[][2] = {{-2, 1 + 0x1p-52}, {0, 4}};
+        n = from_roots(NULL, 0, q2, 2, 1.0, c);
+        expect("minimum 2^-52 (quartic)", c, n, -inf, inf, NULL, 0, 0.0, ALL);
+    }
+    { /* clusters */
+        double r[] = {1.0, 1.001, 1.002, 1.003};
+        n = from_roots(r, 4, NULL, 0, 1.0, c);
+        /* the decimal roots are not exact in the double coefficients: condition ~1e8 x 2^-53 */
+        expect("cluster 1.000..1.003", c, n, -inf, inf, r, 4, 1e-6, ALL);
+        double r6[] = {1.0, 1.001, 1.002, 1.003, -2.0, 5.0}, w6[] = {-2.0, 1.0, 1.001, 1.002, 1.003, 5.0};
+        n = from_roots(r6, 6, NULL, 0, 1.0, c);
+        expect("cluster in degree 6", c, n, -inf, inf, w6, 6, 1e-6, ALL);
+    }
+    { /* scale */
+        double r[] = {-1.5, 0.25, 2, 3};
+        n = from_roots(r, 4, NULL, 0, 1e150, c);
+        expect("coefficients ~1e150", c, n, -inf, inf, r, 4, 1e-14, ALL);
+        n = from_roots(r, 4, NULL, 0, 1e-150, c);
+        expect("coefficients ~1e-150", c, n, -inf, inf, r, 4, 1e-14, ALL);
+        n = from_roots(r, 4, NULL, 0, 1e300, c);
+        expect("coefficients ~1e300", c, n, -inf, inf, r, 4, 1e-14, ALL);
+        double s[] = {-1e30, 1e-30, 1.0};
+        n = from_roots(s, 3, NULL, 0, 1.0, c);
+        double ws[] = {-1e30, 1e-30, 1.0};
+        expect("roots 1e-30 .. 1e30", c, n, -inf, inf, ws, 3, 1e-14, GENERAL); /* closed, Sturm: documented limits */
+        double h[] = {1e100, -3.0, 1e-100, 7.0}, wh[] = {-3.0, 1e-100, 7.0, 1e100};
+        n = from_roots(h, 4, NULL, 0, 1.0, c);
+        expect("root 1e100 (reversed-polynomial range)", c, n, -inf, inf, wh, 4, 1e-14, GENERAL);
+    }
+    { /* high degree products of known factors */
+        double r[] = {-2.5, -1.25, -0.5, 0.375, 1.5, 2.75}, q[][2] = {{0, 1}, {-1, 2}, {2, 5}, {0.5, 0.5}, {-3, 3}, {1, 1}};
+        n = from_roots(r, 6, q, 6, 1.0, c); /* degree 18 */
+        expect("degree 18: 6 real, 6 complex pairs", c, n, -inf, inf, r, 6, 1e-10, ALL);
+        double q9[][2] = {{0, 1}, {-1, 2}, {2, 5}, {0.5, 0.5}, {-3, 3}, {1, 1}, {0, 2}, {1.5, 1}, {-0.5, 1}};
+        n = from_roots(r, 6, q9, 9, 1.0, c); /* degree 24 */
+        expect("degree 24: 6 real, 9 complex pairs", c, n, -inf, inf, r, 6, 1e-9, ALL);
+        double r12[] = {-3, -2.5, -2, -1.5, -1, -0.5, 0.5, 1, 1.5, 2, 2.5, 3};
+        n = from_roots(r12, 12, NULL, 0, 1.0, c);
+        expect("degree 12: 12 real roots", c, n, -inf, inf, r12, 12, 1e-9, ALL);
+        double w[] = {-1, -0.5, 0.5, 1};
+        /* Sturm: its floating-point count goes wrong here (see docs/solvers.md) */
+        expect("degree 12 on [-1, 1]", c, n, -1.0, 1.0, w, 4, 1e-9, NO_STURM);
+    }
+    if (failures == 0)
+        printf("test_roots: all cases passed\n");
+    return failures;
+}
