@@ -1,0 +1,349 @@
+"""Scene files: YAML -> validated dataclasses. The format is documented in docs/tracer.md.
+
+Every error is a UserError naming the scene file and the key at fault (`objects[2].transform.rotate`), so
+the CLI prints one line and exits with status 2 before anything is compiled or written.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Union
+
+import numpy as np
+
+from . import transform as tf
+from .errors import UserError
+from .spec import Spec, load_spec, parse_spec, read_yaml
+
+MAX_CSG_DEPTH = 48   # = RT_MAX_CSG_DEPTH in runtime_c/tracer.h
+MAX_DEPTH = 64       # = RT_MAX_DEPTH
+MAX_SPP = 4096       # = RT_MAX_SPP in tracer_render.c
+CSG_OPS = ("union", "intersection", "difference")
+
+
+@dataclass
+class Material:
+    color: tuple[float, float, float] = (0.8, 0.8, 0.8)
+    color2: tuple[float, float, float] = (0.2, 0.2, 0.2)
+    checker_scale: float = 0.0
+    ambient: float = 0.1
+    diffuse: float = 0.8
+    specular: float = 0.3
+    shininess: float = 50.0
+    reflectivity: float = 0.0
+    transparency: float = 0.0
+    ior: float = 1.5
+    absorption: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def packed(self) -> list[float]:
+        """RT_MATERIAL_DOUBLES values in the order of rt_material (tracer.h)."""
+        return [*self.color, *self.color2, self.checker_scale, self.ambient, self.diffuse, self.specular,
+                self.shininess, self.reflectivity, self.transparency, self.ior, *self.absorption, 0.0, 0.0]
+
+
+@dataclass
+class Leaf:
+    spec: Spec
+    params: dict[str, float]          # every param of the spec, in its declared order
+    matrix: np.ndarray                # 3x4 object -> world
+    material: Material | None
+    where: str                        # key path in the scene, for messages
+
+
+@dataclass
+class Csg:
+    op: str
+    left: "Node"
+    right: "Node"
+    material: Material | None
+    where: str
+
+
+Node = Union[Leaf, Csg]
+
+
+@dataclass
+class Light:
+    position: tuple[float, float, float]
+    color: tuple[float, float, float]     # colour x intensity
+
+
+@dataclass
+class Camera:
+    position: tuple[float, float, float] = (0.0, 1.0, 6.0)
+    look_at: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    up: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    fov: float = 40.0
+
+
+@dataclass
+class Scene:
+    source: str
+    width: int = 640
+    height: int = 480
+    spp: int = 1
+    max_depth: int = 8
+    camera: Camera = field(default_factory=Camera)
+    background: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    lights: list[Light] = field(default_factory=list)
+    objects: list[Node] = field(default_factory=list)
+
+    def leaves(self) -> list[Leaf]:
+        out: list[Leaf] = []
+
+        def walk(n: Node) -> None:
+            if isinstance(n, Leaf):
+                out.append(n)
+            else:
+                walk(n.left)
+                walk(n.right)
+
+        for o in self.objects:
+            walk(o)
+        return out
+
+    def specs(self) -> list[Spec]:
+        """The distinct shapes the scene uses (what gets generated and compiled, nothing else)."""
+        seen: dict[int, Spec] = {}
+        for leaf in self.leaves():
+            seen.setdefault(id(leaf.spec), leaf.spec)
+        return list(seen.values())
+
+
+# ----------------------------------------------------------------------------------------------- helpers
+
+TOP_KEYS = ("image", "camera", "background", "lights", "materials", "objects")
+IMAGE_KEYS = ("width", "height", "spp", "max_depth")
+CAMERA_KEYS = ("position", "look_at", "up", "fov")
+LIGHT_KEYS = ("position", "color", "intensity")
+MATERIAL_KEYS = ("color", "checker", "ambient", "diffuse", "specular", "shininess", "reflectivity",
+                 "transparency", "ior", "absorption")
+LEAF_KEYS = ("shape", "equation", "name", "params", "bounds", "transform", "material")
+
+
+class _Ctx:
+    def __init__(self, path: Path):
+        self.path = path
+        self.source = str(path)
+        self.spec_cache: dict[Path, Spec] = {}
+        self.inline_count = 0
+
+    def fail(self, key: str, msg: str) -> UserError:
+        return UserError(self.source, f"{key}: {msg}")
+
+
+def _mapping(ctx: _Ctx, key: str, value: Any, allowed: tuple[str, ...]) -> dict:
+    if not isinstance(value, dict):
+        raise ctx.fail(key, "expected a mapping")
+    for k in value:
+        if k not in allowed:
+            raise ctx.fail(f"{key}.{k}" if key else str(k), f"unknown key (allowed: {', '.join(allowed)})")
+    return value
+
+
+def _num(ctx: _Ctx, key: str, value: Any, lo: float = -math.inf, hi: float = math.inf,
+         lo_open: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ctx.fail(key, "expected a finite number")
+    v = float(value)
+    if v < lo or v > hi or (lo_open and v == lo):
+        rng = f"{'(' if lo_open else '['}{lo:g}, {hi:g}]"
+        raise ctx.fail(key, f"{v:g} is outside {rng}")
+    return v
+
+
+def _int(ctx: _Ctx, key: str, value: Any, lo: int, hi: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ctx.fail(key, "expected a whole number")
+    if not lo <= value <= hi:
+        raise ctx.fail(key, f"{value} is outside [{lo}, {hi}]")
+    return value
+
+
+def _vec(ctx: _Ctx, key: str, value: Any, lo: float = -math.inf) -> tuple[float, float, float]:
+    if not isinstance(value, (list, tuple)) or len(value) != 3:
+        raise ctx.fail(key, "expected a list of three numbers")
+    return tuple(_num(ctx, f"{key}[{i}]", v, lo) for i, v in enumerate(value))  # type: ignore[return-value]
+
+
+def _material(ctx: _Ctx, key: str, raw: Any) -> Material:
+    raw = _mapping(ctx, key, raw, MATERIAL_KEYS)
+    m = Material()
+    if "color" in raw:
+        m.color = _vec(ctx, f"{key}.color", raw["color"], 0.0)
+    if "checker" in raw:
+        ch = _mapping(ctx, f"{key}.checker", raw["checker"], ("colors", "scale"))
+        cols = ch.get("colors")
+        if not isinstance(cols, list) or len(cols) != 2:
+            raise ctx.fail(f"{key}.checker.colors", "expected two colours")
+        m.color = _vec(ctx, f"{key}.checker.colors[0]", cols[0], 0.0)
+        m.color2 = _vec(ctx, f"{key}.checker.colors[1]", cols[1], 0.0)
+        m.checker_scale = _num(ctx, f"{key}.checker.scale", ch.get("scale", 1.0), 0.0, lo_open=True)
+    for k in ("ambient", "diffuse", "specular", "reflectivity", "transparency"):
+        if k in raw:
+            setattr(m, k, _num(ctx, f"{key}.{k}", raw[k], 0.0, 1.0 if k in ("reflectivity", "transparency")
+                               else math.inf))
+    if "shininess" in raw:
+        m.shininess = _num(ctx, f"{key}.shininess", raw["shininess"], 0.0)
+    if "ior" in raw:
+        m.ior = _num(ctx, f"{key}.ior", raw["ior"], 0.0, lo_open=True)
+    if "absorption" in raw:
+        m.absorption = _vec(ctx, f"{key}.absorption", raw["absorption"], 0.0)
+    return m
+
+
+def _material_ref(ctx: _Ctx, key: str, raw: Any, named: dict[str, Material]) -> Material:
+    if isinstance(raw, str):
+        if raw not in named:
+            known = ", ".join(sorted(named)) or "none defined"
+            raise ctx.fail(key, f"no material named {raw!r} (materials: {known})")
+        return named[raw]
+    return _material(ctx, key, raw)
+
+
+def _resolve_shape_path(ctx: _Ctx, key: str, value: Any) -> Path:
+    if not isinstance(value, str) or not value.strip():
+        raise ctx.fail(key, "expected the path of a spec file")
+    p = Path(value)
+    candidates = [p] if p.is_absolute() else [ctx.path.parent / p, Path.cwd() / p]
+    for c in candidates:
+        if c.is_file():
+            return c.resolve()
+    tried = " or ".join(str(c) for c in candidates)
+    raise ctx.fail(key, f"spec file not found (tried {tried})")
+
+
+def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
+    _mapping(ctx, key, raw, LEAF_KEYS)
+    if ("shape" in raw) == ("equation" in raw):
+        raise ctx.fail(key, "give exactly one of 'shape' (a spec file) or 'equation' (an inline shape), "
+                            f"or a CSG operation ({', '.join(CSG_OPS)})")
+    if "shape" in raw:
+        for k in ("name", "bounds"):
+            if k in raw:
+                raise ctx.fail(f"{key}.{k}", "only for an inline 'equation' (a spec file has its own)")
+        path = _resolve_shape_path(ctx, f"{key}.shape", raw["shape"])
+        if path not in ctx.spec_cache:
+            ctx.spec_cache[path] = load_spec(path)
+        spec = ctx.spec_cache[path]
+        overrides = raw.get("params") or {}
+    else:
+        ctx.inline_count += 1
+        mapping = {"name": raw.get("name", f"inline{ctx.inline_count}"), "equation": raw["equation"]}
+        if "bounds" in raw:
+            mapping["bounds"] = raw["bounds"]
+        if "params" in raw:
+            mapping["params"] = raw["params"]
+        spec = parse_spec(mapping, f"{ctx.source}: {key}")
+        overrides = {}
+    if not isinstance(overrides, dict):
+        raise ctx.fail(f"{key}.params", "expected a mapping name -> number")
+    params = dict(spec.params)
+    for name, v in overrides.items():
+        if name not in spec.params:
+            known = ", ".join(spec.params) or "none"
+            raise ctx.fail(f"{key}.params.{name}", f"shape {spec.name!r} has no such param (params: {known})")
+        params[name] = _num(ctx, f"{key}.params.{name}", v)
+    m = tf.parse_transform(ctx.source, f"{key}.transform", raw.get("transform"))
+    mat = _material_ref(ctx, f"{key}.material", raw["material"], named) if "material" in raw else None
+    return Leaf(spec=spec, params=params, matrix=m, material=mat, where=key)
+
+
+def _node(ctx: _Ctx, key: str, raw: Any, named: dict[str, Material], depth: int) -> Node:
+    if not isinstance(raw, dict):
+        raise ctx.fail(key, "expected a mapping (a shape, an inline equation or a CSG operation)")
+    ops = [op for op in CSG_OPS if op in raw]
+    if not ops:
+        return _leaf(ctx, key, raw, named)
+    if len(ops) > 1:
+        raise ctx.fail(key, f"one CSG operation per node (found {', '.join(ops)})")
+    op = ops[0]
+    _mapping(ctx, key, raw, (op, "material", "transform"))
+    if depth >= MAX_CSG_DEPTH:
+        raise ctx.fail(key, f"CSG nested deeper than {MAX_CSG_DEPTH}")
+    kids = raw[op]
+    if not isinstance(kids, list) or len(kids) < 2:
+        raise ctx.fail(f"{key}.{op}", "expected a list of at least two objects")
+    children = [_node(ctx, f"{key}.{op}[{i}]", k, named, depth + 1) for i, k in enumerate(kids)]
+    mat = _material_ref(ctx, f"{key}.material", raw["material"], named) if "material" in raw else None
+    # n-ary operations fold from the left: difference [A, B, C] = (A - B) - C
+    node: Node = children[0]
+    for c in children[1:]:
+        node = Csg(op=op, left=node, right=c, material=None, where=key)
+    assert isinstance(node, Csg)
+    node.material = mat
+    if "transform" in raw:
+        m = tf.parse_transform(ctx.source, f"{key}.transform", raw["transform"])
+        _apply_transform(node, m)
+    return node
+
+
+def _apply_transform(node: Node, m: np.ndarray) -> None:
+    """A transform on a CSG node moves every leaf below it (applied after the leaves' own)."""
+    if isinstance(node, Leaf):
+        node.matrix = tf.compose(m, node.matrix)
+    else:
+        _apply_transform(node.left, m)
+        _apply_transform(node.right, m)
+
+
+def parse_scene(data: Any, source: str | Path = "<scene>") -> Scene:
+    path = Path(source)
+    ctx = _Ctx(path)
+    if not isinstance(data, dict):
+        raise UserError(ctx.source, "a scene must be a mapping with at least 'objects'")
+    _mapping(ctx, "", data, TOP_KEYS)
+    sc = Scene(source=ctx.source)
+    img = _mapping(ctx, "image", data.get("image") or {}, IMAGE_KEYS)
+    sc.width = _int(ctx, "image.width", img.get("width", sc.width), 1, 16384)
+    sc.height = _int(ctx, "image.height", img.get("height", sc.height), 1, 16384)
+    sc.spp = _int(ctx, "image.spp", img.get("spp", sc.spp), 1, MAX_SPP)
+    sc.max_depth = _int(ctx, "image.max_depth", img.get("max_depth", sc.max_depth), 0, MAX_DEPTH)
+    cam = _mapping(ctx, "camera", data.get("camera") or {}, CAMERA_KEYS)
+    c = Camera()
+    if "position" in cam:
+        c.position = _vec(ctx, "camera.position", cam["position"])
+    if "look_at" in cam:
+        c.look_at = _vec(ctx, "camera.look_at", cam["look_at"])
+    if "up" in cam:
+        c.up = _vec(ctx, "camera.up", cam["up"])
+    if "fov" in cam:
+        c.fov = _num(ctx, "camera.fov", cam["fov"], 0.0, 179.0, lo_open=True)
+    view = np.subtract(c.look_at, c.position)
+    if not np.linalg.norm(view) > 0:
+        raise ctx.fail("camera.look_at", "must differ from camera.position")
+    if not np.linalg.norm(np.cross(view, c.up)) > 1e-9 * np.linalg.norm(view) * np.linalg.norm(c.up):
+        raise ctx.fail("camera.up", "must not be zero or parallel to the viewing direction")
+    sc.camera = c
+    if "background" in data:
+        sc.background = _vec(ctx, "background", data["background"], 0.0)
+    lights = data.get("lights") or []
+    if not isinstance(lights, list):
+        raise ctx.fail("lights", "expected a list")
+    for i, raw in enumerate(lights):
+        raw = _mapping(ctx, f"lights[{i}]", raw, LIGHT_KEYS)
+        if "position" not in raw:
+            raise ctx.fail(f"lights[{i}]", "missing key 'position'")
+        col = _vec(ctx, f"lights[{i}].color", raw.get("color", [1, 1, 1]), 0.0)
+        k = _num(ctx, f"lights[{i}].intensity", raw.get("intensity", 1.0), 0.0)
+        sc.lights.append(Light(_vec(ctx, f"lights[{i}].position", raw["position"]), tuple(k * x for x in col)))
+    named: dict[str, Material] = {}
+    mats = data.get("materials") or {}
+    if not isinstance(mats, dict):
+        raise ctx.fail("materials", "expected a mapping name -> material")
+    for name, raw in mats.items():
+        named[str(name)] = _material(ctx, f"materials.{name}", raw)
+    objs = data.get("objects")
+    if not isinstance(objs, list) or not objs:
+        raise ctx.fail("objects", "expected a non-empty list")
+    sc.objects = [_node(ctx, f"objects[{i}]", raw, named, 0) for i, raw in enumerate(objs)]
+    return sc
+
+
+def load_scene(path: str | Path) -> Scene:
+    path = Path(path)
+    if not path.is_file():
+        raise UserError(path, "scene file not found")
+    return parse_scene(read_yaml(path), path)
