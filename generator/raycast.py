@@ -24,6 +24,9 @@ def _clip(box: np.ndarray | None, o: np.ndarray, d: np.ndarray, t0: np.ndarray, 
     if box is None:
         return t0, t1, valid
     lo, hi = box[:3], box[3:]
+    # the box grows by 1e-9 of its finite extent, as in shape.c: a surface touching its box keeps that root
+    scale = np.maximum(np.where(np.isfinite(lo), np.abs(lo), 0.0), np.where(np.isfinite(hi), np.abs(hi), 0.0))
+    lo, hi = lo - 1e-9 * scale, hi + 1e-9 * scale
     with np.errstate(divide="ignore", invalid="ignore"):
         inv = 1.0 / d
         ta = (lo - o) * inv

@@ -298,7 +298,7 @@ static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n
 {
     const double *q = chain[j], *ddq = chain[j + 2];
     const int m = n - j;
-    double xs[IG_MAX_DEGREE + 2], v[IG_MAX_DEGREE + 2];
+    double xs[IG_MAX_DEGREE + 2], v[IG_MAX_DEGREE + 2], rv[IG_MAX_DEGREE + 2];
     int s[IG_MAX_DEGREE + 2];
     int np = 0;
     xs[np++] = a;
@@ -308,28 +308,43 @@ static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n
     if (b > a)
         xs[np++] = b;
     /* one a-priori rounding bound for the whole interval: gamma_2m sum |q_k| max(|a|,|b|)^k */
-    double big = 0.0;
+    double big = 0.0, g2m = 2.0 * m * IG_U;
+    g2m = g2m / (1.0 - g2m);
     if (final) {
         double M = fmax(fabs(a), fabs(b));
         for (int k = m; k >= 0; --k)
             big = big * M + fabs(q[k]);
-        double g = 2.0 * m * IG_U;
-        big *= g / (1.0 - g);
+        big *= g2m;
     }
     for (int i = 0; i < np; ++i) {
         v[i] = horner(q, m, xs[i]);
         s[i] = (v[i] > 0.0) - (v[i] < 0.0);
+        rv[i] = xs[i];
         if (final && !(fabs(v[i]) > big)) {
-            if (i > 0 && i < np - 1)
-                xs[i] = polish_multiple(chain, n, xs[i], xs[i - 1], xs[i + 1]);
-            s[i] = ig_sign_certified(q, m, xs[i], &v[i]);
+            /* the coarse bound could not decide: the bound at this very point, then the compensated value */
+            double sum = 0.0, ax = fabs(xs[i]), vc;
+            for (int k = m; k >= 0; --k)
+                sum = sum * ax + fabs(q[k]);
+            if (fabs(v[i]) > g2m * sum)
+                continue;
+            s[i] = ig_sign_certified(q, m, xs[i], &vc);
+            v[i] = vc; /* the plain value may even have the wrong sign: refine must see the right one */
+            if (s[i] != 0 && i > 0 && i < np - 1) {
+                /* maybe a multiple root the critical point missed by rounding: polish, and take it only if p
+                 * is then certified zero (a tiny extremum that is not a root stays as it was) */
+                double y = polish_multiple(chain, n, xs[i], xs[i - 1], xs[i + 1]), vy;
+                if (ig_sign_certified(q, m, y, &vy) == 0) {
+                    s[i] = 0;
+                    rv[i] = y;
+                }
+            }
         }
     }
     double tol = final ? 2.0 * IG_U : 1e-7;
     int cnt = 0;
     for (int i = 0; i < np; ++i) {
         if (s[i] == 0 && (final || (i > 0 && i < np - 1)))
-            out[cnt++] = xs[i];
+            out[cnt++] = rv[i];
         if (i + 1 < np && s[i] * s[i + 1] < 0) {
             /* Start guess from the quadratic Taylor model at the critical end with the smaller |q| (q' = 0
              * there): q(xc) + q''(xc) (x - xc)^2 / 2 = 0. Near a tangent -- two roots either side of a

@@ -14,11 +14,20 @@
 
 #include <math.h>
 
-/* Slab clip of [*t0, *t1] against box; an infinite bound imposes nothing on its side. 0 when empty. */
+/* Slab clip of [*t0, *t1] against box (padded, see below); an infinite bound imposes nothing on its
+ * side. 0 when empty. */
 static int clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1)
 {
     for (int i = 0; i < 3; ++i) {
-        double lo = box[i], hi = box[i + 3];
+        /* the box grows by 1e-9 of its finite extent: a surface that touches its own box (the torus at
+         * |x| = a + b) keeps the root there despite the rounding of the slab distances */
+        double lo = box[i], hi = box[i + 3], scale = 0.0;
+        if (isfinite(lo))
+            scale = fabs(lo);
+        if (isfinite(hi) && fabs(hi) > scale)
+            scale = fabs(hi);
+        lo -= 1e-9 * scale;
+        hi += 1e-9 * scale;
         if (d[i] == 0.0) {
             if (o[i] < lo || o[i] > hi)
                 return 0;
