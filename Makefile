@@ -31,5 +31,9 @@ test: install
 regen: install
 	$(BIN)/implgen examples/shapes/*.yaml --lang all -o generated
 
+# Render every example scene into docs/gallery/ (images + times.md).
+gallery: install
+	$(BIN)/python bench/gallery.py
+
 clean:
 	rm -rf $(VENV) build *.egg-info
