@@ -1,0 +1,81 @@
+"""`implgen bench render [SCENE.yaml ...] [--width 800 --height 600 --spp 1] [--fold-compare]`
+
+Renders each scene (default: examples/scenes/*.yaml) once on 1 thread and once on all threads, and prints a
+Markdown table of the wall time and rays per second by kind (primary, shadow, secondary). The library is
+built before timing, so compilation is not measured. With --fold-compare it also renders every scene with
+the shape params folded into the generated code as constants, to see whether that pays.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+from pathlib import Path
+from typing import Sequence
+
+from .build import build_scene
+from .errors import UserError
+from .render import RenderInfo, render
+from .scene import load_scene
+
+
+def _default_scenes() -> list[Path]:
+    here = Path.cwd() / "examples" / "scenes"
+    return sorted(here.glob("*.yaml"))
+
+
+def _cpu() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def main(argv: Sequence[str]) -> int:
+    ap = argparse.ArgumentParser(prog="implgen bench render")
+    ap.add_argument("scenes", nargs="*", type=Path)
+    ap.add_argument("--width", type=int, default=800)
+    ap.add_argument("--height", type=int, default=600)
+    ap.add_argument("--spp", type=int, default=1)
+    ap.add_argument("--fold-compare", action="store_true")
+    args = ap.parse_args(list(argv))
+    scenes = args.scenes or _default_scenes()
+    if not scenes:
+        raise UserError("bench render", "no scenes given and none in ./examples/scenes")
+    ncpu = os.cpu_count() or 1
+    print(f"{args.width}x{args.height}, {args.spp} sample(s) per pixel; {_cpu()}, {ncpu} cores\n")
+    print("| scene | threads | time (s) | primary Mrays/s | shadow Mrays/s | secondary Mrays/s | all Mrays/s |")
+    print("|---|---:|---:|---:|---:|---:|---:|")
+    fold_rows = []
+    for path in scenes:
+        sc = load_scene(path)
+        build_scene(sc)  # compile before timing
+        for threads in sorted({1, ncpu}):
+            info = RenderInfo()
+            render(sc, width=args.width, height=args.height, spp=args.spp, threads=threads, info=info)
+            r = info.rays
+            t = info.seconds
+            print(f"| {path.stem} | {threads} | {t:.2f} | {r['primary'] / t / 1e6:.2f} | "
+                  f"{r['shadow'] / t / 1e6:.2f} | {r['secondary'] / t / 1e6:.2f} | {sum(r.values()) / t / 1e6:.2f} |")
+        if args.fold_compare:
+            times = []
+            for fold in (False, True):
+                build_scene(load_scene(path), fold=fold)
+                best = float("inf")
+                for _ in range(2):
+                    info = RenderInfo()
+                    render(load_scene(path), width=args.width, height=args.height, spp=args.spp, threads=1,
+                           fold=fold, info=info)
+                    best = min(best, info.seconds)
+                times.append(best)
+            fold_rows.append((path.stem, times[0], times[1]))
+    if fold_rows:
+        print("\n| scene | params at run time (s) | params folded (s) | change |")
+        print("|---|---:|---:|---:|")
+        for name, a, b in fold_rows:
+            print(f"| {name} | {a:.3f} | {b:.3f} | {100 * (b - a) / a:+.1f}% |")
+    return 0
