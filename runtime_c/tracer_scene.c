@@ -479,7 +479,8 @@ int rt_scene_node_box(const rt_scene *s, int node, double box[6])
  * coordinate origin). Two estimates, the larger wins: Horner's running error bound eps * sum |c_k| |tau|^k
  * at the root's offset tau from that point, and the disagreement between that expansion and the generated
  * value(p) -- two roundings of the same number, which catches cancellation inside the coefficients (a
- * cubed factor expanded into monomials) that the first estimate cannot see. */
+ * cubed factor expanded into monomials) that the first estimate cannot see. Measured by
+ * tests/c/tracer_offsets.c. */
 static double solver_noise(const rt_node *n, const double oo[3], const double od[3], const double po[3], double fp,
                            double t)
 {
@@ -505,7 +506,21 @@ static double solver_noise(const rt_node *n, const double oo[3], const double od
         pw *= fabs(tau);
     }
     for (k = deg; k >= 0; --k) horner = horner * tau + c[k];
-    (void)po;
+    /* The secondary ray will be solved from its own shift point, not this one; when this ray's shift point
+     * happens to sit at the hit, the sum above sees only |f(po)| ~ 0. So also expand along the segment from
+     * the box centre (the coordinate origin on open axes) to po: the noise any ray solved inside the box
+     * meets near po. */
+    {
+        double centre[3], seg[3], c2[IG_MAX_DEGREE + 1], sum2 = 0.0;
+        for (a = 0; a < 3; ++a) {
+            int finite = n->obounded && isfinite(n->obox[a]) && isfinite(n->obox[a + 3]);
+            centre[a] = finite ? 0.5 * n->obox[a] + 0.5 * n->obox[a + 3] : 0.0;
+            seg[a] = po[a] - centre[a];
+        }
+        n->shape->coeffs(centre, seg, n->params, c2);
+        for (k = 0; k <= deg; ++k) sum2 += fabs(c2[k]);
+        if (sum2 > sum) sum = sum2;
+    }
     sum = RT_ERR_OBJECT * DBL_EPSILON * (double)(deg + 1) * sum;
     horner = RT_ERR_OBJECT * fabs(horner - fp);
     if (!isfinite(sum) || !isfinite(horner)) return 0.0;
