@@ -512,7 +512,7 @@ def targets(r: dict) -> list[str]:
         ours_wrong, pov_wrong = c["povray_right"], c["implgen_right"]
         out.append(f"{name}: disputed pixels checked {c['checked']}; implgen wrong on {ours_wrong}, POV-Ray wrong on "
                    f"{pov_wrong}: fewer disagreements with the exact reference "
-                   f"{'MET' if ours_wrong < pov_wrong or (ours_wrong == 0 and pov_wrong == 0) else 'MISSED'}")
+                   f"{'MET' if ours_wrong < pov_wrong else ('TIE (not strictly met)' if ours_wrong == pov_wrong else 'MISSED')}")
     return out
 
 
