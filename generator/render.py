@@ -36,6 +36,7 @@ class RenderInfo:
     rays: dict[str, float] = field(default_factory=dict)
     library: Path | None = None
     threads: int = 1
+    nonfinite: int = 0       # samples that came out NaN/inf (rendered as 0); should always be 0
 
 
 class CScene:
@@ -167,12 +168,13 @@ def render(scene: Scene | str | Path | dict, *, width: int | None = None, height
         seconds = time.perf_counter() - t0
         if result.get("code", -1) != 0:
             raise RuntimeError(f"render failed (code {result.get('code')})")
-        stats = (ctypes.c_double * 3)()
+        stats = (ctypes.c_double * 4)()
         cs.lib.rt_render_stats(ctx, stats)
         cs.lib.rt_render_free(ctx)
         if info is not None:
             info.seconds = seconds
-            info.rays = dict(zip(RAY_KINDS, stats[:]))
+            info.rays = dict(zip(RAY_KINDS, stats[:3]))
+            info.nonfinite = int(stats[3])
             info.library = built.library
             info.threads = nthreads
         return out
@@ -233,6 +235,8 @@ def main(argv: Sequence[str]) -> int:
     args = ap.parse_args(list(argv))
     if args.output.suffix.lower() != ".png":
         raise UserError(args.output, "the output must be a .png file")
+    if not (args.output.parent if str(args.output.parent) else Path(".")).is_dir():
+        raise UserError(args.output, "the output folder does not exist")
     scene = load_scene(args.scene)
     info = RenderInfo()
     img = render(scene, width=args.width, height=args.height, spp=args.spp, threads=args.threads,

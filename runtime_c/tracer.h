@@ -112,8 +112,9 @@ double rt_fresnel(double cos_i, double eta);
 void rt_spawn_origin(const rt_hit *hit, const double d[3], double origin[3]);
 
 /* ---- rendering (tracer_render.c) ---- */
-/* Ray counts by kind, in rt_render_stats order. */
-enum { RT_RAYS_PRIMARY = 0, RT_RAYS_SHADOW = 1, RT_RAYS_SECONDARY = 2, RT_NSTATS = 3 };
+/* Ray counts by kind, in rt_render_stats order, and the number of samples whose colour came out NaN or
+ * infinite (written as 0 so one bad sample cannot spoil an image, but counted so tests can insist on 0). */
+enum { RT_RAYS_PRIMARY = 0, RT_RAYS_SHADOW = 1, RT_RAYS_SECONDARY = 2, RT_NONFINITE = 3, RT_NSTATS = 4 };
 rt_render *rt_render_new(const rt_scene *s, int width, int height, int spp, int max_depth, int threads,
                          unsigned long seed);
 void rt_render_free(rt_render *r);

@@ -123,11 +123,15 @@ static void render_row(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
             py = (1.0 - 2.0 * (y + sy) / r->height) * r->tan_half;
             for (a = 0; a < 3; ++a) d[a] = px * r->u[a] + py * r->v[a] - r->w[a];
             rt_trace_ray(r->s, r->eye, d, r->max_depth, c, stats);
+            if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {
+                stats[RT_NONFINITE] += 1.0;
+                continue;
+            }
             for (a = 0; a < 3; ++a) acc[a] += c[a];
         }
         for (a = 0; a < 3; ++a) {
             double v = acc[a] / r->spp;
-            r->rgb[((size_t)y * (size_t)r->width + (size_t)x) * 3 + (size_t)a] = (float)(isfinite(v) ? v : 0.0);
+            r->rgb[((size_t)y * (size_t)r->width + (size_t)x) * 3 + (size_t)a] = (float)v;
         }
     }
 }
@@ -135,7 +139,7 @@ static void render_row(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
 static void *worker(void *arg)
 {
     rt_render *r = arg;
-    double stats[RT_NSTATS] = {0.0, 0.0, 0.0};
+    double stats[RT_NSTATS] = {0.0, 0.0, 0.0, 0.0};
     int *perm = malloc((size_t)r->spp * sizeof(int)), y, a;
     if (!perm) return NULL;
     for (;;) {

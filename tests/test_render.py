@@ -12,7 +12,7 @@ import pytest
 from implgen import build, cbuild
 from implgen.cli import main as cli_main
 from implgen.errors import UserError
-from implgen.render import CScene, render
+from implgen.render import CScene, RenderInfo, render
 from implgen.scene import load_scene, parse_scene
 from implgen.transform import invert, parse_transform
 
@@ -186,8 +186,10 @@ def test_glass_sphere_flips_checkerboard() -> None:
 
 @pytest.mark.parametrize("scene", sorted(p.name for p in SCENES.glob("*.yaml")))
 def test_example_scenes_render_without_nan(scene: str) -> None:
-    img = render(SCENES / scene, width=48, height=36, spp=1, threads=2)
+    info = RenderInfo()
+    img = render(SCENES / scene, width=48, height=36, spp=1, threads=2, info=info)
     assert img.shape == (36, 48, 3) and np.isfinite(img).all()
+    assert info.nonfinite == 0          # no sample came out NaN (the renderer would have masked it)
     assert img.std() > 0.01   # not a blank image
 
 
