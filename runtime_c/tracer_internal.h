@@ -61,7 +61,16 @@ typedef struct rt_span {
     rt_end in, out;
 } rt_span;
 
+/* The closest hit before its normal and error bound are worked out (rt_finish_hit), so a shadow ray that
+ * meets an opaque object can stop without that cost. */
+typedef struct rt_pending {
+    double t;
+    int object, leaf, face, entering, entering_known;
+} rt_pending;
+
 /* tracer_scene.c */
+int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax,
+                     rt_pending *out);
 void rt_xform_point(const double m[12], const double p[3], double out[3]);
 void rt_xform_vector(const double m[12], const double v[3], double out[3]);
 int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0,

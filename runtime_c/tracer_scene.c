@@ -538,7 +538,7 @@ static double distance_bound(const rt_node *n, const double po[3], const double 
     n->shape->coeffs(po, u, n->params, c);
     for (k = 1; k <= deg; ++k)
         if (c[k] != 0.0 && isfinite(c[k])) {
-            double sk = pow(level / fabs(c[k]), 1.0 / k);
+            double sk = k == 1 ? level / fabs(c[k]) : pow(level / fabs(c[k]), 1.0 / k);
             if (sk < best) best = sk;
         }
     return isfinite(best) ? best : 0.0;
@@ -624,8 +624,8 @@ void rt_finish_hit(const rt_scene *s, int object, int leaf, int face, int enteri
     hit->singular = singular;
 }
 
-int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax,
-                       rt_hit *hit)
+int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax,
+                     rt_pending *out)
 {
     double best = tmax, t;
     int found = -1, bleaf = -1, bface = 0, bent = 0, bknown = 0, i;
@@ -684,6 +684,20 @@ int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], 
         }
     }
     if (found < 0) return 0;
-    rt_finish_hit(s, found, bleaf, bface, bknown, bent, o, d, best, hit);
+    out->t = best;
+    out->object = found;
+    out->leaf = bleaf;
+    out->face = bface;
+    out->entering = bent;
+    out->entering_known = bknown;
+    return 1;
+}
+
+int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax,
+                       rt_hit *hit)
+{
+    rt_pending h;
+    if (!rt_scene_closest(s, o, d, tmin, tmax, &h)) return 0;
+    rt_finish_hit(s, h.object, h.leaf, h.face, h.entering_known, h.entering, o, d, h.t, hit);
     return 1;
 }

@@ -124,6 +124,7 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
     const rt_scene *s = tr->s;
     double q[3], dd[3];
     rt_hit h;
+    rt_pending ph;
     int i, a;
     T[0] = T[1] = T[2] = 1.0;
     for (a = 0; a < 3; ++a) dd[a] = light[a] - from->p[a];
@@ -132,12 +133,13 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
         const rt_material *m;
         for (a = 0; a < 3; ++a) dd[a] = light[a] - q[a];
         if (tr->stats) tr->stats[RT_RAYS_SHADOW] += 1.0;
-        if (!rt_scene_intersect(s, q, dd, 0.0, 1.0, &h)) return;
-        m = &s->materials[h.material];
+        if (!rt_scene_closest(s, q, dd, 0.0, 1.0, &ph)) return;
+        m = &s->materials[s->nodes[ph.leaf].material];
         if (m->transparency <= 0.0) {
             T[0] = T[1] = T[2] = 0.0;
             return;
         }
+        rt_finish_hit(s, ph.object, ph.leaf, ph.face, ph.entering_known, ph.entering, q, dd, ph.t, &h);
         if (h.entering) {
             for (a = 0; a < 3; ++a) T[a] *= m->transparency;
         } else {
