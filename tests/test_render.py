@@ -58,6 +58,9 @@ def scene_at(tmp_path: Path, data: dict, name: str = "s.yaml") -> Path:
     ({"objects": [{"equation": "y", "colour": 1}]}, "objects[0].colour"),
     ({"materials": {"m": {"transparency": 2}}}, "materials.m.transparency"),
     ({"objects": [{"shape": str(SHAPES / "sphere.yaml"), "params": {"q": 1}}]}, "objects[0].params.q"),
+    ({"objects": [{"equation": "y", "name": "p"}, {"equation": "x +* y"}]}, "objects[1]"),
+    ({"objects": [{"difference": [{"equation": "y"}, {"equation": "x", "transform": {"axes": [[1, 0, 0]]}}]}]},
+     "objects[0].difference[1].transform"),
 ])
 def test_bad_scene_names_file_and_key(tmp_path: Path, patch: dict, key: str) -> None:
     path = scene_at(tmp_path, base_scene(**patch))
@@ -221,3 +224,26 @@ def test_docs_example_scene_is_valid() -> None:
     sc = parse_scene(yaml.safe_load(block), SCENES / "doc_example.yaml")
     img = render(sc, width=32, height=24, spp=1, threads=2)
     assert np.isfinite(img).all()
+
+
+def test_stratified_samples_measure_pixel_coverage() -> None:
+    """A vertical colour edge crosses one pixel at a known fraction; the N-rooks samples are stratified in x,
+    so the pixel's value is that fraction of the two colours to within 1/spp (spp = 1: the pixel centre)."""
+    # wall z = 0 seen head on from (2, 0, 10); tan(fov/2) = 0.5 and 8x2 pixels: pixel k covers x in
+    # [-18 + 5k, -13 + 5k]; the checker edge x = 0 splits pixel 3 into 3/5 (x < 0) and 2/5 (x > 0)
+    fov = 2 * math.degrees(math.atan(0.5))
+    sc = parse_scene(base_scene(
+        image={"width": 8, "height": 2, "spp": 16},
+        camera={"position": [2, 0, 10], "look_at": [2, 0, 0], "fov": fov},
+        lights=[],
+        materials={"w": {"checker": {"colors": [[1, 1, 1], [0, 0, 0]], "scale": 1000.0},
+                         "ambient": 1.0, "diffuse": 0, "specular": 0}},
+        objects=[{"equation": "z", "name": "wall", "material": "w", "transform": {"translate": [0, 500, 0]}}],
+    ))
+    left = render(sc, spp=1, threads=1)[0, 0, 0]            # x < 0 side colour
+    right = render(sc, spp=1, threads=1)[0, 7, 0]
+    assert {float(left), float(right)} == {0.0, 1.0}
+    for spp in (4, 16, 64):
+        v = float(render(sc, spp=spp, threads=1)[:, 3, 0].mean())
+        want = 0.6 * left + 0.4 * right
+        assert abs(v - want) <= 1.0 / spp + 1e-6, (spp, v, want)
