@@ -33,7 +33,7 @@ static int leaf_spans(const rt_scene *s, int k, const double o[3], const double 
 {
     const rt_node *n = &s->nodes[k];
     double oo[3], od[3], r[IG_MAX_DEGREE + 2], x[IG_MAX_DEGREE + 2];
-    int f0 = 0, f1 = 0, nr, nx, i, cnt = 0, inside_prev = 0;
+    int f0 = 0, f1 = 0, nr, nx, i, cnt = 0, inside_prev = 0, lo_leaf, hi_leaf;
     rt_end start;
 
     rt_xform_point(n->minv, o, oo);
@@ -41,7 +41,17 @@ static int leaf_spans(const rt_scene *s, int k, const double o[3], const double 
     if (!rt_clip_box(n->obox, oo, od, &a, &b, &f0, &f1)) return 0;
     if (!(b > a)) return 0;
     nr = rt_leaf_roots(n, oo, od, a, b, r);
-    /* Breakpoints a = x[0] <= roots <= x[nx - 1] = b. */
+    /* Breakpoints a = x[0] <= roots <= x[nx - 1] = b. A root within rounding of a box face means the surface
+     * touches its box there (a cylinder tangent to its box's side): the endpoint is the surface, not the face. */
+    lo_leaf = f0 ? k : -1; /* a box face, or open where the ray's range starts inside */
+    hi_leaf = f1 ? k : -1;
+    {
+        double tol = 1e-9 * (b - a);
+        for (i = 0; i < nr; ++i) {
+            if (f0 && fabs(r[i] - a) <= tol) f0 = 0;
+            if (f1 && fabs(r[i] - b) <= tol) f1 = 0;
+        }
+    }
     nx = 0;
     x[nx++] = a;
     for (i = 0; i < nr; ++i)
@@ -61,7 +71,7 @@ static int leaf_spans(const rt_scene *s, int k, const double o[3], const double 
         if (inside && !inside_prev) {
             start.t = x[i];
             if (i == 0) {
-                start.leaf = f0 ? k : -1; /* a box face, or open where the ray's range starts inside */
+                start.leaf = lo_leaf;
                 start.face = f0;
             } else {
                 start.leaf = k;
@@ -81,7 +91,7 @@ static int leaf_spans(const rt_scene *s, int k, const double o[3], const double 
     if (inside_prev && cnt < max) {
         out[cnt].in = start;
         out[cnt].out.t = b;
-        out[cnt].out.leaf = f1 ? k : -1;
+        out[cnt].out.leaf = hi_leaf;
         out[cnt].out.face = f1;
         ++cnt;
     }

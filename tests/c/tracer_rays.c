@@ -184,6 +184,35 @@ static void test_optics(void)
 }
 
 /* ---------------------------------------------------------------- CSG */
+
+/* A hand-written shape: the cylinder x^2 + z^2 = 1 whose bounds cut it to -1 <= y <= 1. */
+static void cyl_coeffs(const double o[3], const double d[3], const double *p, double *c)
+{
+    (void)p;
+    c[0] = o[0] * o[0] + o[2] * o[2] - 1.0;
+    c[1] = 2.0 * (o[0] * d[0] + o[2] * d[2]);
+    c[2] = d[0] * d[0] + d[2] * d[2];
+}
+static double cyl_value(const double q[3], const double *p)
+{
+    (void)p;
+    return q[0] * q[0] + q[2] * q[2] - 1.0;
+}
+static void cyl_gradient(const double q[3], const double *p, double g[3])
+{
+    (void)p;
+    g[0] = 2.0 * q[0];
+    g[1] = 0.0;
+    g[2] = 2.0 * q[2];
+}
+static int cyl_bounds(const double *p, double box[6])
+{
+    (void)p;
+    box[0] = -1.0; box[1] = -1.0; box[2] = -1.0;
+    box[3] = 1.0; box[4] = 1.0; box[5] = 1.0;
+    return 1;
+}
+static const ig_shape capped_cylinder = {"capped_cylinder", 2, 0, cyl_coeffs, cyl_value, cyl_gradient, cyl_bounds};
 static void test_csg(void)
 {
     rt_scene *s = rt_scene_new();
@@ -200,7 +229,34 @@ static void test_csg(void)
     S = rt_scene_add_leaf(s, &sphere_shape, &one, 1, IDENTITY, mat);
     TD = rt_scene_add_csg(s, RT_DIFFERENCE, T, S, mat);
     rt_scene_add_object(s, D);
+    {
+        /* inside CSG a leaf is {f < 0} cut by its box: the box faces close the cylinder */
+        double mf[12], mc[12];
+        int C, F, CU;
+        translate_scale(mf, 0, 50, 0, 0.1);
+        translate_scale(mc, 0, 0, 20, 1.0); /* away from the spheres below */
+        C = rt_scene_add_leaf(s, &capped_cylinder, NULL, 0, mc, mat);
+        F = rt_scene_add_leaf(s, &sphere_shape, &one, 1, mf, mat);
+        CU = rt_scene_add_csg(s, RT_UNION, C, F, mat);
+        rt_scene_add_object(s, CU);
+    }
     CHECK(rt_scene_commit(s) == 0, "commit: %s", rt_scene_error(s));
+    {
+        double o[3] = {0.3, -5, 20.2}, d[3] = {0, 1, 0};
+        rt_hit hc;
+        CHECK(rt_scene_intersect(s, o, d, 0, INFINITY, &hc) == 1 && fabs(hc.t - 4.0) < 1e-12 && hc.face == -2 &&
+                  hc.entering && fabs(hc.n[1] + 1.0) < 1e-12,
+              "capped cylinder bottom face: t %g face %d n (%g %g %g)", hc.t, hc.face, hc.n[0], hc.n[1], hc.n[2]);
+        o[1] = 0.0; /* from inside: leaves through the top face */
+        CHECK(rt_scene_intersect(s, o, d, 0, INFINITY, &hc) == 1 && fabs(hc.t - 1.0) < 1e-12 && hc.face == 2 &&
+                  !hc.entering && fabs(hc.n[1] - 1.0) < 1e-12,
+              "capped cylinder top face from inside: t %g face %d", hc.t, hc.face);
+        /* the side is the surface f = 0, even where it touches the box face x = -1 */
+        o[0] = -5.0; o[1] = 0.5; o[2] = 20.0; d[0] = 1.0; d[1] = 0.0;
+        CHECK(rt_scene_intersect(s, o, d, 0, INFINITY, &hc) == 1 && fabs(hc.t - 4.0) < 1e-12 && hc.face == 0 &&
+                  fabs(hc.n[0] + 1.0) < 1e-12,
+              "capped cylinder side: t %g face %d", hc.t, hc.face);
+    }
     {
         double o[3] = {-5, 0, 0}, d[3] = {1, 0, 0};
         n = rt_node_spans(s, D, o, d, 0, INFINITY, tin, tout, lin, lout, 8);
