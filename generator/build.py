@@ -166,6 +166,13 @@ _d = ctypes.c_double
 _pd = ctypes.POINTER(ctypes.c_double)
 
 
+class RtHit(ctypes.Structure):
+    """Mirror of rt_hit (tracer.h)."""
+    _fields_ = [("t", _d), ("p", _d * 3), ("n", _d * 3), ("err", _d), ("po", _d * 3), ("no", _d * 3),
+                ("object", ctypes.c_int), ("leaf", ctypes.c_int), ("face", ctypes.c_int),
+                ("material", ctypes.c_int), ("entering", ctypes.c_int), ("singular", ctypes.c_int)]
+
+
 def bind(lib: ctypes.CDLL) -> ctypes.CDLL:
     """Declare the tracer's C signatures (tracer.h) on a loaded scene library."""
     vp = ctypes.c_void_p
@@ -192,6 +199,8 @@ def bind(lib: ctypes.CDLL) -> ctypes.CDLL:
         "rt_render_cancel": (None, [vp]),
         "rt_render_stats": (None, [vp, _pd]),
         "rt_trace_ray": (None, [vp, _pd, _pd, ctypes.c_int, _pd, _pd]),
+        "rt_scene_intersect": (ctypes.c_int, [vp, _pd, _pd, _d, _d, ctypes.POINTER(RtHit)]),
+        "rt_spawn_origin": (None, [ctypes.POINTER(RtHit), _pd, _pd]),
     }
     for name, (res, args) in sig.items():
         fn = getattr(lib, name)

@@ -98,6 +98,22 @@ class CScene:
         self.lib.rt_trace_ray(self.ptr, darr(o), darr(d), max_depth, rgb, None)
         return np.array(rgb[:])
 
+    def intersect(self, o: Sequence[float], d: Sequence[float], tmin: float = 0.0,
+                  tmax: float = float("inf")):
+        """The closest hit as a build.RtHit (t, p, n, err, object, leaf, face, entering, ...), or None."""
+        from .build import RtHit
+
+        hit = RtHit()
+        if self.lib.rt_scene_intersect(self.ptr, darr(o), darr(d), tmin, tmax, ctypes.byref(hit)):
+            return hit
+        return None
+
+    def spawn(self, hit, d: Sequence[float]) -> list[float]:
+        """Origin of a secondary ray leaving `hit` in direction d (offset by the hit's error bound)."""
+        out = (ctypes.c_double * 3)()
+        self.lib.rt_spawn_origin(ctypes.byref(hit), darr(d), out)
+        return list(out)
+
     def close(self) -> None:
         if getattr(self, "ptr", None):
             self.lib.rt_scene_free(self.ptr)

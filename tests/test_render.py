@@ -247,3 +247,19 @@ def test_stratified_samples_measure_pixel_coverage() -> None:
         v = float(render(sc, spp=spp, threads=1)[:, 3, 0].mean())
         want = 0.6 * left + 0.4 * right
         assert abs(v - want) <= 1.0 / spp + 1e-6, (spp, v, want)
+
+
+def test_python_ray_queries_and_spawn_offset() -> None:
+    """CScene.intersect/spawn: a unit sphere scaled by 1e3 far from the origin; the spawned origin sits off the
+    surface by the hit's error bound, on the side the new ray goes to, and a ray from it re-finds the far side."""
+    sc = parse_scene(base_scene(objects=[{"shape": str(SHAPES / "sphere.yaml"),
+                                          "transform": {"scale": 1e3, "translate": [5e3, 0, 0]}}]))
+    c = CScene(sc, build.build_scene(sc))
+    h = c.intersect([5e3, 0, -1e4], [0, 0, 1])
+    assert h is not None and abs(h.t - 9e3) < 1e-9 * 9e3 and h.entering == 1
+    assert 0 < h.err < 1e-9 * 1e3
+    inward = c.spawn(h, [0, 0, 1])
+    assert inward[2] > h.p[2] and abs(inward[2] - h.p[2] - h.err) <= 1e-12 * 1e4
+    far = c.intersect(inward, [0, 0, 1])
+    assert far is not None and abs(far.p[2] - 1e3) < 1e-9 * 1e3 and far.entering == 0
+    c.close()
