@@ -165,15 +165,17 @@ def render(scene: Scene | str | Path | dict, *, width: int | None = None, height
         bar = None
         if progress:
             from tqdm import tqdm
-            bar = tqdm(total=h, unit="row", desc=Path(sc.source).name, leave=False)
+            bar = tqdm(total=h, unit="row", desc=Path(sc.source).name, leave=True)
         try:
             done = 0
-            while worker.is_alive():
+            while True:
                 worker.join(0.1)
                 if bar is not None:
                     now = cs.lib.rt_render_progress(ctx)
                     bar.update(now - done)
                     done = now
+                if not worker.is_alive():
+                    break
         except KeyboardInterrupt:
             cs.lib.rt_render_cancel(ctx)
             worker.join()

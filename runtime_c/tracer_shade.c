@@ -200,7 +200,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
     for (a = 0; a < 3; ++a) col[a] = (1.0 - m->transparency) * local[a];
 
     if (depth < tr->max_depth) {
-        double ci = -rt_dot(u, nf), F = 0.0, kr, kt, tdir[3];
+        double ci = -rt_dot(u, nf), F = 0.0, kr, kt, tdir[3] = {0.0, 0.0, 0.0};
         rt_media next = *media;
         int can_refract = 0;
         if (m->transparency > 0.0) {

@@ -263,3 +263,9 @@ def test_python_ray_queries_and_spawn_offset() -> None:
     far = c.intersect(inward, [0, 0, 1])
     assert far is not None and abs(far.p[2] - 1e3) < 1e-9 * 1e3 and far.entering == 0
     c.close()
+
+
+def test_progress_bar_reaches_every_row(capsys) -> None:
+    render(SCENES / "torus_shadow.yaml", width=40, height=30, spp=1, threads=2, progress=True)
+    err = capsys.readouterr().err
+    assert "30/30" in err
