@@ -534,6 +534,35 @@ static void test_glass(void)
             }
             printf("glass ball, depth 2: (%.6f %.6f %.6f) = F bg + (1-F)^2 exp(-2 sigma) bg\n", rgb[0], rgb[1], rgb[2]);
         }
+        {
+            /* From inside the ball (no absorption): a chord meeting the surface at 60 degrees is beyond the
+             * critical angle asin(1/1.5) = 41.8 degrees, so every bounce is a total internal reflection, the
+             * ray never leaves and the depth limit ends it in black. At 30 degrees the surface lets
+             * (1 - F(30 deg)) of the background through, plus what the reflections bring. */
+            rt_scene *s2 = rt_scene_new();
+            double o[3] = {0, 0, 0}, d60[3], d30[3], Ft, c60[3], c30[3];
+            glass_material(m, 1.5, 1.0, 0, 0, 0);
+            g = rt_scene_add_material(s2, m);
+            rt_scene_add_object(s2, rt_scene_add_leaf(s2, &sphere_shape, &one, 1, IDENTITY, g));
+            rt_scene_set_background(s2, bg);
+            CHECK(rt_scene_commit(s2) == 0, "commit");
+            /* start at (0, -sin a, 0)... a chord from a point at distance sin(a) from the centre, heading along
+             * x, meets the sphere with incidence angle a */
+            o[1] = -sin(60.0 * M_PI / 180.0);
+            d60[0] = 1; d60[1] = 0; d60[2] = 0;
+            rt_trace_ray(s2, o, d60, 12, c60, NULL);
+            o[1] = -sin(30.0 * M_PI / 180.0);
+            d30[0] = 1; d30[1] = 0; d30[2] = 0;
+            rt_trace_ray(s2, o, d30, 12, c30, NULL);
+            Ft = rt_fresnel(cos(30.0 * M_PI / 180.0), 1.5);
+            CHECK(c60[0] == 0.0 && c60[1] == 0.0 && c60[2] == 0.0, "TIR must trap the ray: (%g %g %g)", c60[0],
+                  c60[1], c60[2]);
+            for (a = 0; a < 3; ++a)
+                CHECK(c30[a] >= (1 - Ft) * bg[a] - 1e-12 && c30[a] <= bg[a] + 1e-12, "30 deg: %g (F %g)", c30[a], Ft);
+            printf("inside the ball: 60 deg -> (%g %g %g) (trapped), 30 deg -> %.6f >= (1 - F) bg = %.6f\n", c60[0],
+                   c60[1], c60[2], c30[0], (1 - Ft) * bg[0]);
+            rt_scene_free(s2);
+        }
         rt_scene_free(s);
     }
     {
