@@ -533,14 +533,22 @@ static double solver_noise(const rt_node *n, const double oo[3], const double od
  * keep the estimate finite where grad f vanishes (a cusp, or the heart's singular equator). */
 static double distance_bound(const rt_node *n, const double po[3], const double u[3], double level)
 {
-    double c[IG_MAX_DEGREE + 1], best = INFINITY;
+    double c[IG_MAX_DEGREE + 1], best = INFINITY, best_pow = INFINITY;
     int k, deg = n->shape->degree;
     n->shape->coeffs(po, u, n->params, c);
-    for (k = 1; k <= deg; ++k)
-        if (c[k] != 0.0 && isfinite(c[k])) {
-            double sk = k == 1 ? level / fabs(c[k]) : pow(level / fabs(c[k]), 1.0 / k);
-            if (sk < best) best = sk;
+    for (k = 1; k <= deg; ++k) {
+        double q;
+        if (k > 1 && isfinite(best)) best_pow *= best; /* best^k */
+        if (!(c[k] != 0.0) || !isfinite(c[k])) continue;
+        q = level / fabs(c[k]);
+        if (k == 1) {
+            best = q;
+            best_pow = q;
+        } else if (q < best_pow) { /* only then is q^(1/k) below the best so far */
+            best = pow(q, 1.0 / k);
+            best_pow = q;
         }
+    }
     return isfinite(best) ? best : 0.0;
 }
 
@@ -630,6 +638,7 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
     double best = tmax, t;
     int found = -1, bleaf = -1, bface = 0, bent = 0, bknown = 0, i;
     int stack[128], sp = 0;
+    double entry[128];
     if (!s->committed) return 0;
     if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]) || !isfinite(o[0]) || !isfinite(o[1]) ||
         !isfinite(o[2]))
@@ -645,11 +654,20 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
             bknown = known;
         }
     }
-    if (s->nbvh > 0) stack[sp++] = 0;
-    while (sp > 0) {
-        const rt_bvh_node *b = &s->bvh[stack[--sp]];
+    /* Each stack entry carries the t where the ray enters its box, so a node is clipped once and skipped
+     * when a closer hit has been found since it was pushed. */
+    if (s->nbvh > 0) {
         double t0 = tmin, t1 = best;
-        if (!rt_clip_box(b->box, o, d, &t0, &t1, NULL, NULL)) continue;
+        if (rt_clip_box(s->bvh[0].box, o, d, &t0, &t1, NULL, NULL)) {
+            stack[sp] = 0;
+            entry[sp++] = t0;
+        }
+    }
+    while (sp > 0) {
+        const rt_bvh_node *b;
+        --sp;
+        if (entry[sp] > best) continue;
+        b = &s->bvh[stack[sp]];
         if (b->left < 0) {
             for (i = b->first; i < b->first + b->count; ++i) {
                 int leaf, face, ent, known, obj = s->order[i];
@@ -668,18 +686,20 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
             double la = tmin, lb = best, ra = tmin, rb = best;
             int lhit = rt_clip_box(l->box, o, d, &la, &lb, NULL, NULL);
             int rhit = rt_clip_box(r->box, o, d, &ra, &rb, NULL, NULL);
-            if (lhit && rhit) {
-                if (la <= ra) {
-                    stack[sp++] = b->right;
-                    stack[sp++] = b->left;
-                } else {
-                    stack[sp++] = b->left;
-                    stack[sp++] = b->right;
+            if (lhit && rhit && la > ra) {
+                stack[sp] = b->left;
+                entry[sp++] = la;
+                stack[sp] = b->right;
+                entry[sp++] = ra;
+            } else {
+                if (rhit) {
+                    stack[sp] = b->right;
+                    entry[sp++] = ra;
                 }
-            } else if (lhit) {
-                stack[sp++] = b->left;
-            } else if (rhit) {
-                stack[sp++] = b->right;
+                if (lhit) {
+                    stack[sp] = b->left;
+                    entry[sp++] = la;
+                }
             }
         }
     }
