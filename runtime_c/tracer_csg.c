@@ -36,8 +36,7 @@ static int leaf_spans(const rt_scene *s, int k, const double o[3], const double 
     int f0 = 0, f1 = 0, nr, nx, i, cnt = 0, inside_prev = 0, lo_leaf, hi_leaf;
     rt_end start;
 
-    rt_xform_point(n->minv, o, oo);
-    rt_xform_vector(n->minv, d, od);
+    rt_to_object(n, o, d, oo, od);
     if (!rt_clip_box(n->obox, oo, od, &a, &b, &f0, &f1)) return 0;
     if (!(b > a)) return 0;
     nr = rt_leaf_roots(n, oo, od, a, b, r);
@@ -203,8 +202,7 @@ int rt_object_hit(const rt_scene *s, int object, const double o[3], const double
         /* A top-level leaf is a surface: its nearest root after tmin. */
         double oo[3], od[3], r[IG_MAX_DEGREE + 2];
         int nr, i;
-        rt_xform_point(n->minv, o, oo);
-        rt_xform_vector(n->minv, d, od);
+        rt_to_object(n, o, d, oo, od);
         nr = rt_leaf_roots(n, oo, od, lo, hi, r);
         for (i = 0; i < nr; ++i)
             if (r[i] > tmin && r[i] < tmax) {

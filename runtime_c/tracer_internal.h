@@ -15,6 +15,7 @@ typedef struct rt_node {
     double m[12];        /* object -> world */
     double minv[12];     /* world -> object */
     double mnorm;        /* Frobenius norm of M's linear part: bounds how much M stretches a distance */
+    int identity;        /* M is exactly the identity: rays need no transforming */
     double obox[6];      /* object-space bounds box */
     int obounded;        /* the spec gives bounds (some sides may still be infinite) */
     /* any node */
@@ -78,6 +79,9 @@ int rt_clip_box(const double box[6], const double o[3], const double d[3], doubl
 /* Fills hit (normal, error bound, object-space point) for a hit at t on `leaf` with the given face. */
 void rt_finish_hit(const rt_scene *s, int object, int leaf, int face, int entering_known, int entering,
                    const double o[3], const double d[3], double t, rt_hit *hit);
+
+/* The ray in a leaf's object space (a copy when the leaf's transform is the identity). */
+void rt_to_object(const rt_node *n, const double o[3], const double d[3], double oo[3], double od[3]);
 
 /* tracer_csg.c */
 int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r);

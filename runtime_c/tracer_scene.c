@@ -30,6 +30,17 @@ void rt_xform_vector(const double m[12], const double v[3], double out[3])
     memcpy(out, r, sizeof r);
 }
 
+void rt_to_object(const rt_node *n, const double o[3], const double d[3], double oo[3], double od[3])
+{
+    if (n->identity) {
+        memcpy(oo, o, 3 * sizeof(double));
+        memcpy(od, d, 3 * sizeof(double));
+    } else {
+        rt_xform_point(n->minv, o, oo);
+        rt_xform_vector(n->minv, d, od);
+    }
+}
+
 static double maxabs3(const double v[3])
 {
     double a = fabs(v[0]), b = fabs(v[1]), c = fabs(v[2]);
@@ -94,7 +105,7 @@ int rt_clip_box(const double box[6], const double o[3], const double d[3], doubl
             if (!(o[a] >= bmin && o[a] <= bmax)) return 0;
             continue;
         } else {
-            double ta = (bmin - o[a]) / d[a], tb = (bmax - o[a]) / d[a];
+            double inv = 1.0 / d[a], ta = (bmin - o[a]) * inv, tb = (bmax - o[a]) * inv;
             int fa = -(a + 1), fb = a + 1; /* outward normal of the min / max face */
             if (ta > tb) {
                 double tt = ta;
@@ -217,6 +228,9 @@ int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, 
     for (i = 0; i < 12; ++i)
         if (i % 4 != 3) n->mnorm += m[i] * m[i];
     n->mnorm = sqrt(n->mnorm);
+    n->identity = 1;
+    for (i = 0; i < 12; ++i)
+        if (m[i] != ((i == 0 || i == 5 || i == 10) ? 1.0 : 0.0)) n->identity = 0;
     n->obounded = shape->bounds ? shape->bounds(n->params, n->obox) : 0;
     if (!n->obounded)
         for (i = 0; i < 3; ++i) {
@@ -559,8 +573,7 @@ void rt_finish_hit(const rt_scene *s, int object, int leaf, int face, int enteri
     double oo[3], od[3], g[3], nw[3], len, dist = 0.0, mag_o, mag_w, td[3], tod[3], tr[3];
     int a, singular = 0;
 
-    rt_xform_point(n->minv, o, oo);
-    rt_xform_vector(n->minv, d, od);
+    rt_to_object(n, o, d, oo, od);
     for (a = 0; a < 3; ++a) {
         hit->p[a] = o[a] + t * d[a];
         hit->po[a] = oo[a] + t * od[a];
