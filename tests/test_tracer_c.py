@@ -23,11 +23,8 @@ WARN = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-pthread"]
 
 
 def runtime_sources() -> list[Path]:
-    """The runtime's C files; the tracer tests' plain shape fixture stands in while shape.c is missing."""
-    srcs = sorted(RUNTIME.glob("*.c"))
-    if not (RUNTIME / "shape.c").exists():
-        srcs.append(CDIR / "tracer_fixture_shape.c")
-    return srcs
+    """The runtime's C files (roots, shape, tracer)."""
+    return sorted(RUNTIME.glob("*.c"))
 
 
 def example_shapes() -> list[str]:
