@@ -26,7 +26,7 @@ from .scene import Csg, Leaf, Material, Node, Scene, load_scene, parse_scene
 
 OPS = {"union": 1, "intersection": 2, "difference": 3}
 RAY_KINDS = ("primary", "shadow", "secondary")
-DEFAULT_FOLD = False   # folding constant params into the code: measured (docs/tracer.md), within +-4%: off
+DEFAULT_FOLD = False   # folding constant params into the code: measured (README.md, "Rendering scenes"), within +-4%: off
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""Scene files: YAML -> validated dataclasses. The format is documented in docs/tracer.md.
+"""Scene files: YAML -> validated dataclasses. The format is documented in README.md, "Rendering scenes".
 
 Every error is a UserError naming the scene file and the key at fault (`objects[2].transform.rotate`), so
 the CLI prints one line and exits with status 2 before anything is compiled or written.

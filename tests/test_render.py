@@ -214,12 +214,12 @@ def test_threads_do_not_change_the_image() -> None:
 
 
 def test_docs_example_scene_is_valid() -> None:
-    """The complete example in docs/tracer.md parses and renders (as if it lived in examples/scenes/)."""
+    """The complete scene example in the README parses and renders (as if it lived in examples/scenes/)."""
     import re
 
     import yaml
 
-    text = (ROOT / "docs" / "tracer.md").read_text()
+    text = (ROOT / "README.md").read_text()
     block = re.search(r"### The scene format\n\n```yaml\n(.*?)```", text, re.S).group(1)
     sc = parse_scene(yaml.safe_load(block), SCENES / "doc_example.yaml")
     img = render(sc, width=32, height=24, spp=1, threads=2)
