@@ -27,7 +27,7 @@ from .errors import UserError
 from .roots import bench_solve_batch
 from .roots_reference import Score, reference, score_one
 
-METHODS = ["closed_plain", "closed", "sturm", "bracket", "auto"]
+METHODS = ["closed_plain", "closed", "sturm", "bracket", "bernstein", "auto"]
 
 # ------------------------------------------------------------------------------------------------ shapes
 # f as {(i, j, k): coefficient of x^i y^j z^k}; written out here so the bench does not depend on the generator.
@@ -421,7 +421,7 @@ def plot(rows: list[Row], path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(8, 5.5))
-    markers = {"closed_plain": "s", "closed": "D", "sturm": "^", "bracket": "o", "auto": "*", "numpy.roots": "x"}
+    markers = {"closed_plain": "s", "closed": "D", "sturm": "^", "bracket": "o", "bernstein": "v", "auto": "*", "numpy.roots": "x"}
     cases = list(dict.fromkeys(r.case for r in rows))
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for r in rows:

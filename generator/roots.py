@@ -2,6 +2,8 @@
 
     real_roots(coeffs, lo=-inf, hi=inf, method="auto") -> sorted np.ndarray
     real_roots_batch(coeffs_2d, lo, hi, method) -> (roots padded with NaN, counts)
+    first_root(coeffs, lo=-inf, hi=inf, method="auto") -> the smallest root in [lo, hi], or None
+    first_root_batch(coeffs_2d, lo, hi, method) -> (roots, NaN where none; counts 0/1)
 
 Coefficients are lowest power first. The C library is compiled on first use into the content-hash build
 cache (`implgen.cbuild`), so a plain `pip install` needs no build step.
@@ -20,7 +22,7 @@ from .errors import UserError
 from .resources import runtime_dir
 
 MAX_DEGREE = 24
-METHODS: dict[str, int] = {"auto": 0, "closed": 1, "sturm": 2, "bracket": 3}
+METHODS: dict[str, int] = {"auto": 0, "closed": 1, "sturm": 2, "bracket": 3, "bernstein": 4}
 #: bench-only: the classic unpolished closed forms (Schwarze-style), the speed baseline of the report
 BENCH_METHODS: dict[str, int] = {**METHODS, "closed_plain": 10}
 
@@ -42,6 +44,8 @@ def library() -> ctypes.CDLL:
     lib.ig_real_roots_any.argtypes = [_DP, ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_int, _DP]
     lib.ig_real_roots_batch.restype = None
     lib.ig_real_roots_batch.argtypes = [_DP, ctypes.c_int, ctypes.c_long, _DP, _DP, ctypes.c_int, _DP, _IP]
+    lib.ig_first_root_batch.restype = None
+    lib.ig_first_root_batch.argtypes = [_DP, ctypes.c_int, ctypes.c_long, _DP, _DP, ctypes.c_int, _DP, _IP]
     lib.ig_bench_solve_batch.restype = ctypes.c_double
     lib.ig_bench_solve_batch.argtypes = [_DP, ctypes.c_int, ctypes.c_long, _DP, _DP, ctypes.c_int, _DP, _IP, _DP]
     return lib
@@ -94,6 +98,33 @@ def real_roots_batch(
     counts = np.empty(count, dtype=np.intc)
     if count:
         library().ig_real_roots_batch(
+            c.ctypes.data_as(_DP), n, count, lo_a.ctypes.data_as(_DP), hi_a.ctypes.data_as(_DP), mid,
+            roots.ctypes.data_as(_DP), counts.ctypes.data_as(_IP),
+        )
+    return roots, counts.astype(np.int64)
+
+
+def first_root(coeffs: ArrayLike, lo: float = -np.inf, hi: float = np.inf, method: str = "auto") -> float | None:
+    """The smallest real root of c[0] + c[1] t + ... in [lo, hi] (what real_roots lists first), or None."""
+    c = np.asarray(coeffs, dtype=np.float64)
+    if c.ndim != 1:
+        raise ValueError(f"coeffs must be 1-d (lowest power first), got shape {c.shape}")
+    roots, counts = first_root_batch(c[None, :], lo, hi, method)
+    return float(roots[0]) if counts[0] else None
+
+
+def first_root_batch(
+    coeffs: ArrayLike, lo: ArrayLike = -np.inf, hi: ArrayLike = np.inf, method: str = "auto"
+) -> tuple[np.ndarray, np.ndarray]:
+    """first_root over many polynomials of one degree: (roots with NaN where none, counts 0 or 1)."""
+    mid = method_id(method, bench=True)
+    c = _coeff_matrix(coeffs)
+    count, n = c.shape[0], c.shape[1] - 1
+    lo_a, hi_a = _bounds(lo, count), _bounds(hi, count)
+    roots = np.empty(count, dtype=np.float64)
+    counts = np.empty(count, dtype=np.intc)
+    if count:
+        library().ig_first_root_batch(
             c.ctypes.data_as(_DP), n, count, lo_a.ctypes.data_as(_DP), hi_a.ctypes.data_as(_DP), mid,
             roots.ctypes.data_as(_DP), counts.ctypes.data_as(_IP),
         )

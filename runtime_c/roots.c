@@ -365,8 +365,7 @@ static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n
     return cnt;
 }
 
-/* Derivative bracketing on a finite [a, b], exact degree n >= 3. */
-static int bracket_interval(const double *p, int n, double a, double b, double *out)
+int ig_bracket_interval(const double *p, int n, double a, double b, double *out)
 {
     /* chain[j] = p^(j) scaled to keep the leading coefficient of p: degree n - j, so p^(j) =
      * n (n-1) ... (n-j+1) chain[j] */
@@ -423,7 +422,9 @@ static double root_bound(const double *p, int n)
     return ldexp(1.0, best + 1);
 }
 
-static int solve_general(const double *p, int n, double lo, double hi, interval_solver solver, double *out)
+/* first != 0 may swap in a first-root solver (first_solver) where the interval is solved in one piece. */
+static int solve_general(const double *p, int n, double lo, double hi, interval_solver solver,
+                         interval_solver first_solver, double *out)
 {
     double a = lo, b = hi;
     if (isinf(a) || isinf(b)) {
@@ -439,7 +440,7 @@ static int solve_general(const double *p, int n, double lo, double hi, interval_
     /* coefficients are at most ~2^200 (see ig_real_roots_any); |x|^n below 2^524 keeps Horner and the
      * splitting of Dekker's product (another 2^27) far from overflow */
     if (big <= 1.0 || (double)n * ilogb(big) < 500.0)
-        return solver(p, n, a, b, out);
+        return (first_solver ? first_solver : solver)(p, n, a, b, out);
 
     /* |x| > 1 on the reversed polynomial q(y) = y^n p(1/y), y = 1/x in [-1, 1] */
     double q[IG_MAX_DEGREE + 1], tmp[IG_ROOT_BUF];
@@ -469,15 +470,15 @@ static int solve_general(const double *p, int n, double lo, double hi, interval_
     return ig_sort_unique(out, cnt);
 }
 
-/* Which method `auto` uses per degree (after deflating zero roots); see docs/solvers.md for the report
- * this choice comes from. */
+/* Which method `auto` uses per degree (after deflating zero roots); the solver report (`implgen bench
+ * solvers`, README) is where this choice comes from. */
 static int auto_method(int n)
 {
     (void)n;
-    return IG_ROOTS_BRACKET;
+    return IG_ROOTS_BERNSTEIN;
 }
 
-static int solve_reduced(const double *p, int n, double lo, double hi, int method, double *out)
+static int solve_reduced(const double *p, int n, double lo, double hi, int method, int first, double *out)
 {
     if (n == 1) {
         double x = -p[0] / p[1];
@@ -498,18 +499,20 @@ static int solve_reduced(const double *p, int n, double lo, double hi, int metho
             return ig_closed_cubic(p, lo, hi, polish, out);
         if (n == 4)
             return ig_closed_quartic(p, lo, hi, polish, out);
-        return solve_general(p, n, lo, hi, bracket_interval, out);
+        return solve_general(p, n, lo, hi, ig_bracket_interval, NULL, out);
     }
     case IG_ROOTS_STURM:
-        return solve_general(p, n, lo, hi, ig_sturm_interval, out);
+        return solve_general(p, n, lo, hi, ig_sturm_interval, NULL, out);
     case IG_ROOTS_BRACKET:
-        return solve_general(p, n, lo, hi, bracket_interval, out);
+        return solve_general(p, n, lo, hi, ig_bracket_interval, NULL, out);
+    case IG_ROOTS_BERNSTEIN:
+        return solve_general(p, n, lo, hi, ig_bernstein_interval, first ? ig_bernstein_first : NULL, out);
     default:
         return 0;
     }
 }
 
-int ig_real_roots_any(const double *c, int n, double lo, double hi, int method, double *roots)
+int ig_roots_core(const double *c, int n, double lo, double hi, int method, int first, double *roots)
 {
     if (!c || !roots || n < 0 || n > IG_MAX_DEGREE)
         return 0;
@@ -544,20 +547,30 @@ int ig_real_roots_any(const double *c, int n, double lo, double hi, int method, 
     double r[IG_ROOT_BUF];
     int k = 0;
     if (deg > 0)
-        k = solve_reduced(p + m, deg, lo, hi, method, r);
+        k = solve_reduced(p + m, deg, lo, hi, method, first, r);
     if (m > 0)
         r[k++] = 0.0;
     k = ig_sort_unique(r, k);
-    int cnt = 0;
-    for (int i = 0; i < k && cnt < n; ++i)
+    int cnt = 0, most = first ? 1 : n;
+    for (int i = 0; i < k && cnt < most; ++i)
         if (r[i] >= lo && r[i] <= hi && isfinite(r[i]))
             roots[cnt++] = r[i] == 0.0 ? 0.0 : r[i]; /* no -0 */
     return cnt;
 }
 
+int ig_real_roots_any(const double *c, int n, double lo, double hi, int method, double *roots)
+{
+    return ig_roots_core(c, n, lo, hi, method, 0, roots);
+}
+
 int ig_real_roots(const double *c, int n, double lo, double hi, ig_root_method method, double *roots)
 {
-    return ig_real_roots_any(c, n, lo, hi, (int)method, roots);
+    return ig_roots_core(c, n, lo, hi, (int)method, 0, roots);
+}
+
+int ig_first_root(const double *c, int n, double lo, double hi, ig_root_method method, double *root)
+{
+    return ig_roots_core(c, n, lo, hi, (int)method, 1, root);
 }
 
 void ig_real_roots_batch(const double *c, int n, long count, const double *lo, const double *hi, int method,
@@ -569,5 +582,15 @@ void ig_real_roots_batch(const double *c, int n, long count, const double *lo, c
         counts[i] = k;
         for (int j = 0; j < n; ++j)
             roots[i * n + j] = j < k ? r[j] : NAN;
+    }
+}
+
+void ig_first_root_batch(const double *c, int n, long count, const double *lo, const double *hi, int method,
+                         double *roots, int *counts)
+{
+    for (long i = 0; i < count; ++i) {
+        double r = NAN;
+        counts[i] = ig_roots_core(c + i * (n + 1), n, lo[i], hi[i], method, 1, &r);
+        roots[i] = counts[i] ? r : NAN;
     }
 }

@@ -18,11 +18,17 @@ typedef enum {
     IG_ROOTS_AUTO = 0,    /* the best method for the degree, as the solver report shows */
     IG_ROOTS_CLOSED = 1,  /* closed forms up to degree 4 (falls back to IG_ROOTS_BRACKET above) */
     IG_ROOTS_STURM = 2,   /* Sturm sequence isolation + safeguarded refinement */
-    IG_ROOTS_BRACKET = 3  /* derivative bracketing (recursive roots of p') + safeguarded Newton */
+    IG_ROOTS_BRACKET = 3, /* derivative bracketing (recursive roots of p') + safeguarded Newton */
+    IG_ROOTS_BERNSTEIN = 4 /* isolation by Bernstein subdivision + the same Newton; bracketing where unsure */
 } ig_root_method;
 
 /* Writes at most n roots to roots[] (caller provides room for IG_MAX_DEGREE) and returns their count.
  * n is the nominal degree (c has n + 1 entries), 0 <= n <= IG_MAX_DEGREE; n out of range gives 0. */
 int ig_real_roots(const double *c, int n, double lo, double hi, ig_root_method method, double *roots);
+
+/* The smallest root in [lo, hi] -- the same value ig_real_roots would list first -- into *root; returns 1, or 0
+ * when there is none. What a ray needs for its nearest hit: AUTO and BERNSTEIN stop at the leftmost piece
+ * of the subdivision that holds a root instead of isolating every root. */
+int ig_first_root(const double *c, int n, double lo, double hi, ig_root_method method, double *root);
 
 #endif

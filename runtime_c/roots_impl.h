@@ -44,11 +44,26 @@ int ig_sort_unique(double *r, int k);
 int ig_closed_cubic(const double *c, double lo, double hi, int polish, double *r);
 int ig_closed_quartic(const double *c, double lo, double hi, int polish, double *r);
 
+/* Derivative bracketing on a finite [a, b] for exact degree n >= 3 (c[n] != 0, c[0] != 0). */
+int ig_bracket_interval(const double *c, int n, double a, double b, double *r);
+
+/* Bernstein subdivision on a finite [a, b], same preconditions; falls back to ig_bracket_interval whenever
+ * it cannot conclude. _first: only the leftmost root is guaranteed to be among the output (which is sorted). */
+int ig_bernstein_interval(const double *c, int n, double a, double b, double *r);
+int ig_bernstein_first(const double *c, int n, double a, double b, double *r);
+
 /* Sturm isolation on a finite interval [a, b] for exact degree n >= 3 (c[n] != 0, c[0] != 0). */
 int ig_sturm_interval(const double *c, int n, double a, double b, double *r);
 
 /* The real-roots entry point with a bench-only method id allowed (see IG_ROOTS_CLOSED_PLAIN). */
 int ig_real_roots_any(const double *c, int n, double lo, double hi, int method, double *roots);
+
+/* The same with first != 0: only the smallest root (at most one), as ig_first_root. */
+int ig_roots_core(const double *c, int n, double lo, double hi, int method, int first, double *roots);
+
+/* Batch form of ig_first_root for the Python binding: root i (or NaN) to roots[i], 0/1 to counts[i]. */
+void ig_first_root_batch(const double *c, int n, long count, const double *lo, const double *hi, int method,
+                         double *roots, int *counts);
 
 /* Batch form for the Python binding: `count` polynomials of nominal degree n, coefficients at c + i*(n+1),
  * bounds lo[i], hi[i]; roots of polynomial i go to roots + i*n (padded with NaN), its count to counts[i]. */

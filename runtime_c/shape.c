@@ -76,8 +76,9 @@ static double shift_point(const double box[6], int bounded, const double o[3], c
     return ts;
 }
 
-int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3], const double d[3],
-                   double tmin, double tmax, ig_root_method method, double *roots)
+/* Clip, shift, coefficients, solve (all roots, or only the first), shift back. */
+static int shape_solve(const ig_shape *shape, const double *params, const double o[3], const double d[3],
+                       double tmin, double tmax, ig_root_method method, int first, double *roots)
 {
     if (!shape || !shape->coeffs || !roots)
         return 0;
@@ -103,7 +104,8 @@ int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3
     double c[IG_MAX_DEGREE + 1];
     shape->coeffs(os, d, params, c);
     double s[IG_MAX_DEGREE];
-    int k = ig_real_roots(c, n, t0 - ts, t1 - ts, method, s);
+    int k = first ? ig_first_root(c, n, t0 - ts, t1 - ts, method, s)
+                  : ig_real_roots(c, n, t0 - ts, t1 - ts, method, s);
     int m = 0;
     for (int i = 0; i < k; ++i) {
         double t = ts + s[i];
@@ -115,6 +117,18 @@ int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3
             roots[m++] = t;
     }
     return m;
+}
+
+int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3], const double d[3],
+                   double tmin, double tmax, ig_root_method method, double *roots)
+{
+    return shape_solve(shape, params, o, d, tmin, tmax, method, 0, roots);
+}
+
+int ig_shape_first_root(const ig_shape *shape, const double *params, const double o[3], const double d[3],
+                        double tmin, double tmax, ig_root_method method, double *t)
+{
+    return shape_solve(shape, params, o, d, tmin, tmax, method, 1, t);
 }
 
 int ig_shape_normal(const ig_shape *shape, const double *params, const double p[3], double n[3])

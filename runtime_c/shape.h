@@ -30,6 +30,11 @@ typedef struct ig_shape {
 int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3], const double d[3],
                    double tmin, double tmax, ig_root_method method, double *roots);
 
+/* The nearest of those roots (what ig_shape_roots would list first) into *t: 1, or 0 when there is none.
+ * The same clip and shift; the solver stops at the first root instead of isolating all (ig_first_root). */
+int ig_shape_first_root(const ig_shape *shape, const double *params, const double o[3], const double d[3],
+                        double tmin, double tmax, ig_root_method method, double *t);
+
 /* Unit outward normal at p. At a singular point (grad f = 0 or not finite, e.g. a cone's apex) writes
  * (0, 0, 0) and returns 0 -- never NaN; the caller picks a fallback (e.g. facing the ray). Returns 1 otherwise. */
 int ig_shape_normal(const ig_shape *shape, const double *params, const double p[3], double n[3]);

@@ -27,6 +27,19 @@ int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], doub
     return k;
 }
 
+/* The nearest root of a leaf in [lo, hi] (same unit-direction parameter as rt_leaf_roots): 1, or 0 if none. */
+static int leaf_first_root(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r)
+{
+    double L = sqrt(rt_dot(od, od)), u[3];
+    if (!(L > 0.0) || !isfinite(L)) return 0;
+    u[0] = od[0] / L;
+    u[1] = od[1] / L;
+    u[2] = od[2] / L;
+    if (!ig_shape_first_root(n->shape, n->params, oo, u, lo * L, hi * L, IG_ROOTS_AUTO, r)) return 0;
+    *r /= L;
+    return 1;
+}
+
 /* Spans of one leaf solid over [a, b]. */
 static int leaf_spans(const rt_scene *s, int k, const double o[3], const double d[3], double a, double b,
                       rt_span *out, int max)
@@ -199,11 +212,13 @@ int rt_object_hit(const rt_scene *s, int object, const double o[3], const double
         if (!(hi > lo)) return 0;
     }
     if (n->kind == RT_LEAF) {
-        /* A top-level leaf is a surface: its nearest root after tmin. */
+        /* A top-level leaf is a surface: its nearest root after tmin. The solver stops at the first root in
+         * [lo, hi]; only when that one is not after tmin (a root exactly at tmin) are all of them needed. */
         double oo[3], od[3], r[IG_MAX_DEGREE + 2];
         int nr, i;
         rt_to_object(n, o, d, oo, od);
-        nr = rt_leaf_roots(n, oo, od, lo, hi, r);
+        nr = leaf_first_root(n, oo, od, lo, hi, r);
+        if (nr && !(r[0] > tmin)) nr = rt_leaf_roots(n, oo, od, lo, hi, r);
         for (i = 0; i < nr; ++i)
             if (r[i] > tmin && r[i] < tmax) {
                 *t = r[i];
