@@ -21,7 +21,7 @@ from typing import Sequence
 
 from .errors import UserError
 
-BASE_FLAGS: tuple[str, ...] = ("-std=c99", "-O2", "-fPIC", "-Wall", "-Wextra", "-Werror", "-pedantic")
+BASE_FLAGS: tuple[str, ...] = ("-std=c99", "-O3", "-fPIC", "-Wall", "-Wextra", "-Werror", "-pedantic")
 
 
 def cache_dir() -> Path:

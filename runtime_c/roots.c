@@ -439,7 +439,7 @@ static int solve_general(const double *p, int n, double lo, double hi, interval_
     double big = fmax(fabs(a), fabs(b));
     /* coefficients are at most ~2^200 (see ig_real_roots_any); |x|^n below 2^524 keeps Horner and the
      * splitting of Dekker's product (another 2^27) far from overflow */
-    if (big <= 1.0 || (double)n * ilogb(big) < 500.0)
+    if (big <= 0x1p20 || (double)n * ilogb(big) < 500.0) /* n <= 24: 2^20 is always safe */
         return (first_solver ? first_solver : solver)(p, n, a, b, out);
 
     /* |x| > 1 on the reversed polynomial q(y) = y^n p(1/y), y = 1/x in [-1, 1] */
@@ -520,22 +520,22 @@ int ig_roots_core(const double *c, int n, double lo, double hi, int method, int 
         return 0;
     double cmax = 0.0;
     for (int k = 0; k <= n; ++k) {
-        if (!isfinite(c[k]))
+        double m = fabs(c[k]);
+        if (!(m <= DBL_MAX)) /* NaN or Inf */
             return 0;
-        if (fabs(c[k]) > cmax)
-            cmax = fabs(c[k]);
+        cmax = m > cmax ? m : cmax;
     }
     if (cmax == 0.0)
         return 0; /* the zero polynomial: every t is a root; reported as none */
-    double p[IG_MAX_DEGREE + 1];
+    double scaled[IG_MAX_DEGREE + 1];
+    const double *p = c;
     /* exact rescaling by a power of two when the coefficients are far from 1 */
-    int e = ilogb(cmax);
-    if (e > 200 || e < -200) {
+    if (cmax > 0x1p200 || cmax < 0x1p-200) {
+        int e = ilogb(cmax);
         double s1 = ldexp(1.0, -e / 2), s2 = ldexp(1.0, -e - (-e / 2));
         for (int k = 0; k <= n; ++k)
-            p[k] = (c[k] * s1) * s2;
-    } else {
-        memcpy(p, c, (size_t)(n + 1) * sizeof(double));
+            scaled[k] = (c[k] * s1) * s2;
+        p = scaled;
     }
     int top = n;
     while (top > 0 && p[top] == 0.0)
@@ -550,7 +550,8 @@ int ig_roots_core(const double *c, int n, double lo, double hi, int method, int 
         k = solve_reduced(p + m, deg, lo, hi, method, first, r);
     if (m > 0)
         r[k++] = 0.0;
-    k = ig_sort_unique(r, k);
+    if (k > 1)
+        k = ig_sort_unique(r, k);
     int cnt = 0, most = first ? 1 : n;
     for (int i = 0; i < k && cnt < most; ++i)
         if (r[i] >= lo && r[i] <= hi && isfinite(r[i]))

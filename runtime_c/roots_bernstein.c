@@ -14,7 +14,7 @@
  * what a ray needs: the nearest hit, not all of them.
  *
  * Rounding: every b_i carries an error below tol = 24 n u M, M = sum |p_k| (|a| + |h|)^k (a priori bound of
- * the Taylor shift, the basis change and up to BZ_MAX_DEPTH halvings). A coefficient within tol of zero has no
+ * the Taylor shift, the basis change and up to BZ_MAX_DEPTH halvings: about (6n + 3 + 12n) u M). A coefficient within tol of zero has no
  * certain sign. At the piece ends, where b_0 = p(t_l) and b_n = p(t_r), the compensated evaluation of
  * ig_sign_certified decides instead; inside, uncertain coefficients that might hide sign changes (see
  * variations()) force a split.
@@ -23,13 +23,16 @@
  * tangent ray, a cluster of roots), or p zero within rounding at a piece end -- the derivative-bracketing
  * solver runs on the whole interval and its answer is returned unchanged: in the doubtful cases the two methods
  * give identical results by construction, and bracketing is the one that reports tangent roots.
+ *
+ * Speed: the body (roots_bernstein_body.h) is compiled once per degree 3 .. 12 with the degree a constant,
+ * so the O(n^2) loops unroll into straight-line code, and once more for any degree.
  */
 #include "roots_impl.h"
 
 #include <math.h>
 #include <string.h>
 
-#define BZ_MAX_DEPTH 16
+#define BZ_MAX_DEPTH 12
 
 typedef struct {
     const double *p; /* power-form coefficients, exact degree n */
@@ -42,66 +45,11 @@ typedef struct {
     int fallback; /* something was not certain: bracketing decides */
 } bz_ctx;
 
-/* Bernstein coefficients of p(a + s h) on s in [0, 1]. */
-static void to_bernstein(const double *p, int n, double a, double h, double *b)
-{
-    double t[IG_MAX_DEGREE + 1];
-    memcpy(t, p, (size_t)(n + 1) * sizeof(double));
-    for (int i = 0; i < n; ++i) /* Taylor shift: t(y) = p(a + y), repeated synthetic division */
-        for (int k = n - 1; k >= i; --k)
-            t[k] += a * t[k + 1];
-    double hp = 1.0, binom = 1.0; /* h^j, C(n, j): exact integers up to C(24, 12) */
-    for (int j = 0; j <= n; ++j) {
-        b[j] = t[j] * hp / binom;
-        hp *= h;
-        binom = binom * (n - j) / (j + 1);
-    }
-    for (int r = 1; r <= n; ++r) /* b_i = sum_j C(i, j) w_j: Pascal's triangle, additions only */
-        for (int i = n; i >= r; --i)
-            b[i] += b[i - 1];
-}
-
-/* de Casteljau at s = 1/2: the halves' coefficients (weights 1/2: the only rounding is in the sums). */
-static void split_half(const double *b, int n, double *L, double *R)
-{
-    double w[IG_MAX_DEGREE + 1];
-    memcpy(w, b, (size_t)(n + 1) * sizeof(double));
-    L[0] = w[0];
-    R[n] = w[n];
-    for (int r = 1; r <= n; ++r) {
-        for (int i = 0; i <= n - r; ++i)
-            w[i] = 0.5 * (w[i] + w[i + 1]);
-        L[r] = w[0];
-        R[n - r] = w[n - r];
-    }
-}
-
-/* Sign changes of b[0..n] with end signs sl, sr (certain, nonzero); -1 when uncertain interior coefficients
- * could hide changes: a run of them between two equal signs (+ ? + may be + - +), or a run of two or more
- * between opposite signs (+ ? ? - may be + - + -). A single one between opposite signs changes nothing. */
-static int variations(const double *b, int n, double tol, int sl, int sr)
-{
-    int v = 0, last = sl, pending = 0;
-    for (int i = 1; i <= n; ++i) {
-        int s;
-        if (i == n) {
-            s = sr;
-        } else if (!(fabs(b[i]) > tol)) {
-            ++pending;
-            continue;
-        } else {
-            s = b[i] > 0.0 ? 1 : -1;
-        }
-        if (pending > 1 || (pending == 1 && s == last))
-            return -1;
-        if (s != last) {
-            ++v;
-            last = s;
-        }
-        pending = 0;
-    }
-    return v;
-}
+/* 1/k, k = 0 .. IG_MAX_DEGREE (entry 0 unused): turns the binomial scaling into products. */
+static const double bz_inv[IG_MAX_DEGREE + 1] = {
+    0.0,       1.0,        1.0 / 2,  1.0 / 3,  1.0 / 4,  1.0 / 5,  1.0 / 6,  1.0 / 7,  1.0 / 8,
+    1.0 / 9,   1.0 / 10,   1.0 / 11, 1.0 / 12, 1.0 / 13, 1.0 / 14, 1.0 / 15, 1.0 / 16, 1.0 / 17,
+    1.0 / 18,  1.0 / 19,   1.0 / 20, 1.0 / 21, 1.0 / 22, 1.0 / 23, 1.0 / 24};
 
 /* Certain sign of p at t given the Bernstein value bv there (b_0 or b_n of a piece): the plain value when it
  * is clear of the rounding band, else the compensated evaluation (0: p is zero within rounding). */
@@ -114,47 +62,35 @@ static int end_sign(const bz_ctx *c, double bv, double t, double *val)
     return ig_sign_certified(c->p, c->n, t, val);
 }
 
-/* Start guess for the one root of a piece: where the control polygon first crosses zero (the polygon lies
- * within O(h^2) of the curve, so this is close); NaN (false position) when no segment crosses. */
-static double polygon_crossing(const double *b, int n, double tl, double tr)
-{
-    for (int i = 0; i < n; ++i)
-        if ((b[i] > 0.0) != (b[i + 1] > 0.0) && b[i] != b[i + 1]) {
-            double s = (i + b[i] / (b[i] - b[i + 1])) / n;
-            return tl + s * (tr - tl);
-        }
-    return NAN;
-}
+#define BZ_CAT2(a, b) a##_##b
+#define BZ_CAT(a, b) BZ_CAT2(a, b)
 
-/* Piece [s0, s1] of [0, 1] with Bernstein coefficients b, end signs sl, sr and values vl, vr of p there. */
-static void piece(bz_ctx *c, const double *b, double s0, double s1, double tl, double tr, int sl, int sr,
-                  double vl, double vr, int depth)
-{
-    if (c->fallback || (c->first && c->cnt > 0))
-        return;
-    int v = variations(b, c->n, c->tol, sl, sr);
-    if (v == 0)
-        return;
-    if (v == 1) {
-        c->out[c->cnt++] = ig_refine(c->p, c->n, tl, tr, vl, vr, 2.0 * IG_U, polygon_crossing(b, c->n, tl, tr));
-        return;
-    }
-    double sm = 0.5 * (s0 + s1);
-    double tm = c->a + sm * c->h;
-    if (depth >= BZ_MAX_DEPTH || !(tm > tl && tm < tr)) {
-        c->fallback = 1;
-        return;
-    }
-    double L[IG_MAX_DEGREE + 1], R[IG_MAX_DEGREE + 1], vm;
-    split_half(b, c->n, L, R);
-    int sm_sign = end_sign(c, L[c->n], tm, &vm);
-    if (sm_sign == 0) { /* p zero within rounding at the split point */
-        c->fallback = 1;
-        return;
-    }
-    piece(c, L, s0, sm, tl, tm, sl, sm_sign, vl, vm, depth + 1);
-    piece(c, R, sm, s1, tm, tr, sm_sign, sr, vm, vr, depth + 1);
-}
+#define BZ_TAG 3
+#include "roots_bernstein_body.h"
+#define BZ_TAG 4
+#include "roots_bernstein_body.h"
+#define BZ_TAG 5
+#include "roots_bernstein_body.h"
+#define BZ_TAG 6
+#include "roots_bernstein_body.h"
+#define BZ_TAG 7
+#include "roots_bernstein_body.h"
+#define BZ_TAG 8
+#include "roots_bernstein_body.h"
+#define BZ_TAG 9
+#include "roots_bernstein_body.h"
+#define BZ_TAG 10
+#include "roots_bernstein_body.h"
+#define BZ_TAG 11
+#include "roots_bernstein_body.h"
+#define BZ_TAG 12
+#include "roots_bernstein_body.h"
+#define BZ_TAG any
+#define BZ_ANY_DEGREE
+#include "roots_bernstein_body.h"
+
+typedef void (*bz_piece_fn)(bz_ctx *c, const double *b, double s0, double s1, double tl, double tr, int sl, int sr,
+                            double vl, double vr, int depth);
 
 static int bernstein(const double *p, int n, double a, double b, int first, double *out)
 {
@@ -169,7 +105,20 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     if (!isfinite(c.tol))
         return ig_bracket_interval(p, n, a, b, out);
     double bz[IG_MAX_DEGREE + 1], vl, vr;
-    to_bernstein(p, n, a, h, bz);
+    bz_piece_fn piece;
+    switch (n) {
+    case 3: to_bernstein_3(p, n, a, h, bz); piece = piece_3; break;
+    case 4: to_bernstein_4(p, n, a, h, bz); piece = piece_4; break;
+    case 5: to_bernstein_5(p, n, a, h, bz); piece = piece_5; break;
+    case 6: to_bernstein_6(p, n, a, h, bz); piece = piece_6; break;
+    case 7: to_bernstein_7(p, n, a, h, bz); piece = piece_7; break;
+    case 8: to_bernstein_8(p, n, a, h, bz); piece = piece_8; break;
+    case 9: to_bernstein_9(p, n, a, h, bz); piece = piece_9; break;
+    case 10: to_bernstein_10(p, n, a, h, bz); piece = piece_10; break;
+    case 11: to_bernstein_11(p, n, a, h, bz); piece = piece_11; break;
+    case 12: to_bernstein_12(p, n, a, h, bz); piece = piece_12; break;
+    default: to_bernstein_any(p, n, a, h, bz); piece = piece_any; break;
+    }
     int sl = end_sign(&c, bz[0], a, &vl), sr = end_sign(&c, bz[n], b, &vr);
     if (sl == 0 || sr == 0) /* a root at an end of the interval (within rounding) */
         return ig_bracket_interval(p, n, a, b, out);

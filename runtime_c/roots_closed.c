@@ -220,7 +220,7 @@ static int quartic_classic(const double *c, double *x)
 
 int ig_closed_cubic(const double *c, double lo, double hi, int polish_on, double *r)
 {
-    double y[4];
+    double y[4] = {0.0, 0.0, 0.0, 0.0};
     if (!polish_on) {
         int k = cubic_classic(c[2] / c[3], c[1] / c[3], c[0] / c[3], y);
         return finish(y, k, 0, lo, hi, r);

@@ -1,0 +1,128 @@
+/* Body of the Bernstein-subdivision solver, included by roots_bernstein.c once per specialised degree.
+ *
+ * Before each inclusion define BZ_TAG (the suffix of the function names: a degree such as 4, or `any`) and,
+ * for the any-degree version, BZ_ANY_DEGREE. With a fixed degree N is a constant and the compiler unrolls
+ * the O(n^2) loops; otherwise N is the run-time degree n. Every function takes n either way. Not a public
+ * header: it has no include guard on purpose, and it undefines its macros at the end.
+ */
+#ifdef BZ_ANY_DEGREE
+#define N n
+#else
+#define N BZ_TAG
+#endif
+#define BZ_FN(name) BZ_CAT(name, BZ_TAG)
+
+/* Bernstein coefficients of p(a + s h) on s in [0, 1]. */
+static void BZ_FN(to_bernstein)(const double *p, int n, double a, double h, double *b)
+{
+    double t[IG_MAX_DEGREE + 1];
+    (void)n;
+    t[0] = p[0];
+    for (int k = 1; k <= N; ++k)
+        t[k] = p[k];
+    for (int i = 0; i < N; ++i) /* Taylor shift: t(y) = p(a + y), repeated synthetic division */
+        for (int k = N - 1; k >= i; --k)
+            t[k] += a * t[k + 1];
+    double r = 1.0; /* h^j / C(n, j), C(n, j) = C(n, j - 1) (n - j + 1) / j */
+    b[0] = t[0];
+    for (int j = 1; j <= N; ++j) {
+        r *= h * (j * bz_inv[N - j + 1]);
+        b[j] = t[j] * r;
+    }
+    for (int k = 1; k <= N; ++k) /* b_i = sum_j C(i, j) w_j: Pascal's triangle, additions only */
+        for (int i = N; i >= k; --i)
+            b[i] += b[i - 1];
+}
+
+/* de Casteljau at s = 1/2: the halves' coefficients (weights 1/2: the only rounding is in the sums). */
+static void BZ_FN(split_half)(const double *b, int n, double *L, double *R)
+{
+    double w[IG_MAX_DEGREE + 1];
+    (void)n;
+    w[0] = b[0];
+    for (int i = 1; i <= N; ++i)
+        w[i] = b[i];
+    L[0] = w[0];
+    R[N] = w[N];
+    for (int k = 1; k <= N; ++k) {
+        for (int i = 0; i <= N - k; ++i)
+            w[i] = 0.5 * (w[i] + w[i + 1]);
+        L[k] = w[0];
+        R[N - k] = w[N - k];
+    }
+}
+
+/* Sign changes of b[0..n] with end signs sl, sr (certain, nonzero); -1 when uncertain interior coefficients
+ * could hide changes: a run of them between two equal signs (+ ? + may be + - +), or a run of two or more
+ * between opposite signs (+ ? ? - may be + - + -). A single one between opposite signs changes nothing. */
+static int BZ_FN(variations)(const double *b, int n, double tol, int sl, int sr)
+{
+    int v = 0, last = sl, pending = 0;
+    (void)n;
+    for (int i = 1; i < N; ++i) {
+        if (!(fabs(b[i]) > tol)) {
+            ++pending;
+            continue;
+        }
+        int s = b[i] > 0.0 ? 1 : -1;
+        if (pending > 1 || (pending == 1 && s == last))
+            return -1;
+        v += s != last;
+        last = s;
+        pending = 0;
+    }
+    if (pending > 1 || (pending == 1 && sr == last))
+        return -1;
+    return v + (sr != last);
+}
+
+/* Start guess for the one root of a piece: where the control polygon first crosses zero (the polygon lies
+ * within O(h^2) of the curve, so this is close); NaN (false position) when no segment crosses. */
+static double BZ_FN(polygon_crossing)(const double *b, int n, double tl, double tr)
+{
+    (void)n;
+    for (int i = 0; i < N; ++i)
+        if ((b[i] > 0.0) != (b[i + 1] > 0.0) && b[i] != b[i + 1]) {
+            double s = (i + b[i] / (b[i] - b[i + 1])) / N;
+            return tl + s * (tr - tl);
+        }
+    return NAN;
+}
+
+/* Piece [s0, s1] of [0, 1] with Bernstein coefficients b, end signs sl, sr and values vl, vr of p there. */
+static void BZ_FN(piece)(bz_ctx *c, const double *b, double s0, double s1, double tl, double tr, int sl, int sr,
+                         double vl, double vr, int depth)
+{
+    const int n = c->n;
+    if (c->fallback || (c->first && c->cnt > 0))
+        return;
+    int v = BZ_FN(variations)(b, n, c->tol, sl, sr);
+    if (v == 0)
+        return;
+    if (v == 1) {
+        c->out[c->cnt++] = ig_refine(c->p, n, tl, tr, vl, vr, 2.0 * IG_U, BZ_FN(polygon_crossing)(b, n, tl, tr));
+        return;
+    }
+    double sm = 0.5 * (s0 + s1);
+    double tm = c->a + sm * c->h;
+    if (depth >= BZ_MAX_DEPTH || !(tm > tl && tm < tr)) {
+        c->fallback = 1;
+        return;
+    }
+    double L[IG_MAX_DEGREE + 1], R[IG_MAX_DEGREE + 1], vm;
+    BZ_FN(split_half)(b, n, L, R);
+    int sm_sign = end_sign(c, L[N], tm, &vm);
+    if (sm_sign == 0) { /* p zero within rounding at the split point */
+        c->fallback = 1;
+        return;
+    }
+    BZ_FN(piece)(c, L, s0, sm, tl, tm, sl, sm_sign, vl, vm, depth + 1);
+    BZ_FN(piece)(c, R, sm, s1, tm, tr, sm_sign, sr, vm, vr, depth + 1);
+}
+
+#undef BZ_FN
+#undef N
+#undef BZ_TAG
+#ifdef BZ_ANY_DEGREE
+#undef BZ_ANY_DEGREE
+#endif
