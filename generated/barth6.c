@@ -141,6 +141,12 @@ int barth6_intersect(const double o[3], const double d[3], double tmin, double t
     return count;
 }
 
+int barth6_first_hit(const double o[3], const double d[3], double tmin, double tmax,
+                         const double *params, double *t)
+{
+    return ig_shape_first_root(&barth6_shape, params, o, d, tmin, tmax, IG_ROOTS_AUTO, t);
+}
+
 int barth6_normal(const double p[3], const double *params, double n[3])
 {
     return ig_shape_normal(&barth6_shape, params, p, n);

@@ -25,6 +25,11 @@ int barth6_bounds(const double *params, double box[6]);
  * returns their count. Clips to the box and shifts the origin close to the object before solving. */
 int barth6_intersect(const double o[3], const double d[3], double tmin, double tmax,
                          const double *params, double *roots);
+/* the nearest root of f(o + t d) in [tmin, tmax] into *t: the root barth6_intersect lists first (at times
+ * rounded differently, within its error); returns 1, or 0 when there is none (*t is then left alone). Same clip
+ * and shift; the solver stops at the first root instead of isolating them all (ig_shape_first_root). */
+int barth6_first_hit(const double o[3], const double d[3], double tmin, double tmax,
+                         const double *params, double *t);
 /* unit outward normal at p; at a singular point writes (0, 0, 0) and returns 0 (never NaN) */
 int barth6_normal(const double p[3], const double *params, double n[3]);
 

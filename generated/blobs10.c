@@ -138,6 +138,12 @@ int blobs10_intersect(const double o[3], const double d[3], double tmin, double 
     return count;
 }
 
+int blobs10_first_hit(const double o[3], const double d[3], double tmin, double tmax,
+                         const double *params, double *t)
+{
+    return ig_shape_first_root(&blobs10_shape, params, o, d, tmin, tmax, IG_ROOTS_AUTO, t);
+}
+
 int blobs10_normal(const double p[3], const double *params, double n[3])
 {
     return ig_shape_normal(&blobs10_shape, params, p, n);

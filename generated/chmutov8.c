@@ -144,6 +144,12 @@ int chmutov8_intersect(const double o[3], const double d[3], double tmin, double
     return count;
 }
 
+int chmutov8_first_hit(const double o[3], const double d[3], double tmin, double tmax,
+                         const double *params, double *t)
+{
+    return ig_shape_first_root(&chmutov8_shape, params, o, d, tmin, tmax, IG_ROOTS_AUTO, t);
+}
+
 int chmutov8_normal(const double p[3], const double *params, double n[3])
 {
     return ig_shape_normal(&chmutov8_shape, params, p, n);

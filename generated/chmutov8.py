@@ -5,7 +5,8 @@
     arithmetic operations: coeffs 232, value 36, gradient 39
 
 Every function broadcasts over NumPy arrays whose last axis has length 3 (plain sequences work too).
-`intersect` solves with implgen's C root solvers (`implgen.raycast`), so it needs implgen installed.
+`intersect` and `first_hit` solve with implgen's C root solvers (`implgen.raycast`), so they need implgen
+installed.
 """
 
 import math
@@ -157,3 +158,11 @@ def intersect(o, d, tmin=0.0, tmax=math.inf, /, **params):
     from implgen.raycast import nearest_hit
 
     return nearest_hit(lambda o_, d_: coeffs(o_, d_, **params), bounds(**params), o, d, tmin, tmax)
+
+
+def first_hit(o, d, tmin=0.0, tmax=math.inf, /, **params):
+    """The same nearest root per ray (inf where the ray misses), from the first-root solver: it stops at the
+    smallest root instead of isolating all of them."""
+    from implgen.raycast import first_hit as _first_hit
+
+    return _first_hit(lambda o_, d_: coeffs(o_, d_, **params), bounds(**params), o, d, tmin, tmax)

@@ -70,6 +70,12 @@ int cone_intersect(const double o[3], const double d[3], double tmin, double tma
     return count;
 }
 
+int cone_first_hit(const double o[3], const double d[3], double tmin, double tmax,
+                         const double *params, double *t)
+{
+    return ig_shape_first_root(&cone_shape, params, o, d, tmin, tmax, IG_ROOTS_AUTO, t);
+}
+
 int cone_normal(const double p[3], const double *params, double n[3])
 {
     return ig_shape_normal(&cone_shape, params, p, n);

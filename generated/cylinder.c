@@ -78,6 +78,12 @@ int cylinder_intersect(const double o[3], const double d[3], double tmin, double
     return count;
 }
 
+int cylinder_first_hit(const double o[3], const double d[3], double tmin, double tmax,
+                         const double *params, double *t)
+{
+    return ig_shape_first_root(&cylinder_shape, params, o, d, tmin, tmax, IG_ROOTS_AUTO, t);
+}
+
 int cylinder_normal(const double p[3], const double *params, double n[3])
 {
     return ig_shape_normal(&cylinder_shape, params, p, n);

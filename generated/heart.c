@@ -119,6 +119,12 @@ int heart_intersect(const double o[3], const double d[3], double tmin, double tm
     return count;
 }
 
+int heart_first_hit(const double o[3], const double d[3], double tmin, double tmax,
+                         const double *params, double *t)
+{
+    return ig_shape_first_root(&heart_shape, params, o, d, tmin, tmax, IG_ROOTS_AUTO, t);
+}
+
 int heart_normal(const double p[3], const double *params, double n[3])
 {
     return ig_shape_normal(&heart_shape, params, p, n);

@@ -90,6 +90,12 @@ int piriform_intersect(const double o[3], const double d[3], double tmin, double
     return count;
 }
 
+int piriform_first_hit(const double o[3], const double d[3], double tmin, double tmax,
+                         const double *params, double *t)
+{
+    return ig_shape_first_root(&piriform_shape, params, o, d, tmin, tmax, IG_ROOTS_AUTO, t);
+}
+
 int piriform_normal(const double p[3], const double *params, double n[3])
 {
     return ig_shape_normal(&piriform_shape, params, p, n);

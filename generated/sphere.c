@@ -82,6 +82,12 @@ int sphere_intersect(const double o[3], const double d[3], double tmin, double t
     return count;
 }
 
+int sphere_first_hit(const double o[3], const double d[3], double tmin, double tmax,
+                         const double *params, double *t)
+{
+    return ig_shape_first_root(&sphere_shape, params, o, d, tmin, tmax, IG_ROOTS_AUTO, t);
+}
+
 int sphere_normal(const double p[3], const double *params, double n[3])
 {
     return ig_shape_normal(&sphere_shape, params, p, n);

@@ -116,6 +116,12 @@ int torus_y_intersect(const double o[3], const double d[3], double tmin, double 
     return count;
 }
 
+int torus_y_first_hit(const double o[3], const double d[3], double tmin, double tmax,
+                         const double *params, double *t)
+{
+    return ig_shape_first_root(&torus_y_shape, params, o, d, tmin, tmax, IG_ROOTS_AUTO, t);
+}
+
 int torus_y_normal(const double p[3], const double *params, double n[3])
 {
     return ig_shape_normal(&torus_y_shape, params, p, n);

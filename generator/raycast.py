@@ -13,7 +13,7 @@ from typing import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .roots import real_roots_batch
+from .roots import first_root_batch, real_roots_batch
 
 CoeffsFn = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
@@ -64,7 +64,9 @@ def _shift_point(box: np.ndarray | None, o: np.ndarray, d: np.ndarray, t0: np.nd
 
 
 def _solve(coeffs_fn: CoeffsFn, box: ArrayLike | None, o: ArrayLike, d: ArrayLike, tmin: ArrayLike,
-           tmax: ArrayLike, method: str):
+           tmax: ArrayLike, method: str, first: bool = False):
+    """(batch shape, t per ray with NaN padding, counts); first=True asks the solver for the smallest root only
+    (first_root_batch: one column, counts 0 or 1)."""
     o = np.asarray(o, dtype=np.float64)
     d = np.asarray(d, dtype=np.float64)
     if o.shape[-1:] != (3,) or d.shape[-1:] != (3,):
@@ -86,7 +88,11 @@ def _solve(coeffs_fn: CoeffsFn, box: ArrayLike | None, o: ArrayLike, d: ArrayLik
     c = c.reshape(shifted.shape[0], -1)
     lo = np.where(valid, t0 - ts, 1.0)
     hi = np.where(valid, t1 - ts, 0.0)  # lo > hi: no roots for rays that miss the box
-    s, counts = real_roots_batch(c, lo, hi, method)
+    if first:
+        s1, counts = first_root_batch(c, lo, hi, method)
+        s = s1[:, None]
+    else:
+        s, counts = real_roots_batch(c, lo, hi, method)
     with np.errstate(invalid="ignore"):
         t = np.clip(ts[:, None] + s, t0[:, None], t1[:, None])
     return batch, t, counts
@@ -99,6 +105,14 @@ def nearest_hit(coeffs_fn: CoeffsFn, box: ArrayLike | None, o: ArrayLike, d: Arr
     first = t[:, 0] if t.shape[1] else np.full(t.shape[0], np.nan)
     out = np.where(counts > 0, first, np.inf)
     return out.reshape(batch)
+
+
+def first_hit(coeffs_fn: CoeffsFn, box: ArrayLike | None, o: ArrayLike, d: ArrayLike, tmin: ArrayLike = 0.0,
+              tmax: ArrayLike = np.inf, method: str = "auto") -> np.ndarray:
+    """nearest_hit through the first-root solver (`ig_first_root`: it stops at the smallest root instead of
+    isolating all of them): nearest root t in [tmin, tmax] per ray, np.inf for a miss."""
+    batch, t, counts = _solve(coeffs_fn, box, o, d, tmin, tmax, method, first=True)
+    return np.where(counts > 0, t[:, 0], np.inf).reshape(batch)
 
 
 def all_hits(coeffs_fn: CoeffsFn, box: ArrayLike | None, o: ArrayLike, d: ArrayLike, tmin: float = 0.0,

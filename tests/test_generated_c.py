@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ctypes
 import shutil
 import subprocess
 
@@ -52,6 +53,73 @@ def test_far_away_torus_gives_the_same_hits(lib):
     assert near.size == 4 and np.allclose(far - (1e4 - 5), near, rtol=0, atol=1e-9 * 1e4)
 
 
+def _first_hit(lib: CShapes, name: str, o, d, tmin, tmax, params=()) -> tuple[int, float]:
+    """<name>_first_hit through ctypes: (return value, t); t starts as a sentinel the function must not touch
+    on a miss."""
+    fn = getattr(lib.lib, f"{name}_first_hit")
+    fn.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_void_p,
+                   ctypes.c_void_p]
+    t = ctypes.c_double(-12345.0)
+    got = fn(lib._arr(o), lib._arr(d), tmin, tmax, lib._arr(params), ctypes.byref(t))
+    return got, t.value
+
+
+def test_first_hit_is_the_nearest_root(lib):
+    assert _first_hit(lib, "sphere", [0, 0, -5], [0, 0, 2], 0, np.inf, [1.0]) == (1, 2.0)
+    assert _first_hit(lib, "sphere", [0, 0, -5], [0, 0, 2], 2.5, np.inf, [1.0]) == (1, 3.0)  # tmin past the entry
+    assert _first_hit(lib, "sphere", [0, 0, -5], [0, 0, 2], 0, 2.0, [1.0]) == (1, 2.0)  # root exactly at tmax
+    got, t = _first_hit(lib, "sphere", [0, 0, 0.5], [0, 0, 1], 0, np.inf, [1.0])  # inside: the exit
+    assert got == 1 and t == pytest.approx(0.5, rel=1e-15)
+    got, t = _first_hit(lib, "torus_z", [-5, 0, 0], [1, 0, 0], 0, np.inf, [1.0, 0.25])
+    assert got == 1 and t == pytest.approx(3.75, rel=1e-14)
+    got, t = _first_hit(lib, "torus_y", [-5, 0.25, 0], [1, 0, 0], 0, np.inf, [1.0, 0.25])  # tangent: double root
+    assert got == 1 and t == pytest.approx(4.0, rel=1e-6)
+    got, t = _first_hit(lib, "piriform", [0.5, -1, 0], [0, 1, 0], 0, np.inf)  # degree drop to 2
+    assert got == 1 and t == pytest.approx(0.75, rel=1e-14)
+    near = _first_hit(lib, "torus_z", [-5, 0.1, 0.05], [1, 0, 0], 0, np.inf, [1.0, 0.25])
+    far = _first_hit(lib, "torus_z", [-1e4, 0.1, 0.05], [1, 0, 0], 0, np.inf, [1.0, 0.25])  # origin shift
+    assert near[0] == far[0] == 1 and abs((far[1] - (1e4 - 5)) - near[1]) <= 1e-9 * 1e4, (near, far)
+
+
+def test_first_hit_misses_leave_t_alone(lib):
+    assert _first_hit(lib, "sphere", [0, 0, -5], [0, 0, 2], 0, 1.5, [1.0]) == (0, -12345.0)  # stops short
+    assert _first_hit(lib, "sphere", [0, 3, -5], [0, 0, 1], 0, np.inf, [1.0]) == (0, -12345.0)  # passes by
+    assert _first_hit(lib, "sphere", [0, 0, -5], [0, 0, 2], 1.0, 0.0, [1.0]) == (0, -12345.0)  # tmin > tmax
+    assert _first_hit(lib, "sphere", [0, 0, -5], [0, 0, 0], 0, np.inf, [1.0]) == (0, -12345.0)  # d = 0
+    assert _first_hit(lib, "sphere", [0, 0, np.nan], [0, 0, 1], 0, np.inf, [1.0]) == (0, -12345.0)
+    assert _first_hit(lib, "cylinder", [0.2, -3, 0.1], [0, 1, 0], 0, np.inf, [1.0]) == (0, -12345.0)  # in the wall
+
+
+def test_first_hit_is_intersects_first_root_on_random_rays(lib, rng):
+    """Every example shape, rays from around its box with non-unit directions, random [tmin, tmax]."""
+    from conftest import random_rays
+
+    for path in sorted((GENERATED.parent / "examples" / "shapes").glob("*.yaml")):
+        spec = load_spec(path)
+        params = [float(v) for v in spec.params.values()]
+        flag, box = lib.bounds(spec.name, params)
+        box = np.where(np.isfinite(box), box, [-2.0, -2.0, -2.0, 2.0, 2.0, 2.0])
+        target = box[:3] + rng.random((400, 3)) * (box[3:] - box[:3])  # rays through points of the box
+        o, d = random_rays(rng, 400, spread=3.0)
+        o = target - 2.0 * d
+        hits = differ = 0
+        for i in range(len(o)):
+            tmin, tmax = (0.0, np.inf) if i % 2 else sorted(rng.uniform(-2, 8, 2))
+            roots = lib.intersect(spec.name, o[i], d[i], tmin, tmax, params)
+            got, t = _first_hit(lib, spec.name, o[i], d[i], tmin, tmax, params)
+            assert got == (roots.size > 0), (spec.name, i, roots, t)
+            if not got:
+                assert t == -12345.0
+                continue
+            hits += 1
+            differ += t != roots[0]
+            # the same root up to the Bernstein/bracketing refinement difference (see tests/test_first_root.py)
+            assert abs(t - roots[0]) <= 1e-9 * max(abs(roots[0]), 1.0), (spec.name, i, t, roots)
+            assert roots.size == 1 or t < roots[1]
+        assert hits >= 100, (spec.name, hits)
+        print(f"{spec.name}: {hits} hits, first_hit != intersect()[0] on {differ}")
+
+
 def test_singular_normals_are_zero_not_nan(lib):
     flag, n = lib.normal("cone", [0, 0, 0])
     assert flag == 0 and np.array_equal(n, [0, 0, 0])
@@ -72,8 +140,12 @@ def test_every_generated_shape_under_sanitizers(tmp_path):
     table = ["#include \"shape.h\""]
     table += [f"#include \"{s.name}.h\"" for s in specs]
     table += [f"static const double params_{s.name}[] = {_params_literal(s.params.values())};" for s in specs]
-    table.append("static const struct { const ig_shape *shape; const double *params; } gen_shapes[] = {")
-    table += [f"    {{&{s.name}_shape, params_{s.name}}}," for s in specs]
+    table.append("typedef int (*gen_ray_fn)(const double o[3], const double d[3], double tmin, double tmax, "
+                 "const double *params, double *t);")
+    table.append("typedef struct { const ig_shape *shape; const double *params; gen_ray_fn intersect, first_hit; } "
+                 "gen_shape_entry;")
+    table.append("static const gen_shape_entry gen_shapes[] = {")
+    table += [f"    {{&{s.name}_shape, params_{s.name}, {s.name}_intersect, {s.name}_first_hit}}," for s in specs]
     table.append("};")
     (tmp_path / "gen_shapes_table.h").write_text("\n".join(table) + "\n")
     exe = tmp_path / "gen_check"
