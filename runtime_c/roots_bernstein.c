@@ -21,8 +21,9 @@
  *
  * Whenever this cannot conclude -- a piece still ambiguous after BZ_MAX_DEPTH halvings (a tangent or nearly
  * tangent ray, a cluster of roots), or p zero within rounding at a piece end -- the derivative-bracketing
- * solver runs on the whole interval and its answer is returned unchanged: in the doubtful cases the two methods
- * give identical results by construction, and bracketing is the one that reports tangent roots.
+ * solver (the one that reports tangent roots) takes over from the left end of that piece to b; the roots
+ * already found left of it stand. Pieces are visited left to right in both modes, so the first root in
+ * first-root mode is bitwise the first root of the full search.
  *
  * Speed: the body (roots_bernstein_body.h) is compiled once per degree 3 .. 12 with the degree a constant,
  * so the O(n^2) loops unroll into straight-line code, and once more for any degree.
@@ -42,7 +43,8 @@ typedef struct {
     int first;      /* stop at the leftmost root */
     double *out;
     int cnt;
-    int fallback; /* something was not certain: bracketing decides */
+    int fallback; /* a piece was not certain: bracketing decides from its left end on */
+    double fallback_from;
 } bz_ctx;
 
 /* 1/k, k = 0 .. IG_MAX_DEGREE (entry 0 unused): turns the binomial scaling into products. */
@@ -97,7 +99,7 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     double h = b - a;
     if (!(h > 0.0) || !isfinite(h))
         return ig_bracket_interval(p, n, a, b, out);
-    bz_ctx c = {p, n, a, b, h, 0.0, first, out, 0, 0};
+    bz_ctx c = {p, n, a, b, h, 0.0, first, out, 0, 0, a};
     double x = fabs(a) + h, M = 0.0;
     for (int k = n; k >= 0; --k)
         M = M * x + fabs(p[k]);
@@ -123,8 +125,8 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     if (sl == 0 || sr == 0) /* a root at an end of the interval (within rounding) */
         return ig_bracket_interval(p, n, a, b, out);
     piece(&c, bz, 0.0, 1.0, a, b, sl, sr, vl, vr, 0);
-    if (c.fallback)
-        return ig_bracket_interval(p, n, a, b, out);
+    if (c.fallback) /* the roots left of the unresolved piece stand; bracketing finds the rest */
+        c.cnt += ig_bracket_interval(p, n, c.fallback_from, b, out + c.cnt);
     return c.cnt;
 }
 

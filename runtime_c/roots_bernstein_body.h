@@ -107,6 +107,7 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double s0, double s1, doubl
     double tm = c->a + sm * c->h;
     if (depth >= BZ_MAX_DEPTH || !(tm > tl && tm < tr)) {
         c->fallback = 1;
+        c->fallback_from = tl;
         return;
     }
     double L[IG_MAX_DEGREE + 1], R[IG_MAX_DEGREE + 1], vm;
@@ -114,6 +115,7 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double s0, double s1, doubl
     int sm_sign = end_sign(c, L[N], tm, &vm);
     if (sm_sign == 0) { /* p zero within rounding at the split point */
         c->fallback = 1;
+        c->fallback_from = tl;
         return;
     }
     BZ_FN(piece)(c, L, s0, sm, tl, tm, sl, sm_sign, vl, vm, depth + 1);

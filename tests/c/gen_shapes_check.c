@@ -4,10 +4,9 @@
  * For each root t we check the backward error: |p(t)| <= tol * sum_k |c_k| |t|^k with the coefficients
  * at the ray's own origin, that roots ascend inside [tmin, tmax], and that normals are unit or exactly zero
  * (singular point), never NaN. <name>_intersect must give exactly ig_shape_roots' answer, and <name>_first_hit
- * a hit exactly when intersect has one (leaving t alone on a miss), with the same root: bitwise, or -- where
- * the Bernstein first-root search and the full search refine the root from different brackets (see
- * tests/test_first_root.py) -- within 1e-9 relative, below intersect's second root, with the same backward
- * error bound. Those differences are counted and printed. The shape table comes from a generated
+ * a hit exactly when intersect has one (leaving t alone on a miss), with bitwise the same root (the
+ * first-root search visits the same pieces as the full one; a difference is counted, printed and fails).
+ * The shape table comes from a generated
  * header (gen_shapes_table.h, written by the test). */
 #include <math.h>
 #include <stdio.h>
@@ -34,8 +33,8 @@ static double backward(const double *c, int degree, double t, double *scale)
     return fabs(value);
 }
 
-/* first_hit against intersect on one ray: 0 when consistent; counts last-bit differences in *differ */
-static int check_first_hit(const gen_shape_entry *e, const double o[3], const double d[3], const double *c,
+/* first_hit against intersect on one ray: 0 when consistent; counts differences in *differ */
+static int check_first_hit(const gen_shape_entry *e, const double o[3], const double d[3],
                            const double *roots, int n, int *differ, double *max_rel)
 {
     double t = -12345.0;
@@ -47,11 +46,10 @@ static int check_first_hit(const gen_shape_entry *e, const double o[3], const do
     if (t == roots[0])
         return 0;
     ++*differ;
-    double rel = fabs(t - roots[0]) / fmax(fabs(roots[0]), 1e-300), scale;
+    double rel = fabs(t - roots[0]) / fmax(fabs(roots[0]), 1e-300);
     if (rel > *max_rel)
         *max_rel = rel;
-    double value = backward(c, e->shape->degree, t, &scale);
-    return !(rel <= 1e-9) || !(t >= 0.0 && t <= 1e3) || (n > 1 && !(t < roots[1])) || !(value <= 1e-9 * scale);
+    return 1;
 }
 
 static int check_shape(const gen_shape_entry *e, int rays, int *failures)
@@ -80,7 +78,7 @@ static int check_shape(const gen_shape_entry *e, int rays, int *failures)
         double gen[IG_MAX_DEGREE];
         int ng = e->intersect(o, d, 0.0, 1e3, params, gen);
         int bad_gen = ng != n || (n > 0 && memcmp(gen, roots, (size_t)n * sizeof *roots) != 0);
-        if (bad_gen || check_first_hit(e, o, d, c, roots, n, &differ, &max_rel)) {
+        if (bad_gen || check_first_hit(e, o, d, roots, n, &differ, &max_rel)) {
             double t = NAN;
             int got = e->first_hit(o, d, 0.0, 1e3, params, &t);
             if (*failures < 10)
