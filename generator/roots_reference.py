@@ -13,6 +13,10 @@ then gives each root's condition number. Nothing here calls the C solvers, so it
   - *phantom*: a computed root that matches nothing, or a second computed root on one simple root, unless
     p is zero there to working precision (|p(x)| <= 64 u sum|c_k||x|^k): those are counted apart as
     "near-tangent" reports (e.g. a tangent root reported where the exact polynomial has a tiny minimum).
+
+`score_first` does the same for first-root mode (one computed root: the nearest hit of a ray) against the
+smallest reference root in [lo, hi]: *missed* when a required root (as above) lies before what was returned
+(or nothing was returned), *phantom* when the returned root matches no reference root.
 """
 
 from __future__ import annotations
@@ -156,8 +160,9 @@ def _is_numerical_zero(c: np.ndarray, x: float) -> bool:
     return abs(float(val)) <= 64 * U * _abs_sum(c, x) * len(c)
 
 
-def score_one(c: np.ndarray, lo: float, hi: float, computed: np.ndarray, ref: list[RefRoot]) -> Score:
-    sc = Score(polys=1)
+def _tolerances(ref: list[RefRoot]) -> list[float]:
+    """How far a computed root may lie from each reference root and still match it: grows with the root's
+    conditioning (and multiplicity), never beyond half the distance to its neighbours."""
     vals = [r.value for r in ref]
     tol = []
     for i, r in enumerate(ref):
@@ -168,14 +173,40 @@ def score_one(c: np.ndarray, lo: float, hi: float, computed: np.ndarray, ref: li
         else:
             rel = max(1e-12, (1e3 * U) ** (1.0 / r.mult))
         tol.append(min(rel * abs(r.value) + 1e-300, half_gap))
+    return tol
+
+
+def _match(x: float, ref: list[RefRoot], tol: list[float]) -> int:
+    """Index of the nearest reference root within its tolerance of x, or -1."""
+    best, bd = -1, np.inf
+    for i, r in enumerate(ref):
+        dist = abs(x - r.value)
+        if dist <= tol[i] and dist < bd:
+            best, bd = i, dist
+    return best
+
+
+def _required(r: RefRoot, tol: float, lo: float, hi: float) -> bool:
+    """A root every method must find: simple, condition <= SIMPLE_KAPPA, and inside [lo, hi] by more than its
+    tolerance (a root within its tolerance of lo or hi may truly lie just outside: not required either way)."""
+    return r.mult == 1 and r.kappa <= SIMPLE_KAPPA and lo + tol < r.value < hi - tol
+
+
+def _error(x: float, r: RefRoot, sc: Score) -> None:
+    if r.mult == 1:
+        err = float(abs((mpmath.mpf(float(x)) - mpmath.mpf(r.value))) / abs(r.value)) if r.value else abs(x)
+        sc.errors_all.append(err)
+        if r.kappa <= WELL_KAPPA:
+            sc.errors_well.append(err)
+
+
+def score_one(c: np.ndarray, lo: float, hi: float, computed: np.ndarray, ref: list[RefRoot]) -> Score:
+    sc = Score(polys=1)
+    tol = _tolerances(ref)
     hits = [0] * len(ref)
     mpmath.mp.dps = 50
     for x in computed:
-        best, bd = -1, np.inf
-        for i, r in enumerate(ref):
-            dist = abs(x - r.value)
-            if dist <= tol[i] and dist < bd:
-                best, bd = i, dist
+        best = _match(x, ref, tol)
         if best < 0:
             if _is_numerical_zero(c, float(x)):
                 sc.near_tangent += 1
@@ -188,16 +219,47 @@ def score_one(c: np.ndarray, lo: float, hi: float, computed: np.ndarray, ref: li
             if r.mult == 1 and not _is_numerical_zero(c, float(x)):
                 sc.phantom += 1
             continue
-        if r.mult == 1:
-            err = float(abs((mpmath.mpf(float(x)) - mpmath.mpf(r.value))) / abs(r.value)) if r.value else abs(x)
-            sc.errors_all.append(err)
-            if r.kappa <= WELL_KAPPA:
-                sc.errors_well.append(err)
+        _error(x, r, sc)
     for i, r in enumerate(ref):
-        # a root within its tolerance of lo or hi may truly lie just outside: not required either way
-        inside = lo + tol[i] < r.value < hi - tol[i]
-        if r.mult == 1 and r.kappa <= SIMPLE_KAPPA and inside:
+        if _required(r, tol[i], lo, hi):
             sc.ref_simple += 1
             if hits[i] == 0:
                 sc.missed += 1
+    return sc
+
+
+def score_first(c: np.ndarray, lo: float, hi: float, computed: np.ndarray, ref: list[RefRoot]) -> Score:
+    """First-root mode: computed holds at most one root, which should be the smallest reference root in
+    [lo, hi]. ref_simple counts polynomials with a required root (1 or 0); missed: a required root lies before
+    the returned one, or nothing was returned although one exists -- a ray that sees through a surface;
+    phantom: the returned root matches no reference root (and p is not zero there to working precision) -- a
+    hit where there is none. The returned root may also be a tangent or boundary root before the first
+    required one: that is correct, and scored like score_one scores it."""
+    sc = Score(polys=1)
+    tol = _tolerances(ref)
+    req = [r.value for i, r in enumerate(ref) if _required(r, tol[i], lo, hi)]
+    first_req = min(req) if req else None
+    if first_req is not None:
+        sc.ref_simple += 1
+    mpmath.mp.dps = 50
+    computed = np.asarray(computed, dtype=float).reshape(-1)[:1]
+    if computed.size == 0:
+        if first_req is not None:
+            sc.missed += 1
+        return sc
+    x = float(computed[0])
+    best = _match(x, ref, tol)
+    if best < 0:
+        if _is_numerical_zero(c, x):
+            sc.near_tangent += 1
+        else:
+            sc.phantom += 1
+        if first_req is not None and x > first_req:
+            sc.missed += 1
+        return sc
+    r = ref[best]
+    if first_req is not None and r.value > first_req:
+        sc.missed += 1  # skipped the nearest required root: returned a later one
+        return sc
+    _error(x, r, sc)
     return sc

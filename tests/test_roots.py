@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from conftest import SHAPES_DIR
 from implgen.bench_solvers import hard_set, random_set, shape_set
 from implgen.errors import UserError
 from implgen.roots import METHODS, real_roots, real_roots_batch
@@ -54,9 +55,10 @@ def test_hard_cases_against_exact_reference(hard_polys, method: str) -> None:
     assert max(s.errors_well) <= 1e-12
 
 
-@pytest.mark.parametrize("shapes", [["torus"], ["sphere", "cubic", "piriform"], ["heart", "tooth8"]])
+@pytest.mark.parametrize("shapes", [["torus_y", "torus_z"], ["sphere", "cylinder", "cone", "piriform"],
+                                    ["heart", "barth6", "chmutov8", "blobs10"]])
 def test_ray_polynomials_against_exact_reference(shapes: list[str]) -> None:
-    c, lo, hi = shape_set(shapes, 24, np.random.default_rng(3))
+    c, lo, hi = shape_set(shapes, 24, np.random.default_rng(3), shapes_dir=SHAPES_DIR)
     s = _check(c, lo, hi, "auto")
     assert s.missed == 0 and s.phantom == 0
     assert max(s.errors_well) <= 1e-12
