@@ -312,23 +312,23 @@ RAYS_HIGH = ["heart", "barth6", "chmutov8", "blobs10"]
 _RAY_MIX = "from far (1e4 units), near (3-6 box radii) and inside the box"
 
 CASE_SETS = [
-    CaseSet("random-4", "random quartics, N(0,1) coefficients, whole line", lambda k, r, s: random_set(4, k, r)),
+    CaseSet("random-4", "random quartics, N(0,1) coefficients, whole line", lambda k, r, s=None: random_set(4, k, r)),
     CaseSet("torus rays", f"torus_y (a=1 b=0.25, and the glassware ring a=0.36 b=0.04), torus_z (R=1 r=0.25): "
             f"rays {_RAY_MIX}, and exactly tangent ones, a quarter each; box-clipped and shifted as "
-            "runtime_c/shape.c does", lambda k, r, s: shape_set(TORUS, k, r, True, s)),
+            "runtime_c/shape.c does", lambda k, r, s=None: shape_set(TORUS, k, r, True, s)),
     CaseSet("torus rays (no exact grazing)", "the same tori and ray mix without the exactly tangent rays (a "
             "measure-zero set in a render): far 1/4, near 1/2, inside 1/4",
-            lambda k, r, s: shape_set(TORUS, k, r, False, s)),
+            lambda k, r, s=None: shape_set(TORUS, k, r, False, s)),
     CaseSet("rays deg 2-4", "sphere and cylinder (2, a quarter of their rays exactly tangent), cone (2, "
             "unbounded: [0, inf)), 1/9 each, and piriform (4, d_x = 0 drops the degree), 2/3 -- every method "
             "solves a quadratic the same way, so the median is the quartic's; padded to 4",
-            lambda k, r, s: shape_set(RAYS_LOW, k, r, True, s, weights=[1, 1, 1, 6])),
+            lambda k, r, s=None: shape_set(RAYS_LOW, k, r, True, s, weights=[1, 1, 1, 6])),
     CaseSet("rays deg 6-10", "heart (6), barth6 (6, unbounded: clipped by the box of the ball that cuts it in "
             "examples/scenes/high_degree.yaml), chmutov8 (8), blobs10 (10): the highest-degree example shapes, "
-            "padded to 10", lambda k, r, s: shape_set(RAYS_HIGH, k, r, True, s)),
-    CaseSet("random-12", "random degree-12, N(0,1) coefficients, whole line", lambda k, r, s: random_set(12, k, r)),
+            "padded to 10", lambda k, r, s=None: shape_set(RAYS_HIGH, k, r, True, s)),
+    CaseSet("random-12", "random degree-12, N(0,1) coefficients, whole line", lambda k, r, s=None: random_set(12, k, r)),
     CaseSet("hard", "double/quadruple roots, clusters, 1e-30..1e30 roots, 1e+-150 scale, root at lo/hi, tiny "
-            "minimum, deg 12-24 products (padded to 24)", lambda k, r, s: hard_set(k, r)),
+            "minimum, deg 12-24 products (padded to 24)", lambda k, r, s=None: hard_set(k, r)),
 ]
 #: the set the issue's "degree 6-12 ray polynomials" target is measured on (the example shapes reach 10)
 HIGH_RAYS = "rays deg 6-10"

@@ -168,9 +168,16 @@ double ig_refine(const double *c, int n, double l, double r, double vl, double v
             r = x;
         double step = v / dv, xn = x - step;
         double as = fabs(step), ax = fabs(x);
-        if (as <= 4.0 * IG_U * ax) /* converged (the step may even round away) */
-            return (xn >= l && xn <= r) ? xn : x;
-        if (!(xn > l && xn < r) || !(as <= 0.5 * fabs(dxold))) { /* also catches dv == 0, NaN */
+        /* converged (the step may even round away) -- unless the step leaves the bracket: then it heads for a
+         * root beyond the bracket's end (p is tiny here because one lies just outside), and we bisect */
+        if (as <= 4.0 * IG_U * ax && xn >= l && xn <= r)
+            return xn;
+        /* Newton converging only linearly while its steps are still a sizeable fraction of x (|x|^n growth
+         * on a wide piece: a root at 1e-13 approached from 1e27 by halvings) -> bisect in the ordering of
+         * doubles. Near a multiple root of an intermediate derivative the steps are soon tiny relative to x,
+         * and Newton's linear convergence there is left alone (bisection would stop it early). */
+        int slow = newton_before && as > 0.4 * fabs(dx) && as > 1e-3 * fabs(xn);
+        if (!(xn > l && xn < r) || !(as <= 0.5 * fabs(dxold)) || slow) { /* also catches dv == 0, NaN */
             xn = ig_ordered_mid(l, r);
             if (!(xn > l && xn < r))
                 return x; /* l and r are adjacent doubles */
@@ -180,7 +187,7 @@ double ig_refine(const double *c, int n, double l, double r, double vl, double v
         } else {
             /* Newton's error after this step is about K step^2 with K = |step| / dx^2 estimated from the
              * last two steps: stop when that is below the tolerance (saves the confirming evaluation) */
-            if (newton_before && as <= 1e-3 * fabs(dx) && (as / dx) * (as / dx) * as <= tol * fabs(xn))
+            if (newton_before && as <= 1e-3 * fabs(dx) && as <= 1e-3 * fabs(xn) && (as / dx) * (as / dx) * as <= tol * fabs(xn))
                 return xn;
             /* steps stopped shrinking while already tiny: they are rounding noise of p(x), which is as
              * close as this root can be resolved (or a multiple root, converging linearly) */

@@ -109,11 +109,8 @@ def test_bench_first_batch_matches_first_root_batch() -> None:
         allr, counts = real_roots_batch(c, lo, hi, m)  # the first of all roots
         assert np.array_equal(n1, np.minimum(counts, 1))
         first_of_all = np.where(counts > 0, allr[:, 0], np.nan)[n1 > 0]
-        if m == "bracket":  # no first-root shortcut: the very same computation
-            np.testing.assert_array_equal(first_of_all, r1[n1 > 0])
-        else:  # Bernstein in all-roots mode hands the whole interval to bracketing when a LATER piece is in
-            # doubt (a grazing ray); first-root mode stops before that piece: the same root, refined apart
-            np.testing.assert_allclose(first_of_all, r1[n1 > 0], rtol=1e-9)
+        # bracket: the very same computation; Bernstein visits the same pieces left to right in both modes
+        np.testing.assert_array_equal(first_of_all, r1[n1 > 0])
     roots, counts, ns, _ = bench_solve_batch(c, lo, hi, "auto")
     assert roots.shape == (300, 4) and ns.shape == (300,) and np.all(np.isfinite(ns))
 
