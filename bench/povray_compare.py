@@ -2,8 +2,8 @@
 
     .venv/bin/python bench/povray_compare.py [--quick] [-o bench/results/povray] [--runs N]
 
-For each scene in bench/scenes/ (torus, piriform, heart sextic, Chmutov octic; ground plane, one light,
-shadows, 800x600, 1 sample) it
+For each scene in bench/scenes/ (torus, piriform, heart sextic, Chmutov octic, and the torus again seen from
+10^4 units through a telephoto lens; ground plane, one light, shadows, 800x600, 1 sample) it
   1. exports the same scene to POV-Ray (`polynomial { ... sturm }`, expanded exactly from our spec; matched
      camera: POV-Ray is left-handed, so `right -x*aspect`; our fov is vertical, POV-Ray's angle horizontal);
   2. times both programs as subprocesses (wall clock, median of --runs runs, interleaved) on 1 thread and on
@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-SCENES = ("torus", "piriform", "heart", "chmutov")
+SCENES = ("torus", "piriform", "heart", "chmutov", "torus_far")
 IMPLGEN = Path(sys.executable).parent / "implgen"
 
 
