@@ -10,6 +10,7 @@
  */
 #include "tracer_internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -104,14 +105,20 @@ static void base_colour(const rt_material *m, const rt_hit *h, double c[3])
 {
     if (m->checker_scale > 0.0) {
         /* A 3-D checker in object space, evaluated a little below the surface (a fraction of a cell) so a
-         * surface lying exactly on a cell boundary, like the plane y = 0, does not speckle. */
-        double q, sum = 0.0;
-        int a;
+         * surface lying exactly on a cell boundary, like the plane y = 0, does not speckle. The cell index
+         * floor(q) of each axis is an integer; the colour is color where their sum is even. Below 2^53 the
+         * parity of an integer-valued double is that of its conversion; at and above, every double is even. A
+         * cell index that is not finite (q overflowed) gives color2. */
+        int a, odd = 0;
         for (a = 0; a < 3; ++a) {
-            q = (h->po[a] - 1e-3 * m->checker_scale * h->no[a]) / m->checker_scale;
-            sum += fmod(fabs(floor(q)), 2.0);
+            double q = (h->po[a] - 1e-3 * m->checker_scale * h->no[a]) / m->checker_scale, k = fabs(floor(q));
+            if (!(k <= DBL_MAX)) {
+                odd = 1;
+                break;
+            }
+            if (k < 0x1p53) odd ^= (int)((long long)k & 1);
         }
-        memcpy(c, fmod(sum, 2.0) < 0.5 ? m->color : m->color2, 3 * sizeof(double));
+        memcpy(c, odd ? m->color2 : m->color, 3 * sizeof(double));
     } else {
         memcpy(c, m->color, 3 * sizeof(double));
     }
