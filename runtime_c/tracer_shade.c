@@ -140,13 +140,13 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
         const rt_material *m;
         for (a = 0; a < 3; ++a) dd[a] = light[a] - q[a];
         if (tr->stats) tr->stats[RT_RAYS_SHADOW] += 1.0;
-        if (!rt_scene_closest(s, q, dd, 0.0, 1.0, &ph)) return;
+        if (!rt_scene_closest(s, q, dd, 0.0, 1.0, RT_CLOSEST, &ph)) return;
         m = &s->materials[s->nodes[ph.leaf].material];
         if (m->transparency <= 0.0) {
             T[0] = T[1] = T[2] = 0.0;
             return;
         }
-        rt_finish_hit(s, ph.object, ph.leaf, ph.face, ph.entering_known, ph.entering, q, dd, ph.t, &h);
+        rt_finish_hit(s, &ph, q, dd, &h, NULL);
         if (h.entering) {
             for (a = 0; a < 3; ++a) T[a] *= m->transparency;
         } else {
@@ -167,13 +167,18 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
     const rt_scene *s = tr->s;
     const rt_material *m;
     rt_hit h;
+    rt_hit_lazy lazy;
+    rt_pending ph;
     double u[3], nf[3], base[3], local[3], col[3], dl;
     int a, l;
 
-    if (!rt_scene_intersect(s, o, d, 0.0, INFINITY, &h)) {
+    if (!rt_scene_closest(s, o, d, 0.0, INFINITY, RT_CLOSEST, &ph)) {
         memcpy(rgb, s->background, 3 * sizeof(double));
         return;
     }
+    /* h.err is worked out (rt_hit_error) only before a ray leaves h: a surface lit by no light and
+     * neither reflecting nor refracting never needs it */
+    rt_finish_hit(s, &ph, o, d, &h, &lazy);
     m = &s->materials[h.material];
     dl = sqrt(rt_dot(d, d));
     for (a = 0; a < 3; ++a) u[a] = d[a] / dl;
@@ -192,6 +197,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
             if (!(ll > 0.0)) continue;
             ndl = rt_dot(nf, L) / ll;
             if (ndl <= 0.0) continue; /* the light is behind the surface as seen from the ray */
+            rt_hit_error(s, &h, &lazy);
             shadow_transmittance(tr, &h, lp, T);
             if (T[0] + T[1] + T[2] <= 0.0) continue;
             if (m->specular > 0.0) {
@@ -230,6 +236,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
         if (kr * weight > RT_MIN_WEIGHT) {
             double r[3], q[3], c[3];
             rt_reflect(u, nf, r);
+            rt_hit_error(s, &h, &lazy);
             rt_spawn_origin(&h, r, q);
             if (tr->stats) tr->stats[RT_RAYS_SECONDARY] += 1.0;
             trace(tr, q, r, depth + 1, media, weight * kr, c);
@@ -237,6 +244,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
         }
         if (kt * weight > RT_MIN_WEIGHT) {
             double q[3], c[3];
+            rt_hit_error(s, &h, &lazy);
             rt_spawn_origin(&h, tdir, q);
             if (tr->stats) tr->stats[RT_RAYS_SECONDARY] += 1.0;
             trace(tr, q, tdir, depth + 1, &next, weight * kt, c);
