@@ -140,7 +140,8 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
         const rt_material *m;
         for (a = 0; a < 3; ++a) dd[a] = light[a] - q[a];
         if (tr->stats) tr->stats[RT_RAYS_SHADOW] += 1.0;
-        if (!rt_scene_closest(s, q, dd, 0.0, 1.0, RT_CLOSEST, &ph)) return;
+        /* any opaque hit before the light is full shadow, whether or not it is the closest */
+        if (!rt_scene_closest(s, q, dd, 0.0, 1.0, RT_ANY_OPAQUE, &ph)) return;
         m = &s->materials[s->nodes[ph.leaf].material];
         if (m->transparency <= 0.0) {
             T[0] = T[1] = T[2] = 0.0;
