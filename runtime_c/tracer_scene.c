@@ -41,15 +41,19 @@ void rt_to_object(const rt_node *n, const double o[3], const double d[3], double
     }
 }
 
-void rt_ray_init(rt_ray *r, const double o[3], const double d[3])
+void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far)
 {
     int a;
     memcpy(r->o, o, sizeof r->o);
     memcpy(r->d, d, sizeof r->d);
     r->len = sqrt(rt_dot(d, d));
-    for (a = 0; a < 3; ++a) {
-        r->inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
-        r->u[a] = r->len > 0.0 ? d[a] / r->len : 0.0;
+    for (a = 0; a < 3; ++a) r->inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
+    if (r->len > 0.0) {
+        for (a = 0; a < 3; ++a) r->u[a] = d[a] / r->len;
+        r->far_t = far / r->len;
+    } else {
+        r->u[0] = r->u[1] = r->u[2] = 0.0;
+        r->far_t = INFINITY;
     }
 }
 
@@ -163,6 +167,7 @@ void rt_scene_free(rt_scene *s)
     free(s->materials);
     free(s->lights);
     free(s->unbounded);
+    free(s->flat);
     free(s->order);
     free(s->bvh);
     free(s);
@@ -447,16 +452,19 @@ int rt_scene_commit(rt_scene *s)
     if (s->nmaterials == 0 && s->nobjects > 0) return fail(s, "no materials");
     for (i = 0; i < s->nnodes; ++i) node_box(s, i); /* children always precede parents */
     free(s->unbounded);
+    free(s->flat);
     free(s->order);
     free(s->bvh);
     s->unbounded = malloc((size_t)(s->nobjects + 1) * sizeof(int));
+    s->flat = malloc((size_t)(s->nobjects + 1));
     s->order = malloc((size_t)(s->nobjects + 1) * sizeof(int));
     s->bvh = malloc((size_t)(2 * s->nobjects + 1) * sizeof *s->bvh);
-    if (!s->unbounded || !s->order || !s->bvh) return fail(s, "out of memory");
+    if (!s->unbounded || !s->flat || !s->order || !s->bvh) return fail(s, "out of memory");
     s->nunbounded = 0;
     s->nbvh = 0;
     for (i = 0; i < s->nobjects; ++i) {
         const rt_node *n = &s->nodes[s->objects[i]];
+        s->flat[i] = n->kind == RT_LEAF && n->shape->degree == 1;
         if (n->wbounded) {
             s->order[nb++] = i;
             for (a = 0; a < 6; ++a) size = fmax(size, fabs(n->wbox[a]));
@@ -707,33 +715,32 @@ static int ray_box(const double box[6], const rt_ray *r, double *t0, double *t1)
     return 1;
 }
 
+int rt_spawn_skip(const rt_scene *s, const rt_hit *h) { return s->flat[h->object] ? h->object : -1; }
+
 int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
-                     rt_pending *out)
+                     int skip, rt_pending *out)
 {
-    double best = tmax, t;
-    int found = -1, bleaf = -1, bface = 0, bent = 0, bknown = 0, i, leaf, face, ent, known, obj;
-    int stack[128], sp = 0;
+    double best = tmax;
+    int found = 0, i, sp = 0;
+    int stack[128];
     double entry[128];
     rt_ray ray;
+    rt_pending h;
     if (!s->committed) return 0;
     if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]) || !isfinite(o[0]) || !isfinite(o[1]) ||
         !isfinite(o[2]))
         return 0;
-    rt_ray_init(&ray, o, d);
-#define RT_TAKE_HIT()                                                                                            \
-    do {                                                                                                         \
-        best = t;                                                                                                \
-        found = obj;                                                                                             \
-        bleaf = leaf;                                                                                            \
-        bface = face;                                                                                            \
-        bent = ent;                                                                                              \
-        bknown = known;                                                                                          \
-        if (mode == RT_ANY_OPAQUE && s->materials[s->nodes[leaf].material].transparency <= 0.0) goto done;      \
-    } while (0)
-    for (i = 0; i < s->nunbounded; ++i) {
-        obj = s->unbounded[i];
-        if (rt_object_hit(s, obj, &ray, tmin, best, &t, &leaf, &face, &ent, &known)) RT_TAKE_HIT();
+    rt_ray_init(&ray, o, d, s->far);
+    /* A hit is kept when it is closer than the best so far (rt_object_hit only reports t < best). In
+     * RT_ANY_OPAQUE mode a hit on an opaque material ends the search. */
+#define RT_TAKE(obj)                                                                                             \
+    if ((obj) != skip && rt_object_hit(s, (obj), &ray, tmin, best, &h)) {                                       \
+        *out = h;                                                                                                \
+        best = h.t;                                                                                              \
+        found = 1;                                                                                               \
+        if (mode == RT_ANY_OPAQUE && s->materials[s->nodes[h.leaf].material].transparency <= 0.0) return 1;    \
     }
+    for (i = 0; i < s->nunbounded; ++i) RT_TAKE(s->unbounded[i])
     /* Each stack entry carries the t where the ray enters its box, so a node is clipped once and skipped
      * when a closer hit has been found since it was pushed. */
     if (s->nbvh > 0) {
@@ -749,10 +756,7 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
         if (entry[sp] > best) continue;
         b = &s->bvh[stack[sp]];
         if (b->left < 0) {
-            for (i = b->first; i < b->first + b->count; ++i) {
-                obj = s->order[i];
-                if (rt_object_hit(s, obj, &ray, tmin, best, &t, &leaf, &face, &ent, &known)) RT_TAKE_HIT();
-            }
+            for (i = b->first; i < b->first + b->count; ++i) RT_TAKE(s->order[i])
         } else if (sp + 2 <= (int)(sizeof stack / sizeof stack[0])) {
             /* visit the nearer child first: push it last */
             const rt_bvh_node *l = &s->bvh[b->left], *r = &s->bvh[b->right];
@@ -776,23 +780,15 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
             }
         }
     }
-#undef RT_TAKE_HIT
-done:
-    if (found < 0) return 0;
-    out->t = best;
-    out->object = found;
-    out->leaf = bleaf;
-    out->face = bface;
-    out->entering = bent;
-    out->entering_known = bknown;
-    return 1;
+#undef RT_TAKE
+    return found;
 }
 
 int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax,
                        rt_hit *hit)
 {
     rt_pending h;
-    if (!rt_scene_closest(s, o, d, tmin, tmax, RT_CLOSEST, &h)) return 0;
+    if (!rt_scene_closest(s, o, d, tmin, tmax, RT_CLOSEST, -1, &h)) return 0;
     rt_finish_hit(s, &h, o, d, hit, NULL);
     return 1;
 }

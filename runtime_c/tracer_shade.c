@@ -132,7 +132,7 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
     double q[3], dd[3];
     rt_hit h;
     rt_pending ph;
-    int i, a;
+    int i, a, skip = rt_spawn_skip(s, from);
     T[0] = T[1] = T[2] = 1.0;
     for (a = 0; a < 3; ++a) dd[a] = light[a] - from->p[a];
     rt_spawn_origin(from, dd, q);
@@ -141,7 +141,7 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
         for (a = 0; a < 3; ++a) dd[a] = light[a] - q[a];
         if (tr->stats) tr->stats[RT_RAYS_SHADOW] += 1.0;
         /* any opaque hit before the light is full shadow, whether or not it is the closest */
-        if (!rt_scene_closest(s, q, dd, 0.0, 1.0, RT_ANY_OPAQUE, &ph)) return;
+        if (!rt_scene_closest(s, q, dd, 0.0, 1.0, RT_ANY_OPAQUE, skip, &ph)) return;
         m = &s->materials[s->nodes[ph.leaf].material];
         if (m->transparency <= 0.0) {
             T[0] = T[1] = T[2] = 0.0;
@@ -159,11 +159,13 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
             return;
         }
         rt_spawn_origin(&h, dd, q);
+        skip = rt_spawn_skip(s, &h);
     }
 }
 
-static void trace(const rt_tracer *tr, const double o[3], const double d[3], int depth, const rt_media *media,
-                  double weight, double rgb[3])
+/* The colour seen along o + t d; skip: an object the ray need not test (rt_spawn_skip), or -1. */
+static void trace(const rt_tracer *tr, const double o[3], const double d[3], int skip, int depth,
+                  const rt_media *media, double weight, double rgb[3])
 {
     const rt_scene *s = tr->s;
     const rt_material *m;
@@ -173,7 +175,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
     double u[3], nf[3], base[3], local[3], col[3], dl;
     int a, l;
 
-    if (!rt_scene_closest(s, o, d, 0.0, INFINITY, RT_CLOSEST, &ph)) {
+    if (!rt_scene_closest(s, o, d, 0.0, INFINITY, RT_CLOSEST, skip, &ph)) {
         memcpy(rgb, s->background, 3 * sizeof(double));
         return;
     }
@@ -240,7 +242,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
             rt_hit_error(s, &h, &lazy);
             rt_spawn_origin(&h, r, q);
             if (tr->stats) tr->stats[RT_RAYS_SECONDARY] += 1.0;
-            trace(tr, q, r, depth + 1, media, weight * kr, c);
+            trace(tr, q, r, rt_spawn_skip(s, &h), depth + 1, media, weight * kr, c);
             for (a = 0; a < 3; ++a) col[a] += kr * c[a];
         }
         if (kt * weight > RT_MIN_WEIGHT) {
@@ -248,7 +250,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
             rt_hit_error(s, &h, &lazy);
             rt_spawn_origin(&h, tdir, q);
             if (tr->stats) tr->stats[RT_RAYS_SECONDARY] += 1.0;
-            trace(tr, q, tdir, depth + 1, &next, weight * kt, c);
+            trace(tr, q, tdir, rt_spawn_skip(s, &h), depth + 1, &next, weight * kt, c);
             for (a = 0; a < 3; ++a) col[a] += kt * c[a];
         }
     }
@@ -275,5 +277,5 @@ void rt_trace_ray(const rt_scene *s, const double o[3], const double d[3], int m
         rgb[0] = rgb[1] = rgb[2] = 0.0;
         return;
     }
-    trace(&tr, o, d, 0, &media, 1.0, rgb);
+    trace(&tr, o, d, -1, 0, &media, 1.0, rgb);
 }
