@@ -14,10 +14,12 @@
 
 #include <math.h>
 
-/* Slab clip of [*t0, *t1] against box (padded, see below); an infinite bound imposes nothing on its
- * side. 0 when empty. */
-static int clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1)
+void ig_shape_prepare(const ig_shape *shape, const double *params, ig_shape_prep *prep)
 {
+    double box[6] = {-INFINITY, -INFINITY, -INFINITY, INFINITY, INFINITY, INFINITY};
+    prep->degree = (shape && shape->coeffs && shape->degree >= 0 && shape->degree <= IG_MAX_DEGREE) ? shape->degree : -1;
+    prep->bounded = (shape && shape->bounds) ? shape->bounds(params, box) : 0;
+    prep->nclip = prep->nfinite = 0;
     for (int i = 0; i < 3; ++i) {
         /* the box grows by 1e-9 of its finite extent: a surface that touches its own box (the torus at
          * |x| = a + b) keeps the root there despite the rounding of the slab distances */
@@ -26,8 +28,28 @@ static int clip_box(const double box[6], const double o[3], const double d[3], d
             scale = fabs(lo);
         if (isfinite(hi) && fabs(hi) > scale)
             scale = fabs(hi);
-        lo -= 1e-9 * scale;
-        hi += 1e-9 * scale;
+        prep->lo[i] = lo - 1e-9 * scale;
+        prep->hi[i] = hi + 1e-9 * scale;
+        prep->centre[i] = 0.0;
+        if (!prep->bounded)
+            continue;
+        /* an axis open on both sides (-inf or NaN below, +inf or NaN above) can neither move nor empty the
+         * interval: the clip skips it */
+        if (!((lo == -INFINITY || isnan(lo)) && (hi == INFINITY || isnan(hi))))
+            prep->clip[prep->nclip++] = i;
+        if (isfinite(lo) && isfinite(hi)) {
+            prep->finite[prep->nfinite++] = i;
+            prep->centre[i] = 0.5 * lo + 0.5 * hi;
+        }
+    }
+}
+
+/* Slab clip of [*t0, *t1] against the grown box; an infinite bound imposes nothing on its side. 0 when empty. */
+static int clip_box(const ig_shape_prep *prep, const double o[3], const double d[3], double *t0, double *t1)
+{
+    for (int k = 0; k < prep->nclip; ++k) {
+        int i = prep->clip[k];
+        double lo = prep->lo[i], hi = prep->hi[i];
         if (d[i] == 0.0) {
             if (o[i] < lo || o[i] > hi)
                 return 0;
@@ -49,18 +71,13 @@ static int clip_box(const double box[6], const double o[3], const double d[3], d
 }
 
 /* The shift point: minimises sum over finite axes of (o_i + t d_i - c_i)^2, clamped to [t0, t1]. */
-static double shift_point(const double box[6], int bounded, const double o[3], const double d[3], double t0,
-                          double t1)
+static double shift_point(const ig_shape_prep *prep, const double o[3], const double d[3], double t0, double t1)
 {
     double num = 0.0, den = 0.0;
-    if (bounded) {
-        for (int i = 0; i < 3; ++i) {
-            if (isfinite(box[i]) && isfinite(box[i + 3])) {
-                double c = 0.5 * box[i] + 0.5 * box[i + 3];
-                num += d[i] * (c - o[i]);
-                den += d[i] * d[i];
-            }
-        }
+    for (int k = 0; k < prep->nfinite; ++k) {
+        int i = prep->finite[k];
+        num += d[i] * (prep->centre[i] - o[i]);
+        den += d[i] * d[i];
     }
     if (!(den > 0.0)) { /* unbounded, or the ray runs parallel to every finite axis: coordinate origin */
         num = -(o[0] * d[0] + o[1] * d[1] + o[2] * d[2]);
@@ -76,12 +93,29 @@ static double shift_point(const double box[6], int bounded, const double o[3], c
     return ts;
 }
 
-/* Clip, shift, coefficients, solve (all roots, or only the first), shift back. */
-static int shape_solve(const ig_shape *shape, const double *params, const double o[3], const double d[3],
-                       double tmin, double tmax, ig_root_method method, int first, double *roots)
+/* Degree 1 without the general solver's set-up: the root -c0/c1 of ig_real_roots, case by case (a vanishing
+ * c1 lowers the degree to a constant: no root; c0 == 0 is the deflated root 0; a quotient that is not finite
+ * is dropped; the interval test; no -0). Only below 2^201, where ig_real_roots does not rescale the
+ * coefficients (its rescaling could round a tiny c0); the caller falls back to it otherwise. Returns the
+ * root count, or -1 for "not handled here". */
+static int linear_root(const double c[2], double lo, double hi, double *s)
 {
-    if (!shape || !shape->coeffs || !roots)
+    if (!(fabs(c[0]) < 0x1p201 && fabs(c[1]) < 0x1p201)) /* also NaN and Inf */
+        return -1;
+    if (!(lo <= hi))
         return 0;
+    if (c[1] == 0.0)
+        return 0;
+    double x = c[0] == 0.0 ? 0.0 : -c[0] / c[1];
+    if (!isfinite(x) || !(x >= lo && x <= hi))
+        return 0;
+    *s = x == 0.0 ? 0.0 : x;
+    return 1;
+}
+
+int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_prep *prep, const double o[3],
+                   const double d[3], double tmin, double tmax, ig_root_method method, int first, double *roots)
+{
     for (int i = 0; i < 3; ++i)
         if (!isfinite(o[i]) || !isfinite(d[i]))
             return 0;
@@ -89,23 +123,22 @@ static int shape_solve(const ig_shape *shape, const double *params, const double
         return 0;
     if (!(tmin <= tmax))
         return 0;
-    int n = shape->degree;
-    if (n < 0 || n > IG_MAX_DEGREE)
+    int n = prep->degree;
+    if (n < 0)
         return 0;
-    double box[6] = {-INFINITY, -INFINITY, -INFINITY, INFINITY, INFINITY, INFINITY};
-    int bounded = shape->bounds ? shape->bounds(params, box) : 0;
     double t0 = tmin, t1 = tmax;
-    if (bounded && !clip_box(box, o, d, &t0, &t1))
+    if (prep->bounded && !clip_box(prep, o, d, &t0, &t1))
         return 0;
-    double ts = shift_point(box, bounded, o, d, t0, t1);
+    double ts = shift_point(prep, o, d, t0, t1);
     if (!isfinite(ts))
         ts = 0.0;
     double os[3] = {o[0] + ts * d[0], o[1] + ts * d[1], o[2] + ts * d[2]};
     double c[IG_MAX_DEGREE + 1];
     shape->coeffs(os, d, params, c);
     double s[IG_MAX_DEGREE];
-    int k = first ? ig_first_root(c, n, t0 - ts, t1 - ts, method, s)
-                  : ig_real_roots(c, n, t0 - ts, t1 - ts, method, s);
+    int k = n == 1 ? linear_root(c, t0 - ts, t1 - ts, s) : -1;
+    if (k < 0)
+        k = first ? ig_first_root(c, n, t0 - ts, t1 - ts, method, s) : ig_real_roots(c, n, t0 - ts, t1 - ts, method, s);
     int m = 0;
     for (int i = 0; i < k; ++i) {
         double t = ts + s[i];
@@ -117,6 +150,17 @@ static int shape_solve(const ig_shape *shape, const double *params, const double
             roots[m++] = t;
     }
     return m;
+}
+
+/* Clip, shift, coefficients, solve (all roots, or only the first), shift back. */
+static int shape_solve(const ig_shape *shape, const double *params, const double o[3], const double d[3],
+                       double tmin, double tmax, ig_root_method method, int first, double *roots)
+{
+    ig_shape_prep prep;
+    if (!shape || !shape->coeffs || !roots)
+        return 0;
+    ig_shape_prepare(shape, params, &prep);
+    return ig_shape_solve(shape, params, &prep, o, d, tmin, tmax, method, first, roots);
 }
 
 int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3], const double d[3],

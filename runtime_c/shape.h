@@ -35,6 +35,27 @@ int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3
 int ig_shape_first_root(const ig_shape *shape, const double *params, const double o[3], const double d[3],
                         double tmin, double tmax, ig_root_method method, double *t);
 
+/* ---- The same solve for a caller that solves one shape many times (the tracer) ----
+ *
+ * Everything ig_shape_roots works out from the shape and its params alone -- the box grown for the clip, the
+ * finite axes and their centres -- done once by ig_shape_prepare. ig_shape_solve then gives, bit for bit, what
+ * ig_shape_roots (first == 0) or ig_shape_first_root (first != 0) give for the same arguments; both are
+ * written on top of it. The prep holds no pointers: it stays valid as long as shape and params are unchanged. */
+typedef struct ig_shape_prep {
+    int degree;         /* shape->degree; -1 when out of range or the shape has no coefficients (no roots) */
+    int bounded;        /* shape->bounds returned 1 */
+    int nclip, clip[3]; /* axes with a finite side, in ascending order: the only ones the clip can move */
+    double lo[3], hi[3]; /* per axis, the box grown by 1e-9 of its finite extent (see shape.c) */
+    int nfinite, finite[3]; /* axes with both sides finite, ascending: they place the shift point */
+    double centre[3];   /* centre of each axis in finite[] (of the box as the spec gives it) */
+} ig_shape_prep;
+
+void ig_shape_prepare(const ig_shape *shape, const double *params, ig_shape_prep *prep);
+
+/* shape, params and roots must not be NULL; prep must come from ig_shape_prepare(shape, params). */
+int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_prep *prep, const double o[3],
+                   const double d[3], double tmin, double tmax, ig_root_method method, int first, double *roots);
+
 /* Unit outward normal at p. At a singular point (grad f = 0 or not finite, e.g. a cone's apex) writes
  * (0, 0, 0) and returns 0 -- never NaN; the caller picks a fallback (e.g. facing the ray). Returns 1 otherwise. */
 int ig_shape_normal(const ig_shape *shape, const double *params, const double p[3], double n[3]);

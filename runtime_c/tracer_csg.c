@@ -22,22 +22,9 @@ int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], doub
     u[0] = od[0] / L;
     u[1] = od[1] / L;
     u[2] = od[2] / L;
-    k = ig_shape_roots(n->shape, n->params, oo, u, lo * L, hi * L, IG_ROOTS_AUTO, r);
+    k = ig_shape_solve(n->shape, n->params, &n->prep, oo, u, lo * L, hi * L, IG_ROOTS_AUTO, 0, r);
     for (i = 0; i < k; ++i) r[i] /= L;
     return k;
-}
-
-/* The nearest root of a leaf in [lo, hi] (same unit-direction parameter as rt_leaf_roots): 1, or 0 if none. */
-static int leaf_first_root(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r)
-{
-    double L = sqrt(rt_dot(od, od)), u[3];
-    if (!(L > 0.0) || !isfinite(L)) return 0;
-    u[0] = od[0] / L;
-    u[1] = od[1] / L;
-    u[2] = od[2] / L;
-    if (!ig_shape_first_root(n->shape, n->params, oo, u, lo * L, hi * L, IG_ROOTS_AUTO, r)) return 0;
-    *r /= L;
-    return 1;
 }
 
 /* Spans of one leaf solid over [a, b]. */
@@ -198,55 +185,73 @@ int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d
     return n;
 }
 
-int rt_object_hit(const rt_scene *s, int object, const double o[3], const double d[3], double tmin,
-                  double tmax, double *t, int *leaf, int *face, int *entering, int *entering_known)
+int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, rt_pending *hit)
 {
     int k = s->objects[object];
     const rt_node *n = &s->nodes[k];
     double lo = tmin, hi = tmax;
-    if (n->wbounded) {
-        if (!rt_clip_box(n->wbox, o, d, &lo, &hi, NULL, NULL)) return 0;
-    } else {
-        double dl = sqrt(rt_dot(d, d));
-        if (dl > 0.0 && hi > s->far / dl) hi = s->far / dl;
+    /* A bounded object needs no clip to its world box here: the BVH has clipped the ray to a box around it,
+     * a CSG root clips to its own box first thing in rt_spans, and a leaf's solve clips to the object-space box,
+     * which the world box contains with room (its corners transformed, then padded by 1e-9 of its size). An
+     * unbounded one is solved up to `far` (rt_scene_far). */
+    if (!n->wbounded) {
+        if (hi > ray->far_t) hi = ray->far_t;
         if (!(hi > lo)) return 0;
     }
+    hit->object = object;
     if (n->kind == RT_LEAF) {
         /* A top-level leaf is a surface: its nearest root after tmin. The solver stops at the first root in
-         * [lo, hi]; only when that one is not after tmin (a root exactly at tmin) are all of them needed. */
-        double oo[3], od[3], r[IG_MAX_DEGREE + 2];
+         * [lo, hi]; only when that one is not after tmin (a root exactly at tmin) are all of them needed. The
+         * solve runs along the unit object-space direction (see rt_leaf_roots); an identity leaf takes the
+         * ray's own. */
+        double oo[3], od[3], u[3], L = ray->len, r[IG_MAX_DEGREE + 2];
+        const double *po = ray->o, *pu = ray->u;
         int nr, i;
-        rt_to_object(n, o, d, oo, od);
-        nr = leaf_first_root(n, oo, od, lo, hi, r);
-        if (nr && !(r[0] > tmin)) nr = rt_leaf_roots(n, oo, od, lo, hi, r);
-        for (i = 0; i < nr; ++i)
-            if (r[i] > tmin && r[i] < tmax) {
-                *t = r[i];
-                *leaf = k;
-                *face = 0;
-                *entering = 0;
-                *entering_known = 0;
+        if (!n->identity) {
+            rt_xform_point(n->minv, ray->o, oo);
+            rt_xform_vector(n->minv, ray->d, od);
+            L = sqrt(rt_dot(od, od));
+            if (!(L > 0.0) || !isfinite(L)) return 0;
+            u[0] = od[0] / L;
+            u[1] = od[1] / L;
+            u[2] = od[2] / L;
+            po = oo;
+            pu = u;
+        } else if (!(L > 0.0) || !isfinite(L)) {
+            return 0;
+        }
+        nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, 1, r);
+        if (nr && !(r[0] / L > tmin))
+            nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, 0, r);
+        for (i = 0; i < nr; ++i) {
+            double t = r[i] / L;
+            if (t > tmin && t < tmax) {
+                hit->t = t;
+                hit->leaf = k;
+                hit->face = 0;
+                hit->entering = 0;
+                hit->entering_known = 0;
                 return 1;
             }
+        }
         return 0;
     } else {
         rt_span sp[RT_MAX_SPANS];
-        int ns = rt_spans(s, k, o, d, lo, hi, sp, RT_MAX_SPANS), i;
+        int ns = rt_spans(s, k, ray->o, ray->d, lo, hi, sp, RT_MAX_SPANS), i;
         for (i = 0; i < ns; ++i) {
+            const rt_end *e = NULL;
             if (sp[i].in.t > tmin && sp[i].in.t < tmax && sp[i].in.leaf >= 0) {
-                *t = sp[i].in.t;
-                *leaf = sp[i].in.leaf;
-                *face = sp[i].in.face;
-                *entering = 1;
-                *entering_known = 1;
-                return 1;
+                e = &sp[i].in;
+                hit->entering = 1;
+            } else if (sp[i].out.t > tmin && sp[i].out.t < tmax && sp[i].out.leaf >= 0) {
+                e = &sp[i].out;
+                hit->entering = 0;
             }
-            if (sp[i].out.t > tmin && sp[i].out.t < tmax && sp[i].out.leaf >= 0) {
-                *t = sp[i].out.t;
-                *leaf = sp[i].out.leaf;
-                *face = sp[i].out.face;
-                *entering = 0;
-                *entering_known = 1;
+            if (e) {
+                hit->t = e->t;
+                hit->leaf = e->leaf;
+                hit->face = e->face;
+                hit->entering_known = 1;
                 return 1;
             }
         }

@@ -18,6 +18,7 @@ typedef struct rt_node {
     int identity;        /* M is exactly the identity: rays need no transforming */
     double obox[6];      /* object-space bounds box */
     int obounded;        /* the spec gives bounds (some sides may still be infinite) */
+    ig_shape_prep prep;  /* shape.c's per-shape clip and shift data, worked out once (ig_shape_solve) */
     /* any node */
     double wbox[6];      /* world-space box, slightly padded; valid when wbounded */
     int wbounded;
@@ -45,6 +46,8 @@ struct rt_scene {
     double far;          /* stands in for t = infinity on unbounded shapes: 1e5 x the scene's size */
     int *unbounded;      /* objects outside the BVH */
     int nunbounded;
+    unsigned char *flat; /* per object: a top-level leaf of degree 1 (part of a plane), which no ray leaving
+                            it can meet again: rays spawned from it need not test it (rt_scene_closest) */
     int *order;          /* bounded objects in BVH leaf order */
     rt_bvh_node *bvh;
     int nbvh;
@@ -69,16 +72,47 @@ typedef struct rt_pending {
     int object, leaf, face, entering, entering_known;
 } rt_pending;
 
+/* A world ray with what every object test along it would otherwise work out again. */
+typedef struct rt_ray {
+    double o[3], d[3];
+    double inv[3];       /* 1 / d[a]; not used where d[a] == 0 */
+    double len;          /* |d| */
+    double u[3];         /* d / |d|: the unit direction an identity leaf solves along */
+    double far_t;        /* far / |d|: where an unbounded object's solve stops (INFINITY when d = 0) */
+} rt_ray;
+
+/* What rt_hit_error needs to work out hit->err after rt_finish_hit, kept so that a hit that spawns no ray
+ * never pays for it. */
+typedef struct rt_hit_lazy {
+    int pending;         /* 1: hit->err is not computed yet */
+    double o[3], d[3];   /* the world ray */
+    double oo[3], od[3]; /* the ray in the leaf's object space */
+    double u[3];         /* the unit direction distance_bound expands along (normal, or ray at a singular point) */
+    double f;            /* f at the object-space hit point */
+} rt_hit_lazy;
+
+/* Closest-hit query modes. RT_ANY_OPAQUE: the same, except that the search stops at the first hit on an
+ * opaque material it meets (a shadow ray: any opaque hit in range is full shadow), which may not be the
+ * closest one; a hit on a transparent material is still the closest hit. */
+enum { RT_CLOSEST = 0, RT_ANY_OPAQUE = 1 };
+/* The object a ray spawned at hit h need not test (rt_scene_closest's `skip`): h's object when it is flat
+ * (a plane meets a line once, and that is h itself), else -1. */
+int rt_spawn_skip(const rt_scene *s, const rt_hit *h);
+
 /* tracer_scene.c */
-int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax,
-                     rt_pending *out);
+void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far);
+int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
+                     int skip, rt_pending *out);
 void rt_xform_point(const double m[12], const double p[3], double out[3]);
 void rt_xform_vector(const double m[12], const double v[3], double out[3]);
 int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0,
                 int *f1);
-/* Fills hit (normal, error bound, object-space point) for a hit at t on `leaf` with the given face. */
-void rt_finish_hit(const rt_scene *s, int object, int leaf, int face, int entering_known, int entering,
-                   const double o[3], const double d[3], double t, rt_hit *hit);
+/* Fills hit (normal, object-space point, ...) for the pending hit of the ray o + t d. With lazy == NULL the
+ * error bound hit->err too; otherwise hit->err is left for rt_hit_error, and lazy keeps what it needs. */
+void rt_finish_hit(const rt_scene *s, const rt_pending *p, const double o[3], const double d[3], rt_hit *hit,
+                   rt_hit_lazy *lazy);
+/* Works out hit->err if rt_finish_hit left it pending (else does nothing): the same value either way. */
+void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lazy);
 
 /* The ray in a leaf's object space (a copy when the leaf's transform is the identity). */
 void rt_to_object(const rt_node *n, const double o[3], const double d[3], double oo[3], double od[3]);
@@ -87,9 +121,8 @@ void rt_to_object(const rt_node *n, const double o[3], const double d[3], double
 int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r);
 int rt_spans(const rt_scene *s, int node, const double o[3], const double d[3], double a, double b,
              rt_span *out, int max);
-/* Closest hit of one top-level object with tmin < t < tmax; fills leaf/face/entering. */
-int rt_object_hit(const rt_scene *s, int object, const double o[3], const double d[3], double tmin,
-                  double tmax, double *t, int *leaf, int *face, int *entering, int *entering_known);
+/* Closest hit of one top-level object with tmin < t < tmax: 1 and *hit filled, or 0. */
+int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, rt_pending *hit);
 
 /* small vector helpers */
 static inline double rt_dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }

@@ -100,27 +100,33 @@ void rt_render_free(rt_render *r)
 static void render_row(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
 {
     int x, k, a;
+    /* one sample per pixel: at the pixel's centre, the same for the whole row in y, and no random numbers */
+    const double py_centre = (1.0 - 2.0 * (y + 0.5) / r->height) * r->tan_half;
     for (x = 0; x < r->width; ++x) {
-        uint64_t rng = (uint64_t)r->seed * 0x100000001B3ULL ^ ((uint64_t)y * (uint64_t)r->width + (uint64_t)x);
+        uint64_t rng = 0;
         double acc[3] = {0.0, 0.0, 0.0};
-        splitmix64(&rng);
-        /* N-rooks stratification: sample k sits in column stratum k and row stratum perm[k]. */
-        for (k = 0; k < r->spp; ++k) perm[k] = k;
-        for (k = r->spp - 1; k > 0; --k) {
-            int j = (int)(splitmix64(&rng) % (uint64_t)(k + 1)), t = perm[k];
-            perm[k] = perm[j];
-            perm[j] = t;
+        if (r->spp > 1) {
+            rng = (uint64_t)r->seed * 0x100000001B3ULL ^ ((uint64_t)y * (uint64_t)r->width + (uint64_t)x);
+            splitmix64(&rng);
+            /* N-rooks stratification: sample k sits in column stratum k and row stratum perm[k]. */
+            for (k = 0; k < r->spp; ++k) perm[k] = k;
+            for (k = r->spp - 1; k > 0; --k) {
+                int j = (int)(splitmix64(&rng) % (uint64_t)(k + 1)), t = perm[k];
+                perm[k] = perm[j];
+                perm[j] = t;
+            }
         }
         for (k = 0; k < r->spp; ++k) {
             double sx, sy, px, py, d[3], c[3];
             if (r->spp == 1) {
-                sx = sy = 0.5;
+                px = (2.0 * (x + 0.5) / r->width - 1.0) * r->tan_half * r->aspect;
+                py = py_centre;
             } else {
                 sx = (k + uniform01(&rng)) / r->spp;
                 sy = (perm[k] + uniform01(&rng)) / r->spp;
+                px = (2.0 * (x + sx) / r->width - 1.0) * r->tan_half * r->aspect;
+                py = (1.0 - 2.0 * (y + sy) / r->height) * r->tan_half;
             }
-            px = (2.0 * (x + sx) / r->width - 1.0) * r->tan_half * r->aspect;
-            py = (1.0 - 2.0 * (y + sy) / r->height) * r->tan_half;
             for (a = 0; a < 3; ++a) d[a] = px * r->u[a] + py * r->v[a] - r->w[a];
             rt_trace_ray(r->s, r->eye, d, r->max_depth, c, stats);
             if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {

@@ -41,6 +41,22 @@ void rt_to_object(const rt_node *n, const double o[3], const double d[3], double
     }
 }
 
+void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far)
+{
+    int a;
+    memcpy(r->o, o, sizeof r->o);
+    memcpy(r->d, d, sizeof r->d);
+    r->len = sqrt(rt_dot(d, d));
+    for (a = 0; a < 3; ++a) r->inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
+    if (r->len > 0.0) {
+        for (a = 0; a < 3; ++a) r->u[a] = d[a] / r->len;
+        r->far_t = far / r->len;
+    } else {
+        r->u[0] = r->u[1] = r->u[2] = 0.0;
+        r->far_t = INFINITY;
+    }
+}
+
 static double maxabs3(const double v[3])
 {
     double a = fabs(v[0]), b = fabs(v[1]), c = fabs(v[2]);
@@ -151,6 +167,7 @@ void rt_scene_free(rt_scene *s)
     free(s->materials);
     free(s->lights);
     free(s->unbounded);
+    free(s->flat);
     free(s->order);
     free(s->bvh);
     free(s);
@@ -231,7 +248,12 @@ int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, 
     n->identity = 1;
     for (i = 0; i < 12; ++i)
         if (m[i] != ((i == 0 || i == 5 || i == 10) ? 1.0 : 0.0)) n->identity = 0;
+    for (i = 0; i < 3; ++i) { /* what shape.c starts from too: an axis bounds() leaves alone is open */
+        n->obox[i] = -INFINITY;
+        n->obox[i + 3] = INFINITY;
+    }
     n->obounded = shape->bounds ? shape->bounds(n->params, n->obox) : 0;
+    ig_shape_prepare(shape, n->params, &n->prep);
     if (!n->obounded)
         for (i = 0; i < 3; ++i) {
             n->obox[i] = -INFINITY;
@@ -430,16 +452,19 @@ int rt_scene_commit(rt_scene *s)
     if (s->nmaterials == 0 && s->nobjects > 0) return fail(s, "no materials");
     for (i = 0; i < s->nnodes; ++i) node_box(s, i); /* children always precede parents */
     free(s->unbounded);
+    free(s->flat);
     free(s->order);
     free(s->bvh);
     s->unbounded = malloc((size_t)(s->nobjects + 1) * sizeof(int));
+    s->flat = malloc((size_t)(s->nobjects + 1));
     s->order = malloc((size_t)(s->nobjects + 1) * sizeof(int));
     s->bvh = malloc((size_t)(2 * s->nobjects + 1) * sizeof *s->bvh);
-    if (!s->unbounded || !s->order || !s->bvh) return fail(s, "out of memory");
+    if (!s->unbounded || !s->flat || !s->order || !s->bvh) return fail(s, "out of memory");
     s->nunbounded = 0;
     s->nbvh = 0;
     for (i = 0; i < s->nobjects; ++i) {
         const rt_node *n = &s->nodes[s->objects[i]];
+        s->flat[i] = n->kind == RT_LEAF && n->shape->degree == 1;
         if (n->wbounded) {
             s->order[nb++] = i;
             for (a = 0; a < 6; ++a) size = fmax(size, fabs(n->wbox[a]));
@@ -500,12 +525,11 @@ static double solver_noise(const rt_node *n, const double oo[3], const double od
 {
     double c[IG_MAX_DEGREE + 1], os[3], num = 0.0, den = 0.0, ts, tau, pw = 1.0, sum = 0.0, horner = 0.0;
     int a, k, deg = n->shape->degree;
-    if (n->obounded)
-        for (a = 0; a < 3; ++a)
-            if (isfinite(n->obox[a]) && isfinite(n->obox[a + 3])) {
-                num += od[a] * (0.5 * n->obox[a] + 0.5 * n->obox[a + 3] - oo[a]);
-                den += od[a] * od[a];
-            }
+    for (k = 0; k < n->prep.nfinite; ++k) { /* the box's finite axes (none for an unbounded shape) */
+        a = n->prep.finite[k];
+        num += od[a] * (n->prep.centre[a] - oo[a]);
+        den += od[a] * od[a];
+    }
     if (!(den > 0.0)) {
         num = -rt_dot(oo, od);
         den = rt_dot(od, od);
@@ -525,13 +549,9 @@ static double solver_noise(const rt_node *n, const double oo[3], const double od
      * the box centre (the coordinate origin on open axes) to po: the noise any ray solved inside the box
      * meets near po. */
     {
-        double centre[3], seg[3], c2[IG_MAX_DEGREE + 1], sum2 = 0.0;
-        for (a = 0; a < 3; ++a) {
-            int finite = n->obounded && isfinite(n->obox[a]) && isfinite(n->obox[a + 3]);
-            centre[a] = finite ? 0.5 * n->obox[a] + 0.5 * n->obox[a + 3] : 0.0;
-            seg[a] = po[a] - centre[a];
-        }
-        n->shape->coeffs(centre, seg, n->params, c2);
+        double seg[3], c2[IG_MAX_DEGREE + 1], sum2 = 0.0;
+        for (a = 0; a < 3; ++a) seg[a] = po[a] - n->prep.centre[a];
+        n->shape->coeffs(n->prep.centre, seg, n->params, c2);
         for (k = 0; k <= deg; ++k) sum2 += fabs(c2[k]);
         if (sum2 > sum) sum = sum2;
     }
@@ -566,34 +586,36 @@ static double distance_bound(const rt_node *n, const double po[3], const double 
     return isfinite(best) ? best : 0.0;
 }
 
-void rt_finish_hit(const rt_scene *s, int object, int leaf, int face, int entering_known, int entering,
-                   const double o[3], const double d[3], double t, rt_hit *hit)
+void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], const double d[3], rt_hit *hit,
+                   rt_hit_lazy *lazy)
 {
-    const rt_node *n = &s->nodes[leaf];
-    double oo[3], od[3], g[3], nw[3], len, dist = 0.0, mag_o, mag_w, td[3], tod[3], tr[3];
-    int a, singular = 0;
+    const rt_node *n = &s->nodes[pd->leaf];
+    rt_hit_lazy own, *lz = lazy ? lazy : &own;
+    double g[3], nw[3], len, t = pd->t;
+    int a, singular = 0, face = pd->face, entering = pd->entering, entering_known = pd->entering_known;
 
-    rt_to_object(n, o, d, oo, od);
+    rt_to_object(n, o, d, lz->oo, lz->od);
+    memcpy(lz->o, o, sizeof lz->o);
+    memcpy(lz->d, d, sizeof lz->d);
     for (a = 0; a < 3; ++a) {
         hit->p[a] = o[a] + t * d[a];
-        hit->po[a] = oo[a] + t * od[a];
-        td[a] = t * d[a];
-        tod[a] = t * od[a];
+        hit->po[a] = lz->oo[a] + t * lz->od[a];
+        lz->u[a] = 0.0;
     }
+    lz->f = 0.0;
     if (face == 0) {
-        double f = n->shape->value(hit->po, n->params), gl, u[3], level;
+        double f = n->shape->value(hit->po, n->params), gl;
         n->shape->gradient(hit->po, n->params, g);
         gl = sqrt(rt_dot(g, g));
         if (!(gl > 0.0) || !isfinite(gl) || !isfinite(f)) singular = 1;
-        level = isfinite(f) ? fabs(f) + solver_noise(n, oo, od, hit->po, f, t) : 0.0;
+        /* the direction rt_hit_error measures the distance to f = 0 along */
         if (!singular) {
-            for (a = 0; a < 3; ++a) u[a] = g[a] / gl;
+            for (a = 0; a < 3; ++a) lz->u[a] = g[a] / gl;
         } else {
-            double l = sqrt(rt_dot(od, od));
-            for (a = 0; a < 3; ++a) u[a] = od[a] / l;
+            double l = sqrt(rt_dot(lz->od, lz->od));
+            for (a = 0; a < 3; ++a) lz->u[a] = lz->od[a] / l;
         }
-        /* distance of the computed point from f = 0, including how far the solver's noise can move a root */
-        dist = level > 0.0 ? distance_bound(n, hit->po, u, level) : 0.0;
+        lz->f = f;
     } else {
         g[0] = g[1] = g[2] = 0.0;
         g[abs(face) - 1] = face > 0 ? 1.0 : -1.0;
@@ -624,54 +646,106 @@ void rt_finish_hit(const rt_scene *s, int object, int leaf, int face, int enteri
     memcpy(hit->n, nw, sizeof nw);
     len = sqrt(rt_dot(g, g));
     for (a = 0; a < 3; ++a) hit->no[a] = len > 0.0 ? g[a] / len : nw[a];
-
-    /* Error bound of the hit point, in world units. The object-space part: the measured distance |f|/|grad f|
-     * of the computed point, plus the rounding noise of evaluating f and of forming o' + t d' (relative to
-     * the magnitudes involved); M stretches it by at most its norm. The world part: rounding of o + t d and
-     * of the transforms. */
-    mag_o = maxabs3(oo) + maxabs3(tod) + maxabs3(hit->po);
-    tr[0] = n->m[3];
-    tr[1] = n->m[7];
-    tr[2] = n->m[11];
-    mag_w = maxabs3(o) + maxabs3(td) + maxabs3(hit->p) + maxabs3(tr);
-    hit->err = n->mnorm * (dist + RT_ERR_OBJECT * DBL_EPSILON * (double)(n->shape->degree + 1) * mag_o) +
-               RT_ERR_WORLD * DBL_EPSILON * mag_w;
+    hit->err = 0.0;
     hit->t = t;
-    hit->object = object;
-    hit->leaf = leaf;
+    hit->object = pd->object;
+    hit->leaf = pd->leaf;
     hit->face = face;
     hit->material = n->material;
     hit->entering = entering != 0;
     hit->singular = singular;
+    lz->pending = 1;
+    if (!lazy) rt_hit_error(s, hit, lz);
 }
 
-int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax,
-                     rt_pending *out)
+void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lz)
 {
-    double best = tmax, t;
-    int found = -1, bleaf = -1, bface = 0, bent = 0, bknown = 0, i;
-    int stack[128], sp = 0;
+    const rt_node *n = &s->nodes[hit->leaf];
+    double dist = 0.0, mag_o, mag_w, td[3], tod[3], tr[3], t = hit->t;
+    int a;
+    if (!lz->pending) return;
+    lz->pending = 0;
+    if (hit->face == 0) {
+        double f = lz->f, level;
+        level = isfinite(f) ? fabs(f) + solver_noise(n, lz->oo, lz->od, hit->po, f, t) : 0.0;
+        /* distance of the computed point from f = 0, including how far the solver's noise can move a root */
+        dist = level > 0.0 ? distance_bound(n, hit->po, lz->u, level) : 0.0;
+    }
+    /* Error bound of the hit point, in world units. The object-space part: the measured distance |f|/|grad f|
+     * of the computed point, plus the rounding noise of evaluating f and of forming o' + t d' (relative to
+     * the magnitudes involved); M stretches it by at most its norm. The world part: rounding of o + t d and
+     * of the transforms. */
+    for (a = 0; a < 3; ++a) {
+        td[a] = t * lz->d[a];
+        tod[a] = t * lz->od[a];
+    }
+    mag_o = maxabs3(lz->oo) + maxabs3(tod) + maxabs3(hit->po);
+    tr[0] = n->m[3];
+    tr[1] = n->m[7];
+    tr[2] = n->m[11];
+    mag_w = maxabs3(lz->o) + maxabs3(td) + maxabs3(hit->p) + maxabs3(tr);
+    hit->err = n->mnorm * (dist + RT_ERR_OBJECT * DBL_EPSILON * (double)(n->shape->degree + 1) * mag_o) +
+               RT_ERR_WORLD * DBL_EPSILON * mag_w;
+}
+
+/* Slab test of the ray against an axis-aligned box, as rt_clip_box (same arithmetic) without face codes. */
+static int ray_box(const double box[6], const rt_ray *r, double *t0, double *t1)
+{
+    double lo = *t0, hi = *t1;
+    int a;
+    for (a = 0; a < 3; ++a) {
+        double bmin = box[a], bmax = box[a + 3];
+        if (!(bmin <= bmax)) return 0; /* empty or NaN box */
+        if (r->d[a] == 0.0) {
+            if (!(r->o[a] >= bmin && r->o[a] <= bmax)) return 0;
+        } else {
+            double ta = (bmin - r->o[a]) * r->inv[a], tb = (bmax - r->o[a]) * r->inv[a];
+            if (ta > tb) {
+                double tt = ta;
+                ta = tb;
+                tb = tt;
+            }
+            if (ta > lo) lo = ta;
+            if (tb < hi) hi = tb;
+            if (!(lo <= hi)) return 0;
+        }
+    }
+    *t0 = lo;
+    *t1 = hi;
+    return 1;
+}
+
+int rt_spawn_skip(const rt_scene *s, const rt_hit *h) { return s->flat[h->object] ? h->object : -1; }
+
+int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
+                     int skip, rt_pending *out)
+{
+    double best = tmax;
+    int found = 0, i, sp = 0;
+    int stack[128];
     double entry[128];
+    rt_ray ray;
+    rt_pending h;
     if (!s->committed) return 0;
     if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]) || !isfinite(o[0]) || !isfinite(o[1]) ||
         !isfinite(o[2]))
         return 0;
-    for (i = 0; i < s->nunbounded; ++i) {
-        int leaf, face, ent, known, obj = s->unbounded[i];
-        if (rt_object_hit(s, obj, o, d, tmin, best, &t, &leaf, &face, &ent, &known)) {
-            best = t;
-            found = obj;
-            bleaf = leaf;
-            bface = face;
-            bent = ent;
-            bknown = known;
-        }
+    rt_ray_init(&ray, o, d, s->far);
+    /* A hit is kept when it is closer than the best so far (rt_object_hit only reports t < best). In
+     * RT_ANY_OPAQUE mode a hit on an opaque material ends the search. */
+#define RT_TAKE(obj)                                                                                             \
+    if ((obj) != skip && rt_object_hit(s, (obj), &ray, tmin, best, &h)) {                                       \
+        *out = h;                                                                                                \
+        best = h.t;                                                                                              \
+        found = 1;                                                                                               \
+        if (mode == RT_ANY_OPAQUE && s->materials[s->nodes[h.leaf].material].transparency <= 0.0) return 1;    \
     }
+    for (i = 0; i < s->nunbounded; ++i) RT_TAKE(s->unbounded[i])
     /* Each stack entry carries the t where the ray enters its box, so a node is clipped once and skipped
      * when a closer hit has been found since it was pushed. */
     if (s->nbvh > 0) {
         double t0 = tmin, t1 = best;
-        if (rt_clip_box(s->bvh[0].box, o, d, &t0, &t1, NULL, NULL)) {
+        if (ray_box(s->bvh[0].box, &ray, &t0, &t1)) {
             stack[sp] = 0;
             entry[sp++] = t0;
         }
@@ -682,23 +756,13 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
         if (entry[sp] > best) continue;
         b = &s->bvh[stack[sp]];
         if (b->left < 0) {
-            for (i = b->first; i < b->first + b->count; ++i) {
-                int leaf, face, ent, known, obj = s->order[i];
-                if (rt_object_hit(s, obj, o, d, tmin, best, &t, &leaf, &face, &ent, &known)) {
-                    best = t;
-                    found = obj;
-                    bleaf = leaf;
-                    bface = face;
-                    bent = ent;
-                    bknown = known;
-                }
-            }
+            for (i = b->first; i < b->first + b->count; ++i) RT_TAKE(s->order[i])
         } else if (sp + 2 <= (int)(sizeof stack / sizeof stack[0])) {
             /* visit the nearer child first: push it last */
             const rt_bvh_node *l = &s->bvh[b->left], *r = &s->bvh[b->right];
             double la = tmin, lb = best, ra = tmin, rb = best;
-            int lhit = rt_clip_box(l->box, o, d, &la, &lb, NULL, NULL);
-            int rhit = rt_clip_box(r->box, o, d, &ra, &rb, NULL, NULL);
+            int lhit = ray_box(l->box, &ray, &la, &lb);
+            int rhit = ray_box(r->box, &ray, &ra, &rb);
             if (lhit && rhit && la > ra) {
                 stack[sp] = b->left;
                 entry[sp++] = la;
@@ -716,21 +780,15 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
             }
         }
     }
-    if (found < 0) return 0;
-    out->t = best;
-    out->object = found;
-    out->leaf = bleaf;
-    out->face = bface;
-    out->entering = bent;
-    out->entering_known = bknown;
-    return 1;
+#undef RT_TAKE
+    return found;
 }
 
 int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax,
                        rt_hit *hit)
 {
     rt_pending h;
-    if (!rt_scene_closest(s, o, d, tmin, tmax, &h)) return 0;
-    rt_finish_hit(s, h.object, h.leaf, h.face, h.entering_known, h.entering, o, d, h.t, hit);
+    if (!rt_scene_closest(s, o, d, tmin, tmax, RT_CLOSEST, -1, &h)) return 0;
+    rt_finish_hit(s, &h, o, d, hit, NULL);
     return 1;
 }

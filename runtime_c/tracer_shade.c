@@ -10,6 +10,7 @@
  */
 #include "tracer_internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -104,14 +105,20 @@ static void base_colour(const rt_material *m, const rt_hit *h, double c[3])
 {
     if (m->checker_scale > 0.0) {
         /* A 3-D checker in object space, evaluated a little below the surface (a fraction of a cell) so a
-         * surface lying exactly on a cell boundary, like the plane y = 0, does not speckle. */
-        double q, sum = 0.0;
-        int a;
+         * surface lying exactly on a cell boundary, like the plane y = 0, does not speckle. The cell index
+         * floor(q) of each axis is an integer; the colour is color where their sum is even. Below 2^53 the
+         * parity of an integer-valued double is that of its conversion; at and above, every double is even. A
+         * cell index that is not finite (q overflowed) gives color2. */
+        int a, odd = 0;
         for (a = 0; a < 3; ++a) {
-            q = (h->po[a] - 1e-3 * m->checker_scale * h->no[a]) / m->checker_scale;
-            sum += fmod(fabs(floor(q)), 2.0);
+            double q = (h->po[a] - 1e-3 * m->checker_scale * h->no[a]) / m->checker_scale, k = fabs(floor(q));
+            if (!(k <= DBL_MAX)) {
+                odd = 1;
+                break;
+            }
+            if (k < 0x1p53) odd ^= (int)((long long)k & 1);
         }
-        memcpy(c, fmod(sum, 2.0) < 0.5 ? m->color : m->color2, 3 * sizeof(double));
+        memcpy(c, odd ? m->color2 : m->color, 3 * sizeof(double));
     } else {
         memcpy(c, m->color, 3 * sizeof(double));
     }
@@ -125,7 +132,7 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
     double q[3], dd[3];
     rt_hit h;
     rt_pending ph;
-    int i, a;
+    int i, a, skip = rt_spawn_skip(s, from);
     T[0] = T[1] = T[2] = 1.0;
     for (a = 0; a < 3; ++a) dd[a] = light[a] - from->p[a];
     rt_spawn_origin(from, dd, q);
@@ -133,13 +140,14 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
         const rt_material *m;
         for (a = 0; a < 3; ++a) dd[a] = light[a] - q[a];
         if (tr->stats) tr->stats[RT_RAYS_SHADOW] += 1.0;
-        if (!rt_scene_closest(s, q, dd, 0.0, 1.0, &ph)) return;
+        /* any opaque hit before the light is full shadow, whether or not it is the closest */
+        if (!rt_scene_closest(s, q, dd, 0.0, 1.0, RT_ANY_OPAQUE, skip, &ph)) return;
         m = &s->materials[s->nodes[ph.leaf].material];
         if (m->transparency <= 0.0) {
             T[0] = T[1] = T[2] = 0.0;
             return;
         }
-        rt_finish_hit(s, ph.object, ph.leaf, ph.face, ph.entering_known, ph.entering, q, dd, ph.t, &h);
+        rt_finish_hit(s, &ph, q, dd, &h, NULL);
         if (h.entering) {
             for (a = 0; a < 3; ++a) T[a] *= m->transparency;
         } else {
@@ -151,22 +159,29 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
             return;
         }
         rt_spawn_origin(&h, dd, q);
+        skip = rt_spawn_skip(s, &h);
     }
 }
 
-static void trace(const rt_tracer *tr, const double o[3], const double d[3], int depth, const rt_media *media,
-                  double weight, double rgb[3])
+/* The colour seen along o + t d; skip: an object the ray need not test (rt_spawn_skip), or -1. */
+static void trace(const rt_tracer *tr, const double o[3], const double d[3], int skip, int depth,
+                  const rt_media *media, double weight, double rgb[3])
 {
     const rt_scene *s = tr->s;
     const rt_material *m;
     rt_hit h;
+    rt_hit_lazy lazy;
+    rt_pending ph;
     double u[3], nf[3], base[3], local[3], col[3], dl;
     int a, l;
 
-    if (!rt_scene_intersect(s, o, d, 0.0, INFINITY, &h)) {
+    if (!rt_scene_closest(s, o, d, 0.0, INFINITY, RT_CLOSEST, skip, &ph)) {
         memcpy(rgb, s->background, 3 * sizeof(double));
         return;
     }
+    /* h.err is worked out (rt_hit_error) only before a ray leaves h: a surface lit by no light and
+     * neither reflecting nor refracting never needs it */
+    rt_finish_hit(s, &ph, o, d, &h, &lazy);
     m = &s->materials[h.material];
     dl = sqrt(rt_dot(d, d));
     for (a = 0; a < 3; ++a) u[a] = d[a] / dl;
@@ -185,6 +200,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
             if (!(ll > 0.0)) continue;
             ndl = rt_dot(nf, L) / ll;
             if (ndl <= 0.0) continue; /* the light is behind the surface as seen from the ray */
+            rt_hit_error(s, &h, &lazy);
             shadow_transmittance(tr, &h, lp, T);
             if (T[0] + T[1] + T[2] <= 0.0) continue;
             if (m->specular > 0.0) {
@@ -223,16 +239,18 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
         if (kr * weight > RT_MIN_WEIGHT) {
             double r[3], q[3], c[3];
             rt_reflect(u, nf, r);
+            rt_hit_error(s, &h, &lazy);
             rt_spawn_origin(&h, r, q);
             if (tr->stats) tr->stats[RT_RAYS_SECONDARY] += 1.0;
-            trace(tr, q, r, depth + 1, media, weight * kr, c);
+            trace(tr, q, r, rt_spawn_skip(s, &h), depth + 1, media, weight * kr, c);
             for (a = 0; a < 3; ++a) col[a] += kr * c[a];
         }
         if (kt * weight > RT_MIN_WEIGHT) {
             double q[3], c[3];
+            rt_hit_error(s, &h, &lazy);
             rt_spawn_origin(&h, tdir, q);
             if (tr->stats) tr->stats[RT_RAYS_SECONDARY] += 1.0;
-            trace(tr, q, tdir, depth + 1, &next, weight * kt, c);
+            trace(tr, q, tdir, rt_spawn_skip(s, &h), depth + 1, &next, weight * kt, c);
             for (a = 0; a < 3; ++a) col[a] += kt * c[a];
         }
     }
@@ -259,5 +277,5 @@ void rt_trace_ray(const rt_scene *s, const double o[3], const double d[3], int m
         rgb[0] = rgb[1] = rgb[2] = 0.0;
         return;
     }
-    trace(&tr, o, d, 0, &media, 1.0, rgb);
+    trace(&tr, o, d, -1, 0, &media, 1.0, rgb);
 }

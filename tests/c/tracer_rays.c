@@ -623,6 +623,160 @@ static void test_glass(void)
     }
 }
 
+
+/* ---------------------------------------------------------------- the tracer's own shortcuts */
+
+/* The plane y = 0 as a hand-written unbounded shape of degree 1. */
+static void plane_coeffs(const double o[3], const double d[3], const double *p, double *c)
+{
+    (void)p;
+    c[0] = o[1];
+    c[1] = d[1];
+}
+static double plane_value(const double q[3], const double *p)
+{
+    (void)p;
+    return q[1];
+}
+static void plane_gradient(const double q[3], const double *p, double g[3])
+{
+    (void)p;
+    (void)q;
+    g[0] = 0.0;
+    g[1] = 1.0;
+    g[2] = 0.0;
+}
+static int plane_bounds(const double *p, double box[6])
+{
+    (void)p;
+    box[0] = box[1] = box[2] = -INFINITY;
+    box[3] = box[4] = box[5] = INFINITY;
+    return 0;
+}
+static const ig_shape plane_y = {"plane_y", 1, 0, plane_coeffs, plane_value, plane_gradient, plane_bounds};
+
+static void test_shortcuts(void)
+{
+    /* A tilted plane, a transformed torus, an opaque sphere and a glass sphere. */
+    double one = 1.0, tp[2] = {1.0, 0.3}, M[12], R[9], axis[3] = {0.3, 1, 0.2}, pl[12];
+    double glass[RT_MATERIAL_DOUBLES] = {1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0.9, 1.5, 0, 0, 0, 0, 0};
+    double checker[RT_MATERIAL_DOUBLES] = {1, 1, 1, 0, 0, 0, 0.7, 1, 0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0};
+    unsigned long long seed = 99;
+    rt_scene *s = rt_scene_new();
+    int i, k, mat = add_matte(s), gmat = rt_scene_add_material(s, glass), plane, torus, ball, gball;
+    int same = 0, hits = 0, any_ok = 0, any_n = 0, any_behind = 0, self = 0, spawned = 0;
+    rot_axis(axis, 0.4, R);
+    for (i = 0; i < 3; ++i) {
+        for (k = 0; k < 3; ++k) {
+            M[4 * i + k] = 1.3 * R[3 * i + k];
+            pl[4 * i + k] = R[3 * i + k];
+        }
+        M[4 * i + 3] = i == 1 ? 1.5 : 0.2;
+        pl[4 * i + 3] = i == 1 ? -0.5 : 0.0;
+    }
+    plane = rt_scene_add_object(s, rt_scene_add_leaf(s, &plane_y, NULL, 0, pl, mat));
+    torus = rt_scene_add_object(s, rt_scene_add_leaf(s, &torus_z_shape, tp, 2, M, mat));
+    translate_scale(M, -2.5, 1, 0, 0.8);
+    ball = rt_scene_add_object(s, rt_scene_add_leaf(s, &sphere_shape, &one, 1, M, mat));
+    translate_scale(M, 2.5, 1, 0.5, 0.8);
+    gball = rt_scene_add_object(s, rt_scene_add_leaf(s, &sphere_shape, &one, 1, M, gmat));
+    CHECK(rt_scene_commit(s) == 0, "commit: %s", rt_scene_error(s));
+    (void)torus;
+    (void)ball;
+    for (k = 0; k < 20000; ++k) {
+        double o[3], d[3], q[3], L[3] = {0, 0, 0};
+        rt_pending ph;
+        rt_hit eager, lazy_hit;
+        rt_hit_lazy lz;
+        for (i = 0; i < 3; ++i) {
+            o[i] = 12 * urand(&seed) - 6;
+            d[i] = 2 * urand(&seed) - 1;
+        }
+        o[1] += 8.0;
+        /* the error bound worked out later (rt_hit_error) is the one rt_scene_intersect gives at once */
+        if (rt_scene_intersect(s, o, d, 0, INFINITY, &eager)) {
+            ++hits;
+            CHECK(rt_scene_closest(s, o, d, 0, INFINITY, RT_CLOSEST, -1, &ph), "closest disagrees with intersect");
+            rt_finish_hit(s, &ph, o, d, &lazy_hit, &lz);
+            rt_hit_error(s, &lazy_hit, &lz);
+            rt_hit_error(s, &lazy_hit, &lz); /* a second call changes nothing */
+            same += memcmp(&eager, &lazy_hit, sizeof eager) == 0;
+            /* a ray leaving the plane never meets the plane again (why rays spawned there skip it) */
+            if (eager.object == plane) {
+                for (i = 0; i < 3; ++i) L[i] = 2 * urand(&seed) - 1;
+                rt_spawn_origin(&eager, L, q);
+                ++spawned;
+                if (rt_scene_closest(s, q, L, 0, INFINITY, RT_CLOSEST, -1, &ph) && ph.object == plane) ++self;
+                CHECK(rt_spawn_skip(s, &eager) == plane, "a plane hit must skip the plane");
+            } else {
+                CHECK(rt_spawn_skip(s, &eager) == -1, "only planes are skipped");
+            }
+        }
+        /* RT_ANY_OPAQUE: an opaque hit whenever the segment holds one, else the closest (transparent) hit */
+        {
+            rt_pending pc, pa;
+            int hc = rt_scene_closest(s, o, d, 0, 12.0, RT_CLOSEST, -1, &pc);
+            int ha = rt_scene_closest(s, o, d, 0, 12.0, RT_ANY_OPAQUE, -1, &pa);
+            int opaque_in_range = 0;
+            double t = 0.0;
+            /* walk the segment's hits in order to see whether any is opaque */
+            while (rt_scene_closest(s, o, d, t, 12.0, RT_CLOSEST, -1, &ph)) {
+                if (ph.object != gball) {
+                    opaque_in_range = 1;
+                    break;
+                }
+                t = ph.t;
+            }
+            if (hc) {
+                ++any_n;
+                if (opaque_in_range) {
+                    any_ok += ha && pa.object != gball;
+                    any_behind += pc.object == gball; /* the opaque hit lies behind the glass */
+                } else {
+                    any_ok += ha && pa.object == gball && pa.t == pc.t;
+                }
+            } else {
+                CHECK(!ha, "RT_ANY_OPAQUE finds a hit where RT_CLOSEST finds none");
+            }
+        }
+    }
+    CHECK(hits > 5000 && same == hits, "lazy error bound: %d of %d hits identical", same, hits);
+    CHECK(self == 0 && spawned > 1000, "rays leaving the plane met it again %d times of %d", self, spawned);
+    CHECK(any_ok == any_n && any_n > 1000 && any_behind > 10, "RT_ANY_OPAQUE right on %d of %d segments (%d behind glass)",
+          any_ok, any_n, any_behind);
+    printf("shortcuts: %d hits, lazy error bound identical on %d; %d rays off the plane, %d met it again; any-opaque "
+           "right on %d of %d segments, %d of them opaque behind glass\n", hits, same, spawned, self, any_ok, any_n,
+           any_behind);
+    rt_scene_free(s);
+
+    {
+        /* The checker (ambient 1, nothing else: the colour is the cell colour) against the fmod formula, at
+         * cell indices of both signs and beyond 2^53, where every double is an even integer. */
+        rt_scene *c = rt_scene_new();
+        int cm = rt_scene_add_material(c, checker), wrong = 0, n = 0;
+        double rgb[3];
+        rt_scene_add_object(c, rt_scene_add_leaf(c, &plane_y, NULL, 0, IDENTITY, cm));
+        CHECK(rt_scene_commit(c) == 0, "commit: %s", rt_scene_error(c));
+        for (k = 0; k < 4000; ++k) {
+            double mag = pow(10.0, 17.0 * urand(&seed)), x = (2 * urand(&seed) - 1) * mag,
+                   z = (2 * urand(&seed) - 1) * mag, o[3], d[3] = {0, -1, 0}, sum = 0.0, want, q[3];
+            o[0] = x;
+            o[1] = 1.0;
+            o[2] = z;
+            rt_trace_ray(c, o, d, 0, rgb, NULL);
+            q[0] = x / 0.7;
+            q[1] = (0.0 - 1e-3 * 0.7 * 1.0) / 0.7;
+            q[2] = z / 0.7;
+            for (i = 0; i < 3; ++i) sum += fmod(fabs(floor(q[i])), 2.0);
+            want = fmod(sum, 2.0) < 0.5 ? 1.0 : 0.0;
+            ++n;
+            wrong += rgb[0] != want;
+        }
+        CHECK(wrong == 0, "checker colour wrong at %d of %d points", wrong, n);
+        rt_scene_free(c);
+    }
+}
+
 int main(void)
 {
     test_sphere_distances();
@@ -632,6 +786,7 @@ int main(void)
     test_piriform_basis();
     test_unbounded_and_shading();
     test_glass();
+    test_shortcuts();
     printf("%d failures\n", failures);
     return failures;
 }
