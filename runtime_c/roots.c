@@ -525,7 +525,8 @@ int ig_roots_core(const double *c, int n, double lo, double hi, int method, int 
         return 0;
     if (!(lo <= hi)) /* also NaN bounds */
         return 0;
-    if (n == 1) { /* a plane: the common case in a scene, no scaling needed (the quotient is scale-free) */
+    if (n == 1) { /* a plane, the common case in a scene (the tracer's ground): no set-up, no scaling needed
+                   * (the quotient is scale-free); c[0] == 0 gives +0, c[1] == 0 no root */
         double x = -c[0] / c[1];
         if (!(fabs(c[0]) <= DBL_MAX) || !(fabs(c[1]) <= DBL_MAX) || !isfinite(x) || !(x >= lo && x <= hi))
             return 0; /* also c[1] == 0: no root, or the zero polynomial */

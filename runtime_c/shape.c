@@ -93,26 +93,6 @@ static double shift_point(const ig_shape_prep *prep, const double o[3], const do
     return ts;
 }
 
-/* Degree 1 without the general solver's set-up: the root -c0/c1 of ig_real_roots, case by case (a vanishing
- * c1 lowers the degree to a constant: no root; c0 == 0 is the deflated root 0; a quotient that is not finite
- * is dropped; the interval test; no -0). Only below 2^201, where ig_real_roots does not rescale the
- * coefficients (its rescaling could round a tiny c0); the caller falls back to it otherwise. Returns the
- * root count, or -1 for "not handled here". */
-static int linear_root(const double c[2], double lo, double hi, double *s)
-{
-    if (!(fabs(c[0]) < 0x1p201 && fabs(c[1]) < 0x1p201)) /* also NaN and Inf */
-        return -1;
-    if (!(lo <= hi))
-        return 0;
-    if (c[1] == 0.0)
-        return 0;
-    double x = c[0] == 0.0 ? 0.0 : -c[0] / c[1];
-    if (!isfinite(x) || !(x >= lo && x <= hi))
-        return 0;
-    *s = x == 0.0 ? 0.0 : x;
-    return 1;
-}
-
 int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_prep *prep, const double o[3],
                    const double d[3], double tmin, double tmax, ig_root_method method, int first, double *roots)
 {
@@ -136,9 +116,7 @@ int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_p
     double c[IG_MAX_DEGREE + 1];
     shape->coeffs(os, d, params, c);
     double s[IG_MAX_DEGREE];
-    int k = n == 1 ? linear_root(c, t0 - ts, t1 - ts, s) : -1;
-    if (k < 0)
-        k = first ? ig_first_root(c, n, t0 - ts, t1 - ts, method, s) : ig_real_roots(c, n, t0 - ts, t1 - ts, method, s);
+    int k = first ? ig_first_root(c, n, t0 - ts, t1 - ts, method, s) : ig_real_roots(c, n, t0 - ts, t1 - ts, method, s);
     int m = 0;
     for (int i = 0; i < k; ++i) {
         double t = ts + s[i];
