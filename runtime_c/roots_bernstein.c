@@ -38,13 +38,13 @@
 typedef struct {
     const double *p; /* power-form coefficients, exact degree n */
     int n;
-    double a, b, h; /* the interval; t = a + s h */
+    double a, h;    /* the interval [a, a + h]; t = a + s h */
     double tol;     /* |b_i| <= tol: the sign of b_i is not certain */
     int first;      /* stop at the leftmost root */
     double *out;
     int cnt;
-    int fallback; /* a piece was not certain: bracketing decides from its left end on */
-    double fallback_from;
+    double fallback_from; /* NaN, or the left end of the first piece that was not certain: bracketing decides
+                           * from there on */
 } bz_ctx;
 
 /* 1/k, k = 0 .. IG_MAX_DEGREE (entry 0 unused): turns the binomial scaling into products. */
@@ -99,7 +99,7 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     double h = b - a;
     if (!(h > 0.0) || !isfinite(h))
         return ig_bracket_interval(p, n, a, b, out);
-    bz_ctx c = {p, n, a, b, h, 0.0, first, out, 0, 0, a};
+    bz_ctx c = {p, n, a, h, 0.0, first, out, 0, NAN};
     double x = fabs(a) + h, M = 0.0;
     for (int k = n; k >= 0; --k)
         M = M * x + fabs(p[k]);
@@ -125,7 +125,7 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     if (sl == 0 || sr == 0) /* a root at an end of the interval (within rounding) */
         return ig_bracket_interval(p, n, a, b, out);
     piece(&c, bz, 0.0, 1.0, a, b, sl, sr, vl, vr, 0);
-    if (c.fallback) /* the roots left of the unresolved piece stand; bracketing finds the rest */
+    if (!isnan(c.fallback_from)) /* the roots left of the unresolved piece stand; bracketing finds the rest */
         c.cnt += ig_bracket_interval(p, n, c.fallback_from, b, out + c.cnt);
     return c.cnt;
 }

@@ -94,7 +94,7 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double s0, double s1, doubl
                          double vl, double vr, int depth)
 {
     const int n = c->n;
-    if (c->fallback || (c->first && c->cnt > 0))
+    if (!isnan(c->fallback_from) || (c->first && c->cnt > 0))
         return;
     int v = BZ_FN(variations)(b, n, c->tol, sl, sr);
     if (v == 0)
@@ -106,7 +106,6 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double s0, double s1, doubl
     double sm = 0.5 * (s0 + s1);
     double tm = c->a + sm * c->h;
     if (depth >= BZ_MAX_DEPTH || !(tm > tl && tm < tr)) {
-        c->fallback = 1;
         c->fallback_from = tl;
         return;
     }
@@ -114,7 +113,6 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double s0, double s1, doubl
     BZ_FN(split_half)(b, n, L, R);
     int sm_sign = end_sign(c, L[N], tm, &vm);
     if (sm_sign == 0) { /* p zero within rounding at the split point */
-        c->fallback = 1;
         c->fallback_from = tl;
         return;
     }
