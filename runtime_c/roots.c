@@ -143,7 +143,7 @@ double ig_ordered_mid(double l, double r)
     return unordered(a + (int64_t)(diff / 2u));
 }
 
-double ig_refine(const double *c, int n, double l, double r, double vl, double vr, double tol, double x0)
+static double refine_safe(const double *c, int n, double l, double r, double vl, double vr, double tol, double x0)
 {
     const int positive_left = vl > 0.0;
     /* start from the caller's guess, else the false-position point (exact for a line) */
@@ -200,6 +200,70 @@ double ig_refine(const double *c, int n, double l, double r, double vl, double v
         x = xn;
     }
     return x;
+}
+
+/* p(x), p'(x) and p''(x) / 2 by one Horner pass (three independent chains: about the latency of p alone). */
+static void horner3(const double *c, int n, double x, double *p, double *dp, double *hdd)
+{
+    double v = c[n], d = 0.0, dd = 0.0;
+    for (int k = n - 1; k >= 0; --k) {
+        dd = dd * x + d;
+        d = d * x + v;
+        v = v * x + c[k];
+    }
+    *p = v;
+    *dp = d;
+    *hdd = dd;
+}
+
+/* The fast path: Halley's iteration x - p p' / (p'^2 - p p'' / 2), cubically convergent at a simple root,
+ * inside the bracket. From a start a few digits right it needs two evaluations where Newton needs three or
+ * four. It stops when the step is at rounding level, or when the error it predicts for the new iterate,
+ * |step|^4 / |previous step|^3 (cubic convergence, constant estimated from the last two steps), is below the
+ * tolerance -- trusted only once the iterate is in the asymptotic range: the step below 1e-3 of the one before
+ * and of |x| (a first step from far away says nothing about the error). Anything unusual -- a step leaving the bracket, a zero or negative denominator, steps not
+ * shrinking at least by half, six iterations -- hands the (narrowed) bracket to refine_safe above, whose
+ * rules handle multiple roots, huge ranges and rounding noise. */
+double ig_refine(const double *c, int n, double l, double r, double vl, double vr, double tol, double x0)
+{
+    const int positive_left = vl > 0.0;
+    double x = x0;
+    if (!(x > l && x < r))
+        x = l - vl * ((r - l) / (vr - vl));
+    if (!(x > l && x < r))
+        return refine_safe(c, n, l, r, vl, vr, tol, NAN);
+    double prev = INFINITY;
+    for (int it = 0; it < 6; ++it) {
+        double v, d, hdd;
+        horner3(c, n, x, &v, &d, &hdd);
+        if (v == 0.0)
+            return x;
+        if ((v > 0.0) == positive_left) {
+            l = x;
+            vl = v;
+        } else {
+            r = x;
+            vr = v;
+        }
+        double step = (v * d) / (d * d - v * hdd), xn = x - step;
+        double as = fabs(step);
+        if (!(xn >= l && xn <= r)) /* also NaN: a zero denominator */
+            break;
+        if (as <= 4.0 * IG_U * fabs(xn))
+            return xn;
+        if (prev < INFINITY) {
+            double q = as / prev;
+            if (q <= 1e-3 && as <= 1e-3 * fabs(xn) && q * q * q * as <= tol * fabs(xn))
+                return xn;
+            if (!(q <= 0.5))
+                break;
+        }
+        if (!(xn > l && xn < r))
+            break;
+        prev = as;
+        x = xn;
+    }
+    return refine_safe(c, n, l, r, vl, vr, tol, NAN);
 }
 
 /* ---------------------------------------------------------------- quadratic, sorting */
