@@ -45,6 +45,8 @@ typedef struct {
     int cnt;
     double fallback_from; /* NaN, or the left end of the first piece that was not certain: bracketing decides
                            * from there on */
+    /* all-roots mode: the isolating brackets (ends, values there, start guess), refined together at the end */
+    double bl[IG_MAX_DEGREE], br[IG_MAX_DEGREE], bvl[IG_MAX_DEGREE], bvr[IG_MAX_DEGREE], bx0[IG_MAX_DEGREE];
 } bz_ctx;
 
 /* 1/k, k = 0 .. IG_MAX_DEGREE (entry 0 unused): turns the binomial scaling into products. */
@@ -99,7 +101,15 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     double h = b - a;
     if (!(h > 0.0) || !isfinite(h))
         return ig_bracket_interval(p, n, a, b, out);
-    bz_ctx c = {p, n, a, h, 0.0, first, out, 0, NAN};
+    bz_ctx c;
+    c.p = p;
+    c.n = n;
+    c.a = a;
+    c.h = h;
+    c.first = first;
+    c.out = out;
+    c.cnt = 0;
+    c.fallback_from = NAN;
     double x = fabs(a) + h, M = 0.0;
     for (int k = n; k >= 0; --k)
         M = M * x + fabs(p[k]);
@@ -125,6 +135,8 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     if (sl == 0 || sr == 0) /* a root at an end of the interval (within rounding) */
         return ig_bracket_interval(p, n, a, b, out);
     piece(&c, bz, 0.0, 1.0, a, b, sl, sr, vl, vr, 0);
+    if (!first && c.cnt > 0) /* several roots in flight at once: about the time of one */
+        ig_refine_many(p, n, c.cnt, c.bl, c.br, c.bvl, c.bvr, 2.0 * IG_U, c.bx0, out);
     if (!isnan(c.fallback_from)) /* the roots left of the unresolved piece stand; bracketing finds the rest */
         c.cnt += ig_bracket_interval(p, n, c.fallback_from, b, out + c.cnt);
     return c.cnt;

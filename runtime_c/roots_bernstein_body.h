@@ -99,8 +99,18 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double s0, double s1, doubl
     int v = BZ_FN(variations)(b, n, c->tol, sl, sr);
     if (v == 0)
         return;
-    if (v == 1) {
-        c->out[c->cnt++] = ig_refine(c->p, n, tl, tr, vl, vr, 2.0 * IG_U, BZ_FN(polygon_crossing)(b, n, tl, tr));
+    if (v == 1) { /* one simple root: refined now in first-root mode, else with the others at the end */
+        double x0 = BZ_FN(polygon_crossing)(b, n, tl, tr);
+        if (c->first) {
+            c->out[c->cnt++] = ig_refine(c->p, n, tl, tr, vl, vr, 2.0 * IG_U, x0);
+            return;
+        }
+        int k = c->cnt++;
+        c->bl[k] = tl;
+        c->br[k] = tr;
+        c->bvl[k] = vl;
+        c->bvr[k] = vr;
+        c->bx0[k] = x0;
         return;
     }
     double sm = 0.5 * (s0 + s1);
