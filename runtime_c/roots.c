@@ -202,58 +202,57 @@ static double refine_safe(const double *c, int n, double l, double r, double vl,
     return x;
 }
 
-/* p(x), p'(x) and p''(x) / 2 by one Horner pass (three independent chains: about the latency of p alone). */
-static void horner3(const double *c, int n, double x, double *p, double *dp, double *hdd)
+/* p(x), p'(x), p''(x) / 2 and p^(3)(x) / 6 by one Horner pass (independent chains). */
+static void horner4(const double *c, int n, double x, double *e)
 {
-    double v = c[n], d = 0.0, dd = 0.0;
+    double v = c[n], d = 0.0, dd = 0.0, d3 = 0.0;
     for (int k = n - 1; k >= 0; --k) {
+        d3 = d3 * x + dd;
         dd = dd * x + d;
         d = d * x + v;
         v = v * x + c[k];
     }
-    *p = v;
-    *dp = d;
-    *hdd = dd;
+    e[0] = v;
+    e[1] = d;
+    e[2] = dd;
+    e[3] = d3;
 }
 
-/* The same at four points at once: four independent sets of chains, so four roots are refined in about the
- * time of one (evaluation is latency-bound). Bitwise the same operations as horner3 for each point. */
-static void horner3_x4(const double *c, int n, const double *x, double *p, double *dp, double *hdd)
+static void horner4_x2(const double *c, int n, const double *x, double *e)
 {
-    double v[4], d[4] = {0.0, 0.0, 0.0, 0.0}, dd[4] = {0.0, 0.0, 0.0, 0.0};
-    for (int j = 0; j < 4; ++j)
-        v[j] = c[n];
-    for (int k = n - 1; k >= 0; --k)
-        for (int j = 0; j < 4; ++j) {
-            dd[j] = dd[j] * x[j] + d[j];
-            d[j] = d[j] * x[j] + v[j];
-            v[j] = v[j] * x[j] + c[k];
-        }
-    for (int j = 0; j < 4; ++j) {
-        p[j] = v[j];
-        dp[j] = d[j];
-        hdd[j] = dd[j];
-    }
-}
-
-/* Two points at once (the common case: a ray through one tube of a torus). */
-static void horner3_x2(const double *c, int n, const double *x, double *p, double *dp, double *hdd)
-{
-    double v0 = c[n], v1 = c[n], d0 = 0.0, d1 = 0.0, e0 = 0.0, e1 = 0.0;
+    double v0 = c[n], v1 = c[n], d0 = 0.0, d1 = 0.0, f0 = 0.0, f1 = 0.0, g0 = 0.0, g1 = 0.0;
     for (int k = n - 1; k >= 0; --k) {
-        e0 = e0 * x[0] + d0;
-        e1 = e1 * x[1] + d1;
+        g0 = g0 * x[0] + f0;
+        g1 = g1 * x[1] + f1;
+        f0 = f0 * x[0] + d0;
+        f1 = f1 * x[1] + d1;
         d0 = d0 * x[0] + v0;
         d1 = d1 * x[1] + v1;
         v0 = v0 * x[0] + c[k];
         v1 = v1 * x[1] + c[k];
     }
-    p[0] = v0;
-    p[1] = v1;
-    dp[0] = d0;
-    dp[1] = d1;
-    hdd[0] = e0;
-    hdd[1] = e1;
+    e[0] = v0; e[1] = d0; e[2] = f0; e[3] = g0;
+    e[4] = v1; e[5] = d1; e[6] = f1; e[7] = g1;
+}
+
+static void horner4_x4(const double *c, int n, const double *x, double *e)
+{
+    double v[4], d[4] = {0.0, 0.0, 0.0, 0.0}, dd[4] = {0.0, 0.0, 0.0, 0.0}, d3[4] = {0.0, 0.0, 0.0, 0.0};
+    for (int j = 0; j < 4; ++j)
+        v[j] = c[n];
+    for (int k = n - 1; k >= 0; --k)
+        for (int j = 0; j < 4; ++j) {
+            d3[j] = d3[j] * x[j] + dd[j];
+            dd[j] = dd[j] * x[j] + d[j];
+            d[j] = d[j] * x[j] + v[j];
+            v[j] = v[j] * x[j] + c[k];
+        }
+    for (int j = 0; j < 4; ++j) {
+        e[4 * j] = v[j];
+        e[4 * j + 1] = d[j];
+        e[4 * j + 2] = dd[j];
+        e[4 * j + 3] = d3[j];
+    }
 }
 
 /* The fast path of the refinement: Halley's iteration x - p p' / (p'^2 - p p'' / 2), cubically convergent at
@@ -288,8 +287,9 @@ static inline int lane_start(halley_lane *s, double l, double r, double vl, doub
 }
 
 /* One iteration given p, p', p''/2 at s->x: LANE_DONE with the root in *root, LANE_MORE, or LANE_SAFE. */
-static inline int lane_step(halley_lane *s, double v, double d, double hdd, double tol, double *root)
+static inline int lane_step(halley_lane *s, const double *e, double tol, double *root)
 {
+    double v = e[0], d = e[1], hdd = e[2], h3 = e[3];
     double x = s->x;
     if (v == 0.0) {
         *root = x;
@@ -302,7 +302,8 @@ static inline int lane_step(halley_lane *s, double v, double d, double hdd, doub
         s->r = x;
         s->vr = v;
     }
-    double step = (v * d) / (d * d - v * hdd), xn = x - step;
+    double d2 = d * d;
+    double step = (v * (d2 - v * hdd)) / (d2 * d - 2.0 * v * d * hdd + v * v * h3), xn = x - step;
     double as = fabs(step);
     int ok = xn >= s->l && xn <= s->r; /* false also for NaN: a zero denominator */
     if (ok && as <= 4.0 * IG_U * fabs(xn)) {
@@ -311,7 +312,7 @@ static inline int lane_step(halley_lane *s, double v, double d, double hdd, doub
     }
     if (ok && s->prev < INFINITY) {
         double q = as / s->prev;
-        if (q <= 1e-3 && as <= 1e-3 * fabs(xn) && q * q * q * as <= tol * fabs(xn)) {
+        if (q <= 1e-3 && as <= 1e-3 * fabs(xn) && (q * q) * (q * q) * as <= tol * fabs(xn)) {
             *root = xn;
             return LANE_DONE;
         }
@@ -342,9 +343,9 @@ double ig_refine(const double *c, int n, double l, double r, double vl, double v
     double root;
     if (lane_start(&s, l, r, vl, vr, x0) == LANE_MORE)
         for (int it = 0; it < IG_HALLEY_ITERS; ++it) {
-            double v, d, hdd;
-            horner3(c, n, s.x, &v, &d, &hdd);
-            int st = lane_step(&s, v, d, hdd, tol, &root);
+            double e[4];
+            horner4(c, n, s.x, e);
+            int st = lane_step(&s, e, tol, &root);
             if (st == LANE_DONE)
                 return root;
             if (st == LANE_SAFE)
@@ -366,7 +367,7 @@ void ig_refine_many(const double *c, int n, int k, const double *l, const double
         for (int j = 0; j < m; ++j)
             state[j] = lane_start(&s[j], l[g + j], r[g + j], vl[g + j], vr[g + j], x0[g + j]);
         for (int it = 0; it < IG_HALLEY_ITERS; ++it) {
-            double x[4], v[4], d[4], hdd[4];
+            double x[4], e[16];
             int live = 0;
             for (int j = 0; j < 4; ++j) {
                 x[j] = j < m && state[j] == LANE_MORE ? s[j].x : 0.0;
@@ -375,12 +376,12 @@ void ig_refine_many(const double *c, int n, int k, const double *l, const double
             if (!live)
                 break;
             if (m <= 2)
-                horner3_x2(c, n, x, v, d, hdd);
+                horner4_x2(c, n, x, e);
             else
-                horner3_x4(c, n, x, v, d, hdd);
+                horner4_x4(c, n, x, e);
             for (int j = 0; j < m; ++j)
                 if (state[j] == LANE_MORE)
-                    state[j] = lane_step(&s[j], v[j], d[j], hdd[j], tol, &roots[g + j]);
+                    state[j] = lane_step(&s[j], e + 4 * j, tol, &roots[g + j]);
         }
         for (int j = 0; j < m; ++j)
             if (state[j] != LANE_DONE)

@@ -59,6 +59,16 @@ static int BZ_FN(variations)(const double *b, int n, double tol, int sl, int sr)
 {
     int v = 0, last = sl, pending = 0;
     (void)n;
+    /* the common case without branches on the data: every interior sign certain */
+    int certain = 0, changes = 0, prev = sl > 0;
+    for (int i = 1; i < N; ++i) {
+        int pos = b[i] > 0.0;
+        certain += fabs(b[i]) > tol;
+        changes += pos != prev;
+        prev = pos;
+    }
+    if (certain == N - 1)
+        return changes + ((sr > 0) != prev);
     for (int i = 1; i < N; ++i) {
         if (!(fabs(b[i]) > tol)) {
             ++pending;
@@ -81,11 +91,14 @@ static int BZ_FN(variations)(const double *b, int n, double tol, int sl, int sr)
 static double BZ_FN(polygon_crossing)(const double *b, int n, double tl, double tr)
 {
     (void)n;
-    for (int i = 0; i < N; ++i)
-        if ((b[i] > 0.0) != (b[i + 1] > 0.0) && b[i] != b[i + 1]) {
-            double s = (i + b[i] / (b[i] - b[i + 1])) / N;
-            return tl + s * (tr - tl);
-        }
+    /* one sign change (the caller's case): it follows the leading run of coefficients with b_0's sign */
+    int i = 0, lead = b[0] > 0.0;
+    for (int j = 1; j < N; ++j)
+        i += (b[j] > 0.0) == lead;
+    if ((b[i] > 0.0) != (b[i + 1] > 0.0) && b[i] != b[i + 1]) {
+        double s = (i + b[i] / (b[i] - b[i + 1])) / N;
+        return tl + s * (tr - tl);
+    }
     return NAN;
 }
 
