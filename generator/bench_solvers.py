@@ -390,6 +390,26 @@ def _score(c, lo, hi, roots_of: Callable[[int], np.ndarray], ref, scorer=score_o
     return total
 
 
+#: polynomials per round of the interleaved timing (see _time_interleaved)
+CHUNK = 5000
+
+
+def _time_interleaved(c: np.ndarray, lo: np.ndarray, hi: np.ndarray, methods: list[str],
+                      first_methods: list[str]) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray, float]]:
+    """Time every method (all roots) and every first-root method on the same CHUNK polynomials in turn, chunk
+    after chunk, and join the pieces: each method then sees the machine in the same state. On a shared virtual
+    machine the speed drifts by tens of percent within a minute, which timing one method after the other turned
+    into ratio errors of the same size. Returns {name: (roots, counts, ns per solve, untimed total ns)}."""
+    jobs = [(m, m, bench_solve_batch) for m in methods] + [(m + FIRST, m, bench_first_batch) for m in first_methods]
+    parts: dict[str, list] = {name: [] for name, _, _ in jobs}
+    for s in range(0, c.shape[0], CHUNK):
+        sl = slice(s, s + CHUNK)
+        for name, m, fn in jobs:
+            parts[name].append(fn(c[sl], lo[sl], hi[sl], m))
+    return {name: (np.concatenate([p[0] for p in ps]), np.concatenate([p[1] for p in ps]),
+                   np.concatenate([p[2] for p in ps]), float(sum(p[3] for p in ps))) for name, ps in parts.items()}
+
+
 def run(timed: int, nref: int, seed: int, methods: list[str], sets: list[CaseSet], log=print,
         first_methods: list[str] | None = None, shapes_dir: str | Path | None = None) -> list[Row]:
     first_methods = FIRST_METHODS if first_methods is None else first_methods
@@ -401,12 +421,13 @@ def run(timed: int, nref: int, seed: int, methods: list[str], sets: list[CaseSet
         ref = reference(c[:nref])
         log(f"  {cs.name}: {c.shape[0]} polynomials (degree <= {c.shape[1] - 1}), reference on {len(ref)} "
             f"in {time.time() - t:.1f} s")
+        timings = _time_interleaved(c, lo, hi, methods, first_methods)
         for m in methods:
-            roots, counts, ns, total = bench_solve_batch(c, lo, hi, m)
+            roots, counts, ns, total = timings[m]
             sc = _score(c, lo, hi, lambda i: roots[i, : counts[i]], ref)
             rows.append(Row(cs.name, m, float(np.median(ns)), total / c.shape[0], sc, c.shape[0]))
         for m in first_methods:
-            r1, n1, ns, total = bench_first_batch(c, lo, hi, m)
+            r1, n1, ns, total = timings[m + FIRST]
             sc = _score(c, lo, hi, lambda i: r1[i : i + n1[i]], ref, score_first)
             rows.append(Row(cs.name, m + FIRST, float(np.median(ns)), total / c.shape[0], sc, c.shape[0]))
         k = min(c.shape[0], max(nref, 2000))

@@ -6,8 +6,9 @@
  * the Bernstein basis), so
  *   - no sign change: no root on the piece;
  *   - one sign change: exactly one root, a simple one, and b_0 = q(0), b_n = q(1) bracket it: it is refined
- *     by the same safeguarded Newton on the ORIGINAL coefficients the bracketing method uses, so the root is
- *     as accurate as bracketing's;
+ *     by the same ig_refine on the ORIGINAL coefficients the bracketing method uses, so the root is as
+ *     accurate as bracketing's. All-roots mode collects the brackets and refines them together at the end
+ *     (ig_refine_many: their evaluations overlap), first-root mode refines the first one at once;
  *   - more: the piece is halved (de Casteljau at s = 1/2, exact weights) and both halves examined, left first.
  * Splitting the control polygon converges to the curve quadratically, so well separated roots are isolated
  * after a few halvings. In first-root mode the leftmost piece that holds a root ends the search, which is

@@ -24,10 +24,11 @@ void ig_horner2(const double *c, int n, double x, double *p, double *dp);
  * a compensated (twice-the-working-precision) evaluation -- then x is taken as a root. *val gets p(x). */
 int ig_sign_certified(const double *c, int n, double x, double *val);
 
-/* Safeguarded Newton on a bracket [l, r] where c changes sign (sl = sign at l, nonzero). Never leaves the
- * bracket, bisects (in the ordering of doubles, so at most 64 halvings span the whole range) when a Newton
- * step would, and stops after a bounded number of iterations. tol: relative accuracy wanted (2^-52: full);
- * x0: a starting guess (NaN or outside the bracket: false position). */
+/* The root of c on a bracket [l, r] where c changes sign (vl, vr: the values there, nonzero): Householder's
+ * third-order step (order-four convergence) with bisection, then, for anything unusual, a safeguarded Newton
+ * that bisects in the ordering of doubles (at most 64 halvings span the whole range). Never leaves the
+ * bracket; a bounded number of iterations. tol: relative accuracy wanted (2^-52: full); x0: a starting guess
+ * (NaN or outside the bracket: false position). */
 double ig_refine(const double *c, int n, double l, double r, double vl, double vr, double tol, double x0);
 
 /* ig_refine on k brackets of the same polynomial at once (four evaluation chains in flight): roots[i] is

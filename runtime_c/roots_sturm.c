@@ -1,11 +1,11 @@
-/* Sturm-sequence isolation (after Hook & McAree, Graphics Gems I) with safeguarded Newton refinement.
+/* Sturm-sequence isolation (after Hook & McAree, Graphics Gems I) with safeguarded refinement (ig_refine).
  *
  * The sequence p, p', -rem(p, p'), ... is built in floating point, each member scaled to a largest
  * coefficient of 1. A remainder whose coefficients are all within the rounding error of the division that
  * produced it ends the sequence: the last member is then (numerically) gcd(p, p'), and the variation count
  * still counts DISTINCT roots, so a tangent (double) root is counted once. [a, b] is bisected (in the
  * ordering of doubles) until each piece holds one root; a piece where p changes sign is refined by the same
- * safeguarded Newton the bracketing method uses, so the two methods are compared at equal accuracy; a piece
+ * ig_refine the bracketing method uses, so the two methods are compared at equal accuracy; a piece
  * without a sign change holds an even-multiplicity root and is narrowed by counting alone.
  */
 #include "roots_impl.h"

@@ -32,6 +32,12 @@ def test_roots_hard_cases_under_sanitizers(tmp_path: Path) -> None:
     assert "all cases passed" in run.stdout
 
 
+def test_refinement_batched_equals_single_under_sanitizers(tmp_path: Path) -> None:
+    run = _build_and_run(tmp_path, "test_refine", [CDIR / "test_refine.c", *sorted(RUNTIME.glob("roots*.c"))])
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "all refinement checks passed" in run.stdout
+
+
 def test_far_torus_matches_near_torus_under_sanitizers(tmp_path: Path) -> None:
     run = _build_and_run(tmp_path, "test_shape_torus",
                          [CDIR / "test_shape_torus.c", CDIR / "shape_torus_fixture.c", RUNTIME / "shape.c",
