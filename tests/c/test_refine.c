@@ -8,22 +8,10 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "poly_from_roots.h"
 #include "roots_impl.h"
 
 static int failures = 0;
-
-/* c = scale * prod (x - r_i), lowest power first; returns the degree */
-static int from_roots(const double *r, int nr, double scale, double *c)
-{
-    c[0] = scale;
-    for (int i = 0; i < nr; ++i) {
-        c[i + 1] = 0.0;
-        for (int k = i + 1; k >= 1; --k)
-            c[k] = c[k - 1] - r[i] * c[k];
-        c[0] = -r[i] * c[0];
-    }
-    return nr;
-}
 
 static double eval(const double *c, int n, double x)
 {
@@ -60,7 +48,7 @@ static void check(const char *name, const double *c, int n, int k, const double 
 static void simple_roots(const char *name, const double *roots, int nr, int guess)
 {
     double c[IG_MAX_DEGREE + 1], l[IG_MAX_DEGREE], r[IG_MAX_DEGREE], x0[IG_MAX_DEGREE];
-    int n = from_roots(roots, nr, 1.0, c);
+    int n = from_roots(roots, nr, NULL, 0, 1.0, c);
     for (int i = 0; i < nr; ++i) {
         l[i] = i == 0 ? roots[0] - 1.0 : 0.5 * (roots[i - 1] + roots[i]);
         r[i] = i == nr - 1 ? roots[nr - 1] + 1.0 : 0.5 * (roots[i] + roots[i + 1]);
@@ -84,13 +72,13 @@ int main(void)
     { /* a triple root: Householder converges only linearly there, the safeguarded Newton finishes; the
        * polynomial's rounding limits the accuracy to about u^(1/3) */
         double roots[] = {1.0, 1.0, 1.0, -2.0}, c[5];
-        int n = from_roots(roots, 4, 1.0, c);
+        int n = from_roots(roots, 4, NULL, 0, 1.0, c);
         double l[] = {0.5, -3.0}, r[] = {1.7, 0.0}, x0[] = {1.6, NAN}, want[] = {1.0, -2.0};
         check("triple root beside a simple one", c, n, 2, l, r, x0, want, 1e-4);
     }
     { /* a root at 1e-13 in a bracket reaching 1e27 (|x|^n growth: bisection in the ordering of doubles) */
         double roots[] = {1e-13, -1.0, -2.0}, c[4];
-        int n = from_roots(roots, 3, 1.0, c);
+        int n = from_roots(roots, 3, NULL, 0, 1.0, c);
         double l[] = {0.0, -1.5}, r[] = {1e27, -0.5}, x0[] = {NAN, NAN}, want[] = {1e-13, -1.0};
         check("root near 0 in a huge bracket", c, n, 2, l, r, x0, want, 1e-14);
     }
