@@ -206,7 +206,8 @@ static double refine_safe(const double *c, int n, double l, double r, double vl,
     return x;
 }
 
-/* p(x), p'(x), p''(x) / 2 and p^(3)(x) / 6 by one Horner pass (independent chains). */
+/* p(x), p'(x), p''(x) / 2 and p^(3)(x) / 6 into e[0..3] by one Horner pass: four independent chains, so about
+ * the latency of p alone. */
 static void horner4(const double *c, int n, double x, double *e)
 {
     double v = c[n], d = 0.0, dd = 0.0, d3 = 0.0;
@@ -222,6 +223,9 @@ static void horner4(const double *c, int n, double x, double *e)
     e[3] = d3;
 }
 
+/* The same at two points (e[0..3], e[4..7]) and at four (e[4j..4j+3]): independent chains again, so two or four
+ * roots are refined in about the time of one. Bitwise the same operations as horner4 for each point, which is
+ * what makes ig_refine_many equal to ig_refine lane by lane. */
 static void horner4_x2(const double *c, int n, const double *x, double *e)
 {
     double v0 = c[n], v1 = c[n], d0 = 0.0, d1 = 0.0, f0 = 0.0, f1 = 0.0, g0 = 0.0, g1 = 0.0;
@@ -270,7 +274,7 @@ static void horner4_x4(const double *c, int n, const double *x, double *e)
  * only once the iterate is in the asymptotic range: q <= 1e-3 and the step below 1e-3 |x| (a first step from
  * far away says nothing about the error). A step that leaves the bracket or does not at least halve is
  * replaced by bisection of the bracket. Steps that shrink only linearly near the root (a multiple root,
- * rounding noise) and a ninth evaluation hand the narrowed bracket and the iterate to refine_safe above,
+ * rounding noise) and eight evaluations without convergence hand the narrowed bracket and the iterate to refine_safe above,
  * whose rules handle multiple roots, huge ranges and rounding noise. */
 typedef struct {
     double x, l, r, vl, vr, prev;
@@ -294,7 +298,7 @@ static inline int lane_start(hh_lane *s, double l, double r, double vl, double v
     return s->x > l && s->x < r ? LANE_MORE : LANE_SAFE;
 }
 
-/* One iteration given p, p', p''/2 at s->x: LANE_DONE with the root in *root, LANE_MORE, or LANE_SAFE. */
+/* One iteration given e = p, p', p''/2, p'''/6 at s->x: LANE_DONE with the root in *root, LANE_MORE, or LANE_SAFE. */
 static inline int lane_step(hh_lane *s, const double *e, double tol, double *root)
 {
     double v = e[0], d = e[1], hdd = e[2], h3 = e[3];
