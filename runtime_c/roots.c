@@ -206,56 +206,25 @@ static double refine_safe(const double *c, int n, double l, double r, double vl,
     return x;
 }
 
-/* p(x), p'(x), p''(x) / 2 and p^(3)(x) / 6 into e[0..3] by one Horner pass: four independent chains, so about
- * the latency of p alone. */
-static void horner4(const double *c, int n, double x, double *e)
+/* p(x), p'(x), p''(x) / 2 and p^(3)(x) / 6 at K points x[j] into e[4j .. 4j+3], by one Horner pass: 4K
+ * independent chains, so K roots are refined in about the time of one (evaluation is latency-bound). Always
+ * inlined with a constant K (1, 2, 4), so the compiler keeps the chains in registers; the operations for each
+ * point are the same whatever K is, which is what makes ig_refine_many equal to ig_refine lane by lane. */
+static inline void horner4(const double *c, int n, const double *x, double *e, const int K)
 {
-    double v = c[n], d = 0.0, dd = 0.0, d3 = 0.0;
-    for (int k = n - 1; k >= 0; --k) {
-        d3 = d3 * x + dd;
-        dd = dd * x + d;
-        d = d * x + v;
-        v = v * x + c[k];
-    }
-    e[0] = v;
-    e[1] = d;
-    e[2] = dd;
-    e[3] = d3;
-}
-
-/* The same at two points (e[0..3], e[4..7]) and at four (e[4j..4j+3]): independent chains again, so two or four
- * roots are refined in about the time of one. Bitwise the same operations as horner4 for each point, which is
- * what makes ig_refine_many equal to ig_refine lane by lane. */
-static void horner4_x2(const double *c, int n, const double *x, double *e)
-{
-    double v0 = c[n], v1 = c[n], d0 = 0.0, d1 = 0.0, f0 = 0.0, f1 = 0.0, g0 = 0.0, g1 = 0.0;
-    for (int k = n - 1; k >= 0; --k) {
-        g0 = g0 * x[0] + f0;
-        g1 = g1 * x[1] + f1;
-        f0 = f0 * x[0] + d0;
-        f1 = f1 * x[1] + d1;
-        d0 = d0 * x[0] + v0;
-        d1 = d1 * x[1] + v1;
-        v0 = v0 * x[0] + c[k];
-        v1 = v1 * x[1] + c[k];
-    }
-    e[0] = v0; e[1] = d0; e[2] = f0; e[3] = g0;
-    e[4] = v1; e[5] = d1; e[6] = f1; e[7] = g1;
-}
-
-static void horner4_x4(const double *c, int n, const double *x, double *e)
-{
-    double v[4], d[4] = {0.0, 0.0, 0.0, 0.0}, dd[4] = {0.0, 0.0, 0.0, 0.0}, d3[4] = {0.0, 0.0, 0.0, 0.0};
-    for (int j = 0; j < 4; ++j)
+    double v[4], d[4], dd[4], d3[4];
+    for (int j = 0; j < K; ++j) {
         v[j] = c[n];
+        d[j] = dd[j] = d3[j] = 0.0;
+    }
     for (int k = n - 1; k >= 0; --k)
-        for (int j = 0; j < 4; ++j) {
+        for (int j = 0; j < K; ++j) {
             d3[j] = d3[j] * x[j] + dd[j];
             dd[j] = dd[j] * x[j] + d[j];
             d[j] = d[j] * x[j] + v[j];
             v[j] = v[j] * x[j] + c[k];
         }
-    for (int j = 0; j < 4; ++j) {
+    for (int j = 0; j < K; ++j) {
         e[4 * j] = v[j];
         e[4 * j + 1] = d[j];
         e[4 * j + 2] = dd[j];
@@ -267,15 +236,15 @@ static void horner4_x4(const double *c, int n, const double *x, double *e)
  *     x - p (p'^2 - p p''/2) / (p'^3 - p p' p'' + p^2 p'''/6),
  * which converges with order four (Halley's step, one order lower, drops the p^2 p''' term). p''' costs a
  * fourth Horner chain that runs alongside the others, and evaluation is latency-bound, so a step costs about
- * what a Newton step does: from a start one or two digits right, two evaluations give full accuracy where
- * Newton needs three or four (measured in `implgen bench solvers`). It stops when the step is at rounding
- * level, or when the error it predicts for the new iterate, |step| q^4 with q = |step| / |previous step|
- * (order-four convergence, constant estimated from the last two steps), is below the tolerance -- trusted
- * only once the iterate is in the asymptotic range: q <= 1e-3 and the step below 1e-3 |x| (a first step from
- * far away says nothing about the error). A step that leaves the bracket or does not at least halve is
- * replaced by bisection of the bracket. Steps that shrink only linearly near the root (a multiple root,
- * rounding noise) and eight evaluations without convergence hand the narrowed bracket and the iterate to refine_safe above,
- * whose rules handle multiple roots, huge ranges and rounding noise. */
+ * what a Newton step does: from a start two digits right the error goes 1e-2 -> 1e-8 -> 1e-32, so two
+ * evaluations give full accuracy where Newton's 1e-2 -> 1e-4 -> 1e-8 -> 1e-16 needs four. It stops when the
+ * step is at rounding level, or when the error it predicts for the new iterate, |step| q^4 with q = |step| /
+ * |previous step| (order-four convergence, constant estimated from the last two steps), is below the tolerance
+ * -- trusted only once the iterate is in the asymptotic range: q <= 1e-3 and the step below 1e-3 |x| (a first
+ * step from far away says nothing about the error). A step that leaves the bracket or does not at least halve
+ * is replaced by bisection of the bracket. Steps that shrink only linearly near the root (a multiple root,
+ * rounding noise) and eight evaluations without convergence hand the narrowed bracket and the iterate to
+ * refine_safe above, whose rules handle multiple roots, huge ranges and rounding noise. */
 typedef struct {
     double x, l, r, vl, vr, prev;
     int positive_left;
@@ -298,7 +267,8 @@ static inline int lane_start(hh_lane *s, double l, double r, double vl, double v
     return s->x > l && s->x < r ? LANE_MORE : LANE_SAFE;
 }
 
-/* One iteration given e = p, p', p''/2, p'''/6 at s->x: LANE_DONE with the root in *root, LANE_MORE, or LANE_SAFE. */
+/* One iteration given e = p, p', p''/2, p'''/6 at s->x: LANE_DONE with the root in *root, LANE_MORE or
+ * LANE_SAFE. */
 static inline int lane_step(hh_lane *s, const double *e, double tol, double *root)
 {
     double v = e[0], d = e[1], hdd = e[2], h3 = e[3];
@@ -360,7 +330,7 @@ double ig_refine(const double *c, int n, double l, double r, double vl, double v
     if (lane_start(&s, l, r, vl, vr, x0) == LANE_MORE)
         for (int it = 0; it < IG_FAST_ITERS; ++it) {
             double e[4];
-            horner4(c, n, s.x, e);
+            horner4(c, n, &s.x, e, 1);
             int st = lane_step(&s, e, tol, &root);
             if (st == LANE_DONE)
                 return root;
@@ -392,9 +362,9 @@ void ig_refine_many(const double *c, int n, int k, const double *l, const double
             if (!live)
                 break;
             if (m <= 2)
-                horner4_x2(c, n, x, e);
+                horner4(c, n, x, e, 2);
             else
-                horner4_x4(c, n, x, e);
+                horner4(c, n, x, e, 4);
             for (int j = 0; j < m; ++j)
                 if (state[j] == LANE_MORE)
                     state[j] = lane_step(&s[j], e + 4 * j, tol, &roots[g + j]);
