@@ -28,7 +28,7 @@ import numpy as np
 
 from . import raycast
 from .errors import UserError
-from .roots import bench_solve_batch, library, method_id
+from .roots import bench_first_batch, bench_solve_batch
 from .roots_reference import Score, reference, score_first, score_one
 
 METHODS = ["closed_plain", "closed", "sturm", "bracket", "bernstein", "auto"]
@@ -358,29 +358,6 @@ class Row:
 #: methods also timed in first-root mode (ig_first_root: the nearest hit, what the tracer asks for)
 FIRST_METHODS = ["bernstein", "auto"]
 FIRST = " (first root)"
-
-
-def bench_first_batch(coeffs: np.ndarray, lo: np.ndarray, hi: np.ndarray, method: str):
-    """First-root twin of implgen.roots.bench_solve_batch (runtime_c/roots_bench.c: ig_bench_first_batch):
-    (roots with NaN where none, counts 0/1, ns per solve, total ns of the untimed pass)."""
-    import ctypes
-
-    lib = library()
-    fn = lib.ig_bench_first_batch
-    dp, ip = ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_int)
-    fn.restype = ctypes.c_double
-    fn.argtypes = [dp, ctypes.c_int, ctypes.c_long, dp, dp, ctypes.c_int, dp, ip, dp]
-    c = np.ascontiguousarray(coeffs, dtype=np.float64)
-    count, n = c.shape[0], c.shape[1] - 1
-    lo_a = np.ascontiguousarray(np.broadcast_to(np.asarray(lo, dtype=np.float64), (count,)))
-    hi_a = np.ascontiguousarray(np.broadcast_to(np.asarray(hi, dtype=np.float64), (count,)))
-    roots = np.empty(count, dtype=np.float64)
-    counts = np.empty(count, dtype=np.intc)
-    ns = np.empty(count, dtype=np.float64)
-    total = fn(c.ctypes.data_as(dp), n, count, lo_a.ctypes.data_as(dp), hi_a.ctypes.data_as(dp),
-               method_id(method, bench=True), roots.ctypes.data_as(dp), counts.ctypes.data_as(ip),
-               ns.ctypes.data_as(dp))
-    return roots, counts.astype(np.int64), ns, float(total)
 
 
 def _score(c, lo, hi, roots_of: Callable[[int], np.ndarray], ref, scorer=score_one) -> Score:

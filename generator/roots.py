@@ -48,6 +48,8 @@ def library() -> ctypes.CDLL:
     lib.ig_first_root_batch.argtypes = [_DP, ctypes.c_int, ctypes.c_long, _DP, _DP, ctypes.c_int, _DP, _IP]
     lib.ig_bench_solve_batch.restype = ctypes.c_double
     lib.ig_bench_solve_batch.argtypes = [_DP, ctypes.c_int, ctypes.c_long, _DP, _DP, ctypes.c_int, _DP, _IP, _DP]
+    lib.ig_bench_first_batch.restype = ctypes.c_double
+    lib.ig_bench_first_batch.argtypes = [_DP, ctypes.c_int, ctypes.c_long, _DP, _DP, ctypes.c_int, _DP, _IP, _DP]
     return lib
 
 
@@ -72,6 +74,28 @@ def _bounds(value: ArrayLike, count: int) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(np.asarray(value, dtype=np.float64), (count,)))
 
 
+def _batch(entry: str, coeffs: ArrayLike, lo: ArrayLike, hi: ArrayLike, method: str, first: bool,
+           timed: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """Call one of the C batch entry points: (roots, counts, ns per solve, untimed total ns). first: one root per
+    polynomial (NaN where none), else a row of degree entries padded with NaN; timed: the bench entry points,
+    which also fill ns and return the total (else ns is left empty and the total is 0)."""
+    mid = method_id(method, bench=True)
+    c = _coeff_matrix(coeffs)
+    count, n = c.shape[0], c.shape[1] - 1
+    lo_a, hi_a = _bounds(lo, count), _bounds(hi, count)
+    roots = np.empty(count if first else (count, n), dtype=np.float64)
+    counts = np.empty(count, dtype=np.intc)
+    ns = np.empty(count, dtype=np.float64)
+    total = 0.0
+    if count:
+        args = [c.ctypes.data_as(_DP), n, count, lo_a.ctypes.data_as(_DP), hi_a.ctypes.data_as(_DP), mid,
+                roots.ctypes.data_as(_DP), counts.ctypes.data_as(_IP)]
+        if timed:
+            args.append(ns.ctypes.data_as(_DP))
+        total = getattr(library(), entry)(*args) or 0.0
+    return roots, counts.astype(np.int64), ns, float(total)
+
+
 def real_roots(coeffs: ArrayLike, lo: float = -np.inf, hi: float = np.inf, method: str = "auto") -> np.ndarray:
     """All distinct real roots of c[0] + c[1] t + ... in [lo, hi], ascending (tangent roots once)."""
     c = np.asarray(coeffs, dtype=np.float64)
@@ -90,18 +114,8 @@ def real_roots_batch(
     Returns (roots, counts): roots has shape (count, degree), row i ascending in its first counts[i]
     entries and NaN after.
     """
-    mid = method_id(method, bench=True)
-    c = _coeff_matrix(coeffs)
-    count, n = c.shape[0], c.shape[1] - 1
-    lo_a, hi_a = _bounds(lo, count), _bounds(hi, count)
-    roots = np.empty((count, n), dtype=np.float64)
-    counts = np.empty(count, dtype=np.intc)
-    if count:
-        library().ig_real_roots_batch(
-            c.ctypes.data_as(_DP), n, count, lo_a.ctypes.data_as(_DP), hi_a.ctypes.data_as(_DP), mid,
-            roots.ctypes.data_as(_DP), counts.ctypes.data_as(_IP),
-        )
-    return roots, counts.astype(np.int64)
+    roots, counts, _, _ = _batch("ig_real_roots_batch", coeffs, lo, hi, method, first=False, timed=False)
+    return roots, counts
 
 
 def first_root(coeffs: ArrayLike, lo: float = -np.inf, hi: float = np.inf, method: str = "auto") -> float | None:
@@ -117,18 +131,8 @@ def first_root_batch(
     coeffs: ArrayLike, lo: ArrayLike = -np.inf, hi: ArrayLike = np.inf, method: str = "auto"
 ) -> tuple[np.ndarray, np.ndarray]:
     """first_root over many polynomials of one degree: (roots with NaN where none, counts 0 or 1)."""
-    mid = method_id(method, bench=True)
-    c = _coeff_matrix(coeffs)
-    count, n = c.shape[0], c.shape[1] - 1
-    lo_a, hi_a = _bounds(lo, count), _bounds(hi, count)
-    roots = np.empty(count, dtype=np.float64)
-    counts = np.empty(count, dtype=np.intc)
-    if count:
-        library().ig_first_root_batch(
-            c.ctypes.data_as(_DP), n, count, lo_a.ctypes.data_as(_DP), hi_a.ctypes.data_as(_DP), mid,
-            roots.ctypes.data_as(_DP), counts.ctypes.data_as(_IP),
-        )
-    return roots, counts.astype(np.int64)
+    roots, counts, _, _ = _batch("ig_first_root_batch", coeffs, lo, hi, method, first=True, timed=False)
+    return roots, counts
 
 
 def bench_solve_batch(
@@ -136,15 +140,12 @@ def bench_solve_batch(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """Like real_roots_batch, plus the time of every solve measured in C (ns) and the total time (ns) of an
     untimed second pass (throughput)."""
-    mid = method_id(method, bench=True)
-    c = _coeff_matrix(coeffs)
-    count, n = c.shape[0], c.shape[1] - 1
-    lo_a, hi_a = _bounds(lo, count), _bounds(hi, count)
-    roots = np.empty((count, n), dtype=np.float64)
-    counts = np.empty(count, dtype=np.intc)
-    ns = np.empty(count, dtype=np.float64)
-    total = library().ig_bench_solve_batch(
-        c.ctypes.data_as(_DP), n, count, lo_a.ctypes.data_as(_DP), hi_a.ctypes.data_as(_DP), mid,
-        roots.ctypes.data_as(_DP), counts.ctypes.data_as(_IP), ns.ctypes.data_as(_DP),
-    )
-    return roots, counts.astype(np.int64), ns, float(total)
+    return _batch("ig_bench_solve_batch", coeffs, lo, hi, method, first=False, timed=True)
+
+
+def bench_first_batch(
+    coeffs: np.ndarray, lo: ArrayLike, hi: ArrayLike, method: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """First-root twin of bench_solve_batch (runtime_c/roots_bench.c: ig_bench_first_batch): (roots with NaN
+    where none, counts 0/1, ns per solve, total ns of the untimed pass)."""
+    return _batch("ig_bench_first_batch", coeffs, lo, hi, method, first=True, timed=True)
