@@ -92,10 +92,10 @@ def plan_shapes(scene: Scene, fold: bool) -> tuple[list[ShapeEntry], dict[int, i
         if key not in index:
             base = spec.name
             name, k = base, 1
-            while name in used:
+            while name.lower() in used:   # without case: Torus.h and torus.h are one file on some systems
                 k += 1
                 name = f"{base}_{k}"
-            used.add(name)
+            used.add(name.lower())
             if fold and spec.params:
                 s2 = spec.specialise(leaf.params, name=name)
             elif name != spec.name:

@@ -13,7 +13,8 @@ import numpy as np
 
 from .cbuild import build_shared
 from .derive import derive
-from .emit import derivation_ops, generate, write_files
+from .emit import derivation_ops, generate
+from .outputs import write_text_files
 from .errors import UserError
 from .resources import runtime_dir
 from .spec import load_spec
@@ -56,7 +57,7 @@ def main(argv: Sequence[str]) -> int:
         start = time.perf_counter()
         spec = load_spec(path)
         derivation = derive(spec)
-        write_files(generate(spec, ("c", "python"), derivation), gen_dir)
+        write_text_files(generate(spec, ("c", "python"), derivation), gen_dir)
         ms = (time.perf_counter() - start) * 1000
         rows.append((spec, derivation_ops(derivation, "coeffs"), ms))
     build_shared([gen_dir / f"{s.name}.c" for s, _, _ in rows] + sorted(runtime_dir().glob("roots*.c"))

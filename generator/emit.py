@@ -1,16 +1,15 @@
 """Derivation -> source files, one backend per language: a SymPy code printer + Jinja2 templates.
 
-`generate(spec, langs)` returns {file name: text}; `write_files` puts them on disk atomically. Output is
+`generate(spec, langs)` returns {file name: text}; `outputs.write_text_files` puts them on disk atomically. Output is
 deterministic (byte-identical on rerun), so the checked-in `generated/` folder can be compared in tests.
 """
 
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
-from typing import Callable, Iterable, Mapping
+from typing import Callable, Iterable
 
 import jinja2
 import sympy
@@ -18,14 +17,27 @@ from sympy.codegen.rewriting import create_expand_pow_optimization, optimize
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.pycode import PythonCodePrinter
 
-from . import __version__
+from . import __version__, escape
 from .derive import DIRECTION, ORIGIN, POINT, Block, Derivation, derive
+from .errors import UserError
 from .resources import templates_dir
 from .spec import Spec
 
 LANGS = ("c", "python")
 _EXPAND_POW = create_expand_pow_optimization(3)  # b**2, b**3 -> b*b, b*b*b; higher powers are chained
 _EXACT_INT = 2 ** 53
+
+
+class ConstantRangeError(ValueError):
+    """A constant of the generated code is not a finite double (the spec's coefficients are too large)."""
+
+
+def _finite_double(p: int, q: int = 1) -> float:
+    try:
+        return float(Fraction(p, q))
+    except OverflowError:
+        raise ConstantRangeError(f"a constant of the generated code ({'beyond' if abs(p) > q else 'below'} "
+                                 "double range) comes from the equation's coefficients") from None
 
 
 class CPrinter(C99CodePrinter):
@@ -35,7 +47,11 @@ class CPrinter(C99CodePrinter):
         value = int(expr)
         if abs(value) < 2 ** 31:
             return str(value)
-        return repr(float(value)) if abs(value) < _EXACT_INT else f"{float(value):.17g}"
+        return repr(_finite_double(value)) if abs(value) < _EXACT_INT else f"{_finite_double(value):.17g}"
+
+    def _print_Rational(self, expr: sympy.Rational) -> str:  # noqa: N802
+        _finite_double(int(expr.p), int(expr.q))
+        return super()._print_Rational(expr)
 
     def _print_Infinity(self, expr: sympy.Expr) -> str:  # noqa: N802
         return "INFINITY"
@@ -49,7 +65,11 @@ class PyPrinter(PythonCodePrinter):
 
     def _print_Integer(self, expr: sympy.Integer) -> str:  # noqa: N802
         value = int(expr)
-        return str(value) if abs(value) < _EXACT_INT else f"{float(value):.17g}"
+        return str(value) if abs(value) < _EXACT_INT else f"{_finite_double(value):.17g}"
+
+    def _print_Rational(self, expr: sympy.Rational) -> str:  # noqa: N802
+        _finite_double(int(expr.p), int(expr.q))
+        return super()._print_Rational(expr)
 
     def _print_Infinity(self, expr: sympy.Expr) -> str:  # noqa: N802
         return "math.inf"
@@ -77,7 +97,7 @@ def _print_block(block: Block, doprint: Callable[[sympy.Expr], str]) -> PrintedB
 
 
 def _environment() -> jinja2.Environment:
-    return jinja2.Environment(
+    env = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(templates_dir())),
         undefined=jinja2.StrictUndefined,
         keep_trailing_newline=True,
@@ -85,6 +105,10 @@ def _environment() -> jinja2.Environment:
         lstrip_blocks=True,
         autoescape=False,
     )
+    # Text in comments, docstrings and string literals goes through the filter for the place it lands in.
+    env.filters.update(c_comment=escape.c_comment, c_string=escape.c_string, py_doc=escape.py_docstring,
+                       py_str=escape.py_string)
+    return env
 
 
 def _context(derivation: Derivation, doprint: Callable[[sympy.Expr], str]) -> dict:
@@ -105,7 +129,7 @@ def _context(derivation: Derivation, doprint: Callable[[sympy.Expr], str]) -> di
         "degree": spec.degree,
         "params": [(p, f"k_{p}", repr(float(v))) for p, v in spec.params.items()],
         "folded": [(p, repr(v)) for p, v in spec.folded.items()],
-        "equation": " ".join(spec.equation.split()),
+        "equation": spec.equation,
         "ops": {k: derivation_ops(derivation, k) for k in ("coeffs", "value", "gradient")},
         "blocks": blocks,
         "origin": [s.name for s in ORIGIN],
@@ -130,33 +154,17 @@ def generate(spec: Spec, langs: Iterable[str] = LANGS, derivation: Derivation | 
     derivation = derivation or derive(spec)
     env = _environment()
     files: dict[str, str] = {}
-    for lang in langs:
-        if lang == "c":
-            ctx = _context(derivation, CPrinter().doprint)
-            files[f"{spec.name}.h"] = _render(env, "c/shape.h.j2", ctx)
-            files[f"{spec.name}.c"] = _render(env, "c/shape.c.j2", ctx)
-        elif lang == "python":
-            ctx = _context(derivation, PyPrinter().doprint)
-            files[f"{spec.name}.py"] = _render(env, "python/shape.py.j2", ctx)
-        else:
-            raise ValueError(f"unknown language {lang!r}")
+    try:
+        for lang in langs:
+            if lang == "c":
+                ctx = _context(derivation, CPrinter().doprint)
+                files[f"{spec.name}.h"] = _render(env, "c/shape.h.j2", ctx)
+                files[f"{spec.name}.c"] = _render(env, "c/shape.c.j2", ctx)
+            elif lang == "python":
+                ctx = _context(derivation, PyPrinter().doprint)
+                files[f"{spec.name}.py"] = _render(env, "python/shape.py.j2", ctx)
+            else:
+                raise ValueError(f"unknown language {lang!r}")
+    except ConstantRangeError as err:
+        raise UserError(spec.source, f"equation: {err}") from None
     return files
-
-
-def write_files(files: Mapping[str, str], outdir: Path) -> list[Path]:
-    """Write every file atomically (temporary file + rename): a failure leaves nothing half-written."""
-    outdir.mkdir(parents=True, exist_ok=True)
-    written = []
-    for fname, text in files.items():
-        target = outdir / fname
-        fd, tmp = tempfile.mkstemp(prefix=f".{fname}.", dir=outdir)
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-                fh.write(text)
-            os.replace(tmp, target)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
-        written.append(target)
-    return written

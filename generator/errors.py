@@ -12,9 +12,16 @@ class UserError(Exception):
     """
 
     def __init__(self, source: str | Path | None, message: str) -> None:
-        self.source = str(source) if source is not None else None
-        self.message = " ".join(str(message).split())  # always one line
+        self.source = _one_line(str(source)) if source is not None else None
+        self.message = _one_line(str(message))
         super().__init__(str(self))
 
     def __str__(self) -> str:
         return f"{self.source}: {self.message}" if self.source else self.message
+
+
+def _one_line(text: str) -> str:
+    """White space folded to single spaces; anything unprintable (terminal escapes, NUL) shown as \\xNN."""
+    text = " ".join(text.split())
+    return "".join(ch if ch.isprintable() else f"\\x{ord(ch):02x}" if ord(ch) < 0x100 else f"\\u{ord(ch):04x}"
+                   for ch in text)

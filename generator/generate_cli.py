@@ -12,8 +12,9 @@ import time
 from pathlib import Path
 from typing import Sequence
 
-from .emit import LANGS, generate, write_files
+from .emit import LANGS, generate
 from .errors import UserError
+from .outputs import check_output_folder, write_text_files
 from .spec import load_spec
 
 
@@ -36,20 +37,20 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str]) -> int:
     args = _parser().parse_args(list(argv))
     langs = LANGS if args.lang == "all" else (args.lang,)
-    if args.output.exists() and not args.output.is_dir():
-        raise UserError(args.output, "output exists and is not a folder")
+    check_output_folder(args.output, "-o")
     outputs: dict[str, str] = {}
     summary = []
     for path in args.specs:
         start = time.perf_counter()
         spec = load_spec(path)
         files = generate(spec, langs)
-        clash = set(files) & set(outputs)
+        # Compared without case: on a case-insensitive file system Torus.c and torus.c are one file.
+        clash = {f.lower() for f in files} & {f.lower() for f in outputs}
         if clash:
             raise UserError(path, f"writes {sorted(clash)[0]}, which another spec given also writes")
         outputs.update(files)
         summary.append((spec, time.perf_counter() - start, list(files)))
-    write_files(outputs, args.output)
+    write_text_files(outputs, args.output)
     if not args.quiet:
         for spec, seconds, names in summary:
             print(f"{spec.name:<14} degree {spec.degree:>2}  {seconds * 1000:7.1f} ms  -> "

@@ -5,22 +5,35 @@ we then walk that tree and accept a small whitelist: numbers, declared symbols, 
 constant non-negative integer exponent, and parentheses. Division is by non-zero constants only. Anything
 else (calls, attribute access, lambdas, comprehensions, names we do not know) is refused with a message.
 
+Before any of that, every character is checked against the grammar's own alphabet (ASCII letters, digits,
+spaces, `. _ + - * / ^ ( )` and one `=`): the grammar has no comments, strings or escapes, so `#`, quotes,
+backslashes, control characters and non-ASCII text are refused with the position of the first one.
+
 While walking we track an upper bound of the degree, so `x^100000` or `(x+1)^(10^10)` is refused before any
-algebra is attempted.
+algebra is attempted. Constants are exact rationals whose numerator and denominator must stay below
+2^MAX_CONST_BITS, so every number the generated code prints is a finite double.
+
+`format_expression` prints a parsed expression back in this same grammar: what generated files show.
 """
 
 from __future__ import annotations
 
 import ast
+import re
+import string
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Mapping
 
 import sympy
+from sympy.printing.str import StrPrinter
 
 MAX_TEXT_LENGTH = 20_000
 MAX_NESTING = 100          # parentheses / operator nesting a user could mean
-MAX_CONST_BITS = 4_096     # size of a constant computed from powers of constants
+MAX_CONST_BITS = 256       # numerators and denominators of constants stay below 2^256 (about 1e77)
+MAX_DIGITS = 80           # digits in one number as written
+_LONG_NUMBER = re.compile(r"[0-9_]{%d,}" % (MAX_DIGITS + 1))
+ALPHABET = frozenset(string.ascii_letters + string.digits + " \t\n._+-*/^()=")
 
 
 class ParseError(ValueError):
@@ -98,8 +111,8 @@ class _Builder:
                 frac = Fraction(segment.replace("_", ""))
             except ValueError:
                 frac = Fraction(value)
-            return sympy.Rational(frac.numerator, frac.denominator)
-        return sympy.Integer(value)
+            return _bounded(sympy.Rational(frac.numerator, frac.denominator))
+        return _bounded(sympy.Integer(value))
 
     def _name(self, name: str) -> Parsed:
         if name in self.variables:
@@ -117,12 +130,10 @@ class _Builder:
             raise ParseError(self._refusal(node))
         left = self.build(node.left, depth + 1)
         right = self.build(node.right, depth + 1)
-        if isinstance(op, ast.Add):
-            return Parsed(left.expr + right.expr, max(left.degree_bound, right.degree_bound),
-                          max(left.param_degree_bound, right.param_degree_bound))
-        if isinstance(op, ast.Sub):
-            return Parsed(left.expr - right.expr, max(left.degree_bound, right.degree_bound),
-                          max(left.param_degree_bound, right.param_degree_bound))
+        if isinstance(op, (ast.Add, ast.Sub)):
+            expr = left.expr + right.expr if isinstance(op, ast.Add) else left.expr - right.expr
+            return self._constant_checked(Parsed(expr, max(left.degree_bound, right.degree_bound),
+                                                 max(left.param_degree_bound, right.param_degree_bound)))
         if isinstance(op, ast.Mult):
             return self._checked(left.expr * right.expr, left.degree_bound + right.degree_bound,
                                  left.param_degree_bound + right.param_degree_bound)
@@ -132,7 +143,7 @@ class _Builder:
             raise ParseError(f"division by a non-constant ({segment[:40]}) is not polynomial")
         if right.expr == 0:
             raise ParseError("division by zero")
-        return Parsed(left.expr / right.expr, left.degree_bound, left.param_degree_bound)
+        return self._constant_checked(Parsed(left.expr / right.expr, left.degree_bound, left.param_degree_bound))
 
     def _power(self, node: ast.BinOp, depth: int) -> Parsed:
         base = self.build(node.left, depth + 1)
@@ -145,9 +156,9 @@ class _Builder:
         k = int(exponent.expr)
         if base.degree_bound == 0 and base.param_degree_bound == 0:
             bits = max(abs(base.expr.p).bit_length(), abs(base.expr.q).bit_length(), 1)
-            if k > 1 and bits * k > MAX_CONST_BITS:
+            if k > 1 and bits * k > 2 * MAX_CONST_BITS:
                 raise ParseError(f"constant power too large: exponent {k}")
-            return Parsed(base.expr ** k, 0, 0)
+            return Parsed(_bounded(base.expr ** k), 0, 0)
         return self._checked(base.expr ** k, base.degree_bound * k, base.param_degree_bound * k)
 
     def _checked(self, expr: sympy.Expr, degree: int, param_degree: int) -> Parsed:
@@ -155,7 +166,33 @@ class _Builder:
             raise ParseError(f"degree would exceed {self.max_degree} (the highest supported)")
         if param_degree > self.max_param_degree:
             raise ParseError(f"parameters raised to a degree above {self.max_param_degree}")
-        return Parsed(expr, degree, param_degree)
+        return self._constant_checked(Parsed(expr, degree, param_degree))
+
+    @staticmethod
+    def _constant_checked(parsed: Parsed) -> Parsed:
+        """A node that evaluated to a number (`10^70 * 10^70`) obeys the same bound as a literal."""
+        if parsed.expr.is_Rational:
+            _bounded(parsed.expr)
+        return parsed
+
+
+def _bounded(value: sympy.Rational) -> sympy.Rational:
+    if max(abs(value.p).bit_length(), abs(value.q).bit_length()) > MAX_CONST_BITS:
+        raise ParseError(f"constant too large: numerator and denominator must stay below 2^{MAX_CONST_BITS} "
+                         "(about 1e77)")
+    return value
+
+
+def _show(ch: str) -> str:
+    return repr(ch) if " " < ch < "\x7f" else f"U+{ord(ch):04X}"
+
+
+def check_alphabet(text: str) -> None:
+    """Refuse the first character outside the grammar's alphabet (comments, quotes, escapes, non-ASCII)."""
+    for i, ch in enumerate(text):
+        if ch not in ALPHABET:
+            raise ParseError(f"character {_show(ch)} at position {i + 1} is not allowed (an equation uses "
+                             "letters, digits, spaces, . _ + - * / ^ ( ) and one =)")
 
 
 def parse_expression(text: str, variables: Mapping[str, sympy.Symbol], params: Mapping[str, sympy.Symbol],
@@ -165,8 +202,11 @@ def parse_expression(text: str, variables: Mapping[str, sympy.Symbol], params: M
         raise ParseError("expression must be text")
     if len(text) > MAX_TEXT_LENGTH:
         raise ParseError(f"expression longer than {MAX_TEXT_LENGTH} characters")
+    check_alphabet(text)
     if not text.strip():
         raise ParseError("expression is empty")
+    if _LONG_NUMBER.search(text):
+        raise ParseError(f"a number is written with more than {MAX_DIGITS} digits")
     if _paren_depth(text) > MAX_NESTING:
         raise ParseError(f"parentheses nested deeper than {MAX_NESTING}")
     source = text.replace("^", "**").strip()
@@ -187,9 +227,34 @@ def split_equation(text: str) -> tuple[str, str]:
     """`lhs = rhs` -> (lhs, rhs); a bare `expr` means `expr = 0`."""
     if not isinstance(text, str):
         raise ParseError("equation must be text")
+    if len(text) > MAX_TEXT_LENGTH:
+        raise ParseError(f"equation longer than {MAX_TEXT_LENGTH} characters")
+    check_alphabet(text)
     parts = text.split("=")
     if len(parts) == 1:
         return parts[0], "0"
     if len(parts) == 2 and parts[0].strip() and parts[1].strip():
         return parts[0], parts[1]
     raise ParseError("equation must be 'expr' or 'lhs = rhs' with a single '='")
+
+
+class _GrammarPrinter(StrPrinter):
+    """SymPy's str printer, with powers written `^` and internal symbols under the user's names."""
+
+    def __init__(self, names: Mapping[sympy.Symbol, str]) -> None:
+        super().__init__({"order": "lex"})
+        self._names = names
+
+    def _print_Symbol(self, expr: sympy.Symbol) -> str:  # noqa: N802 -- SymPy's naming
+        return self._names.get(expr, expr.name)
+
+    def _print_Pow(self, expr: sympy.Pow, rational: bool = False) -> str:  # noqa: N802
+        return super()._print_Pow(expr, rational).replace("**", "^")
+
+
+def format_expression(expr: sympy.Expr, names: Mapping[sympy.Symbol, str]) -> str:
+    """`expr` printed in the equation grammar (it parses back to the same polynomial), symbols renamed by
+    `names`. Its text comes from the expression tree, never from what a user typed."""
+    text = _GrammarPrinter(names).doprint(expr)
+    check_alphabet(text)          # identifiers, digits, operators: nothing else can come out
+    return text

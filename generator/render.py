@@ -10,7 +10,6 @@ from __future__ import annotations
 import argparse
 import ctypes
 import os
-import tempfile
 import threading
 import time
 from dataclasses import dataclass, field
@@ -19,13 +18,15 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from . import cbuild
+from . import cbuild, validate
 from .build import BuildResult, bind, build_scene, darr, leaf_params
 from .errors import UserError
-from .scene import Csg, Leaf, Material, Node, Scene, load_scene, parse_scene
+from .outputs import atomic_write, check_output_file
+from .scene import MAX_DEPTH, MAX_SIZE, MAX_SPP, Csg, Leaf, Material, Node, Scene, load_scene, parse_scene
 
 OPS = {"union": 1, "intersection": 2, "difference": 3}
 RAY_KINDS = ("primary", "shadow", "secondary")
+MAX_THREADS = 1024
 DEFAULT_FOLD = False   # folding constant params into the code: measured (README.md, "Rendering scenes"), within +-4%: off
 
 
@@ -142,10 +143,9 @@ def render(scene: Scene | str | Path | dict, *, width: int | None = None, height
     n = spp or sc.spp
     depth = sc.max_depth if max_depth is None else max_depth
     nthreads = threads or os.cpu_count() or 1
-    for key, v, lo, hi in (("width", w, 1, 16384), ("height", h, 1, 16384), ("spp", n, 1, 4096),
-                           ("threads", nthreads, 1, 1024), ("max_depth", depth, 0, 64)):
-        if not lo <= v <= hi:
-            raise UserError(f"--{key}", f"{v} is outside [{lo}, {hi}]")
+    for option, v, lo, hi in (("--width", w, 1, MAX_SIZE), ("--height", h, 1, MAX_SIZE), ("--spp", n, 1, MAX_SPP),
+                              ("--threads", nthreads, 1, MAX_THREADS), ("--max-depth", depth, 0, MAX_DEPTH)):
+        validate.whole(option, "", v, lo, hi)
     built = build_scene(sc, fold=fold)
     cs = CScene(sc, built)
     try:
@@ -208,23 +208,11 @@ def to_uint8(img: np.ndarray) -> np.ndarray:
 
 
 def write_png(img: np.ndarray, path: Path) -> None:
-    """Write atomically: a temporary file in the same folder renamed into place, so a failure leaves
-    nothing half-written."""
+    """Write atomically (outputs.atomic_write): a failure leaves nothing half-written."""
     from PIL import Image
 
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise UserError(path, "the output folder does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".png", dir=folder)
-    os.close(fd)
-    try:
-        Image.fromarray(to_uint8(img), mode="RGB").save(tmp, format="PNG")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    picture = Image.fromarray(to_uint8(img), mode="RGB")
+    atomic_write(Path(path), lambda fh: picture.save(fh, format="PNG"))
 
 
 def _positive(text: str) -> int:
@@ -250,14 +238,11 @@ def main(argv: Sequence[str]) -> int:
     ap.add_argument("--height", type=_positive)
     ap.add_argument("--spp", type=_positive, help="samples per pixel (stratified)")
     ap.add_argument("--threads", type=_positive, help="default: all cores")
-    ap.add_argument("--max-depth", type=int, dest="max_depth")
+    ap.add_argument("--max-depth", type=int, dest="max_depth", metavar="N")
     ap.add_argument("--fold", action="store_true", help="fold constant shape params into the generated code")
     ap.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     args = ap.parse_args(list(argv))
-    if args.output.suffix.lower() != ".png":
-        raise UserError(args.output, "the output must be a .png file")
-    if not (args.output.parent if str(args.output.parent) else Path(".")).is_dir():
-        raise UserError(args.output, "the output folder does not exist")
+    check_output_file(args.output, "-o", (".png",))
     scene = load_scene(args.scene)
     info = RenderInfo()
     img = render(scene, width=args.width, height=args.height, spp=args.spp, threads=args.threads,

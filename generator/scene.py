@@ -6,7 +6,7 @@ the CLI prints one line and exits with status 2 before anything is compiled or w
 
 from __future__ import annotations
 
-import math
+import heapq
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Union
@@ -14,13 +14,27 @@ from typing import Any, Union
 import numpy as np
 
 from . import transform as tf
+from . import validate
 from .errors import UserError
 from .spec import Spec, load_spec, parse_spec, read_yaml
 
-MAX_CSG_DEPTH = 48   # = RT_MAX_CSG_DEPTH in runtime_c/tracer.h
-MAX_DEPTH = 64       # = RT_MAX_DEPTH
-MAX_SPP = 4096       # = RT_MAX_SPP in tracer_render.c
+MAX_CSG_DEPTH = 96     # = RT_MAX_CSG_DEPTH in runtime_c/tracer.h: depth of the binary tree the tracer gets
+MAX_CSG_NESTING = 32   # CSG operations nested inside each other, as written in the scene
+MAX_CSG_CHILDREN = 1024  # objects in one CSG list (a list becomes a balanced binary tree)
+MAX_SHAPES = 256       # distinct shapes (spec files and inline equations) in one scene
+MAX_DEPTH = 64         # = RT_MAX_DEPTH
+MAX_SPP = 4096         # = RT_MAX_SPP in tracer_render.c
+MAX_SIZE = 16384       # image width and height
 CSG_OPS = ("union", "intersection", "difference")
+
+# Documented ranges of colours and material terms ([lo, hi]; lengths and positions use
+# validate.MAX_COORDINATE). Light colour x intensity stays below 100 x 1e4.
+COLOR_MAX = 100.0
+INTENSITY_MAX = 1e4
+MATERIAL_RANGES = {"ambient": (0.0, 100.0), "diffuse": (0.0, 100.0), "specular": (0.0, 100.0),
+                   "shininess": (0.0, 1e4), "reflectivity": (0.0, 1.0), "transparency": (0.0, 1.0)}
+IOR_MAX = 10.0
+ABSORPTION_MAX = 1e6
 
 
 @dataclass
@@ -59,9 +73,17 @@ class Csg:
     right: "Node"
     material: Material | None
     where: str
+    depth: int = field(init=False)   # of this binary node: 1 + the deeper child's
+
+    def __post_init__(self) -> None:
+        self.depth = 1 + max(_depth(self.left), _depth(self.right))
 
 
 Node = Union[Leaf, Csg]
+
+
+def _depth(node: Node) -> int:
+    return node.depth if isinstance(node, Csg) else 0
 
 
 @dataclass
@@ -133,64 +155,59 @@ class _Ctx:
     def fail(self, key: str, msg: str) -> UserError:
         return UserError(self.source, f"{key}: {msg}")
 
+    def count_shape(self, key: str) -> None:
+        if self.inline_count + len(self.spec_cache) >= MAX_SHAPES:
+            raise self.fail(key, f"more than {MAX_SHAPES} distinct shapes in one scene")
+
 
 def _mapping(ctx: _Ctx, key: str, value: Any, allowed: tuple[str, ...]) -> dict:
     if not isinstance(value, dict):
         raise ctx.fail(key, "expected a mapping")
     for k in value:
         if k not in allowed:
-            raise ctx.fail(f"{key}.{k}" if key else str(k), f"unknown key (allowed: {', '.join(allowed)})")
+            name = k if isinstance(k, str) and k.isidentifier() else validate.describe(k)
+            raise ctx.fail(f"{key}.{name}" if key else str(name), f"unknown key (allowed: {', '.join(allowed)})")
     return value
 
 
-def _num(ctx: _Ctx, key: str, value: Any, lo: float = -math.inf, hi: float = math.inf,
-         lo_open: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ctx.fail(key, "expected a finite number")
-    v = float(value)
-    if v < lo or v > hi or (lo_open and v == lo):
-        rng = f"{'(' if lo_open else '['}{lo:g}, {hi:g}]"
-        raise ctx.fail(key, f"{v:g} is outside {rng}")
-    return v
+def _num(ctx: _Ctx, key: str, value: Any, lo: float = -validate.MAX_COORDINATE,
+         hi: float = validate.MAX_COORDINATE, lo_open: bool = False) -> float:
+    return validate.number(ctx.source, key, value, lo, hi, lo_open=lo_open)
 
 
 def _int(ctx: _Ctx, key: str, value: Any, lo: int, hi: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ctx.fail(key, "expected a whole number")
-    if not lo <= value <= hi:
-        raise ctx.fail(key, f"{value} is outside [{lo}, {hi}]")
-    return value
+    return validate.whole(ctx.source, key, value, lo, hi)
 
 
-def _vec(ctx: _Ctx, key: str, value: Any, lo: float = -math.inf) -> tuple[float, float, float]:
-    if not isinstance(value, (list, tuple)) or len(value) != 3:
-        raise ctx.fail(key, "expected a list of three numbers")
-    return tuple(_num(ctx, f"{key}[{i}]", v, lo) for i, v in enumerate(value))  # type: ignore[return-value]
+def _vec(ctx: _Ctx, key: str, value: Any, lo: float = -validate.MAX_COORDINATE,
+         hi: float = validate.MAX_COORDINATE) -> tuple[float, float, float]:
+    return validate.vector(ctx.source, key, value, lo, hi)
+
+
+def _color(ctx: _Ctx, key: str, value: Any) -> tuple[float, float, float]:
+    return _vec(ctx, key, value, 0.0, COLOR_MAX)
 
 
 def _material(ctx: _Ctx, key: str, raw: Any) -> Material:
     raw = _mapping(ctx, key, raw, MATERIAL_KEYS)
     m = Material()
     if "color" in raw:
-        m.color = _vec(ctx, f"{key}.color", raw["color"], 0.0)
+        m.color = _color(ctx, f"{key}.color", raw["color"])
     if "checker" in raw:
         ch = _mapping(ctx, f"{key}.checker", raw["checker"], ("colors", "scale"))
         cols = ch.get("colors")
         if not isinstance(cols, list) or len(cols) != 2:
             raise ctx.fail(f"{key}.checker.colors", "expected two colours")
-        m.color = _vec(ctx, f"{key}.checker.colors[0]", cols[0], 0.0)
-        m.color2 = _vec(ctx, f"{key}.checker.colors[1]", cols[1], 0.0)
+        m.color = _color(ctx, f"{key}.checker.colors[0]", cols[0])
+        m.color2 = _color(ctx, f"{key}.checker.colors[1]", cols[1])
         m.checker_scale = _num(ctx, f"{key}.checker.scale", ch.get("scale", 1.0), 0.0, lo_open=True)
-    for k in ("ambient", "diffuse", "specular", "reflectivity", "transparency"):
+    for k, (lo, hi) in MATERIAL_RANGES.items():
         if k in raw:
-            setattr(m, k, _num(ctx, f"{key}.{k}", raw[k], 0.0, 1.0 if k in ("reflectivity", "transparency")
-                               else math.inf))
-    if "shininess" in raw:
-        m.shininess = _num(ctx, f"{key}.shininess", raw["shininess"], 0.0)
+            setattr(m, k, _num(ctx, f"{key}.{k}", raw[k], lo, hi))
     if "ior" in raw:
-        m.ior = _num(ctx, f"{key}.ior", raw["ior"], 0.0, lo_open=True)
+        m.ior = _num(ctx, f"{key}.ior", raw["ior"], 0.0, IOR_MAX, lo_open=True)
     if "absorption" in raw:
-        m.absorption = _vec(ctx, f"{key}.absorption", raw["absorption"], 0.0)
+        m.absorption = _vec(ctx, f"{key}.absorption", raw["absorption"], 0.0, ABSORPTION_MAX)
     return m
 
 
@@ -198,19 +215,19 @@ def _material_ref(ctx: _Ctx, key: str, raw: Any, named: dict[str, Material]) -> 
     if isinstance(raw, str):
         if raw not in named:
             known = ", ".join(sorted(named)) or "none defined"
-            raise ctx.fail(key, f"no material named {raw!r} (materials: {known})")
+            raise ctx.fail(key, f"no material named {validate.describe(raw)} (materials: {known})")
         return named[raw]
     return _material(ctx, key, raw)
 
 
 def _resolve_shape_path(ctx: _Ctx, key: str, value: Any) -> Path:
-    if not isinstance(value, str) or not value.strip():
+    if not isinstance(value, str) or not value.strip() or "\0" in value:
         raise ctx.fail(key, "expected the path of a spec file")
     p = Path(value)
     candidates = [p] if p.is_absolute() else [ctx.path.parent / p, Path.cwd() / p]
     for c in candidates:
-        if c.is_file():
-            return c.resolve()
+        if c.exists():
+            return c.resolve()       # whatever it is: read_yaml says what is wrong with it
     tried = " or ".join(str(c) for c in candidates)
     raise ctx.fail(key, f"spec file not found (tried {tried})")
 
@@ -226,10 +243,12 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
                 raise ctx.fail(f"{key}.{k}", "only for an inline 'equation' (a spec file has its own)")
         path = _resolve_shape_path(ctx, f"{key}.shape", raw["shape"])
         if path not in ctx.spec_cache:
+            ctx.count_shape(f"{key}.shape")
             ctx.spec_cache[path] = load_spec(path)
         spec = ctx.spec_cache[path]
         overrides = raw.get("params") or {}
     else:
+        ctx.count_shape(f"{key}.equation")
         ctx.inline_count += 1
         mapping = {"name": raw.get("name", f"inline{ctx.inline_count}"), "equation": raw["equation"]}
         if "bounds" in raw:
@@ -244,7 +263,8 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
     for name, v in overrides.items():
         if name not in spec.params:
             known = ", ".join(spec.params) or "none"
-            raise ctx.fail(f"{key}.params.{name}", f"shape {spec.name!r} has no such param (params: {known})")
+            where = f"{key}.params.{name}" if isinstance(name, str) and name.isidentifier() else f"{key}.params"
+            raise ctx.fail(where, f"shape {spec.name!r} has no param {validate.describe(name)} (params: {known})")
         params[name] = _num(ctx, f"{key}.params.{name}", v)
     m = tf.parse_transform(ctx.source, f"{key}.transform", raw.get("transform"))
     mat = _material_ref(ctx, f"{key}.material", raw["material"], named) if "material" in raw else None
@@ -261,22 +281,41 @@ def _node(ctx: _Ctx, key: str, raw: Any, named: dict[str, Material], depth: int)
         raise ctx.fail(key, f"one CSG operation per node (found {', '.join(ops)})")
     op = ops[0]
     _mapping(ctx, key, raw, (op, "material", "transform"))
-    if depth >= MAX_CSG_DEPTH:
-        raise ctx.fail(key, f"CSG nested deeper than {MAX_CSG_DEPTH}")
+    if depth >= MAX_CSG_NESTING:
+        raise ctx.fail(key, f"CSG operations nested more than {MAX_CSG_NESTING} deep as written")
     kids = raw[op]
-    if not isinstance(kids, list) or len(kids) < 2:
-        raise ctx.fail(f"{key}.{op}", "expected a list of at least two objects")
+    if not isinstance(kids, list) or not 2 <= len(kids) <= MAX_CSG_CHILDREN:
+        raise ctx.fail(f"{key}.{op}", f"expected a list of 2 to {MAX_CSG_CHILDREN} objects")
     children = [_node(ctx, f"{key}.{op}[{i}]", k, named, depth + 1) for i, k in enumerate(kids)]
     mat = _material_ref(ctx, f"{key}.material", raw["material"], named) if "material" in raw else None
-    # n-ary operations fold from the left: difference [A, B, C] = (A - B) - C
-    node: Node = children[0]
-    for c in children[1:]:
-        node = Csg(op=op, left=node, right=c, material=None, where=key)
-    assert isinstance(node, Csg)
+    # difference [A, B, C] = A - (B u C); union and intersection lists become the shallowest binary tree
+    if op == "difference":
+        rest = children[1] if len(children) == 2 else _balanced("union", children[1:], key)
+        node = Csg(op=op, left=children[0], right=rest, material=None, where=key)
+    else:
+        node = _balanced(op, children, key)
     node.material = mat
     if "transform" in raw:
         m = tf.parse_transform(ctx.source, f"{key}.transform", raw["transform"])
         _apply_transform(node, m)
+    return node
+
+
+def _balanced(op: str, nodes: list[Node], where: str) -> Csg:
+    """One associative operation over a list as the shallowest binary tree: always join the two shallowest
+    subtrees (Huffman's merge on depth), ties in list order. A long flat list stays a few levels deep."""
+    heap = [(_depth(n), i, n) for i, n in enumerate(nodes)]
+    heapq.heapify(heap)
+    order = len(nodes)
+    while len(heap) > 1:
+        _, i, a = heapq.heappop(heap)
+        _, j, b = heapq.heappop(heap)
+        left, right = (a, b) if i < j else (b, a)
+        joined = Csg(op=op, left=left, right=right, material=None, where=where)
+        heapq.heappush(heap, (joined.depth, order, joined))
+        order += 1
+    node = heap[0][2]
+    assert isinstance(node, Csg)
     return node
 
 
@@ -297,8 +336,8 @@ def parse_scene(data: Any, source: str | Path = "<scene>") -> Scene:
     _mapping(ctx, "", data, TOP_KEYS)
     sc = Scene(source=ctx.source)
     img = _mapping(ctx, "image", data.get("image") or {}, IMAGE_KEYS)
-    sc.width = _int(ctx, "image.width", img.get("width", sc.width), 1, 16384)
-    sc.height = _int(ctx, "image.height", img.get("height", sc.height), 1, 16384)
+    sc.width = _int(ctx, "image.width", img.get("width", sc.width), 1, MAX_SIZE)
+    sc.height = _int(ctx, "image.height", img.get("height", sc.height), 1, MAX_SIZE)
     sc.spp = _int(ctx, "image.spp", img.get("spp", sc.spp), 1, MAX_SPP)
     sc.max_depth = _int(ctx, "image.max_depth", img.get("max_depth", sc.max_depth), 0, MAX_DEPTH)
     cam = _mapping(ctx, "camera", data.get("camera") or {}, CAMERA_KEYS)
@@ -318,7 +357,7 @@ def parse_scene(data: Any, source: str | Path = "<scene>") -> Scene:
         raise ctx.fail("camera.up", "must not be zero or parallel to the viewing direction")
     sc.camera = c
     if "background" in data:
-        sc.background = _vec(ctx, "background", data["background"], 0.0)
+        sc.background = _color(ctx, "background", data["background"])
     lights = data.get("lights") or []
     if not isinstance(lights, list):
         raise ctx.fail("lights", "expected a list")
@@ -326,24 +365,30 @@ def parse_scene(data: Any, source: str | Path = "<scene>") -> Scene:
         raw = _mapping(ctx, f"lights[{i}]", raw, LIGHT_KEYS)
         if "position" not in raw:
             raise ctx.fail(f"lights[{i}]", "missing key 'position'")
-        col = _vec(ctx, f"lights[{i}].color", raw.get("color", [1, 1, 1]), 0.0)
-        k = _num(ctx, f"lights[{i}].intensity", raw.get("intensity", 1.0), 0.0)
+        col = _color(ctx, f"lights[{i}].color", raw.get("color", [1, 1, 1]))
+        k = _num(ctx, f"lights[{i}].intensity", raw.get("intensity", 1.0), 0.0, INTENSITY_MAX)
         sc.lights.append(Light(_vec(ctx, f"lights[{i}].position", raw["position"]), tuple(k * x for x in col)))
     named: dict[str, Material] = {}
     mats = data.get("materials") or {}
     if not isinstance(mats, dict):
         raise ctx.fail("materials", "expected a mapping name -> material")
     for name, raw in mats.items():
-        named[str(name)] = _material(ctx, f"materials.{name}", raw)
+        if not isinstance(name, str) or not 0 < len(name) <= 64 or not name.isprintable():
+            raise ctx.fail("materials", f"{validate.describe(name)} is not a material name (text, 1 to 64 "
+                                        "printable characters)")
+        named[name] = _material(ctx, f"materials.{name}", raw)
     objs = data.get("objects")
     if not isinstance(objs, list) or not objs:
         raise ctx.fail("objects", "expected a non-empty list")
     sc.objects = [_node(ctx, f"objects[{i}]", raw, named, 0) for i, raw in enumerate(objs)]
+    for obj in sc.objects:
+        if _depth(obj) > MAX_CSG_DEPTH:   # cannot happen within the documented limits; the tracer's own
+            raise ctx.fail(getattr(obj, "where", "objects"), f"CSG tree deeper than {MAX_CSG_DEPTH}")
+    for leaf in sc.leaves():
+        tf.check_matrix(ctx.source, f"{leaf.where}.transform", leaf.matrix)
     return sc
 
 
 def load_scene(path: str | Path) -> Scene:
     path = Path(path)
-    if not path.is_file():
-        raise UserError(path, "scene file not found")
-    return parse_scene(read_yaml(path), path)
+    return parse_scene(read_yaml(path, what="scene"), path)

@@ -14,7 +14,9 @@ from __future__ import annotations
 
 import keyword
 import math
+import os
 import re
+import stat
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Mapping
@@ -24,12 +26,18 @@ import yaml
 from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
+from . import validate
 from .errors import UserError
-from .parse import ParseError, parse_expression, split_equation
+from .parse import ParseError, format_expression, parse_expression, split_equation
+from .resources import runtime_dir
 
 MAX_DEGREE = 24          # must match IG_MAX_DEGREE in runtime_c/roots.h
 MAX_FILE_BYTES = 1 << 20
+MAX_YAML_NODES = 100_000   # scalars, lists and mappings of a document with every alias expanded
 MAX_PARAMS = 64
+MAX_DESCRIPTION = 2_000
+MAX_COEFF_BITS = 900       # |numerator|, |denominator| of every expanded coefficient (2^900 ~ 8e270: room
+                           # for the multinomial factors the ray coefficients multiply them by)
 AXES = ("x", "y", "z")
 KEYS = ("name", "equation", "params", "bounds", "description")
 X, Y, Z = sympy.symbols("x y z", real=True)
@@ -42,7 +50,16 @@ _C_KEYWORDS = frozenset(
     "register restrict return short signed sizeof static struct switch typedef union unsigned void volatile "
     "while _Bool _Complex _Imaginary".split()
 )
-_RESERVED_SHAPE_NAMES = frozenset({"implgen", "roots", "shape", "raycast", "numpy", "math"})
+_RESERVED_SHAPE_NAMES = frozenset({"implgen", "roots", "shape", "raycast", "numpy", "math", "ig", "rt"})
+# Names the C runtime and the scene glue own (functions, types, macros): a shape called `rt_scene` would
+# define `rt_scene_shape`, which the glue defines too. Compared lower-cased: `<NAME>_DEGREE` is a macro.
+_RESERVED_SHAPE_PREFIXES = ("ig_", "rt_", "implgen")
+# Headers: `<name>.h` sits in a folder on the compiler's include path, so a shape called `math` would stand
+# in for <math.h>. Every C99 header, the POSIX ones the runtime includes, and the runtime's own.
+_C_HEADERS = frozenset(
+    "assert complex ctype errno fenv float inttypes iso646 limits locale math setjmp signal stdarg stdbool "
+    "stddef stdint stdio stdlib string tgmath time wchar wctype pthread unistd sched".split()
+)
 
 
 def param_symbol(name: str) -> sympy.Symbol:
@@ -54,7 +71,7 @@ def param_symbol(name: str) -> sympy.Symbol:
 @dataclass(frozen=True)
 class Spec:
     name: str
-    equation: str
+    equation: str                                # f printed back from the parsed tree (never the raw text)
     params: dict[str, float]                     # ordered: the order the generated code takes them in
     f: sympy.Expr                                # lhs - rhs, structure as written; x, y, z and k_* symbols
     degree: int                                  # exact total degree in x, y, z
@@ -82,18 +99,22 @@ class Spec:
         if unknown:
             raise UserError(self.source, f"unknown params {sorted(unknown)} for shape {self.name!r}")
         new_name = name or self.name
-        _check_identifier(self.source, "name", new_name)
-        subs = {param_symbol(k): sympy.nsimplify(_finite(self.source, f"params.{k}", v), rational=True)
+        check_shape_name(self.source, "name", new_name)
+        subs = {param_symbol(k): sympy.nsimplify(validate.number(self.source, f"params.{k}", v), rational=True)
                 for k, v in values.items()}
         bounds = None
         if self.bounds is not None:
             bounds = {a: (lo.subs(subs), hi.subs(subs)) for a, (lo, hi) in self.bounds.items()}
-        return replace(self, name=new_name, f=self.f.subs(subs),
-                       params={k: v for k, v in self.params.items() if k not in values},
+        rest = {k: v for k, v in self.params.items() if k not in values}
+        f = self.f.subs(subs)
+        return replace(self, name=new_name, f=f, equation=canonical_equation(f, rest), params=rest,
                        bounds=bounds, folded={**self.folded, **{k: float(v) for k, v in values.items()}})
 
 
-class _UniqueKeyLoader(yaml.SafeLoader):
+_BaseLoader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)   # libyaml's parser when PyYAML has it: 20x faster
+
+
+class _UniqueKeyLoader(_BaseLoader):  # type: ignore[misc,valid-type]
     """safe_load, but a key given twice is an error rather than silently the last one."""
 
 
@@ -109,31 +130,95 @@ def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: b
 
 
 _UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+# YAML 1.1 (PyYAML) reads `1e-3` and `2E6` as text: it wants a dot and a signed exponent. Read them as
+# numbers, as YAML 1.2 and every user do.
+_UniqueKeyLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float", re.compile(r"^[-+]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[eE][-+]?[0-9]+$"),
+    list("-+0123456789."))
 
 
-def read_yaml(path: Path) -> Any:
-    """Read a small YAML file safely; any failure is a one-line UserError naming the file."""
+def _expanded_size(root: yaml.Node, limit: int) -> int:
+    """Nodes in the document with every alias expanded, counted without expanding anything: a node reached
+    through several aliases is counted once per path. Raises ValueError past `limit` or on a cycle."""
+    sizes: dict[int, int] = {}
+    open_nodes: set[int] = set()
+
+    def size(node: yaml.Node) -> int:
+        key = id(node)
+        if key in sizes:
+            return sizes[key]
+        if key in open_nodes:
+            raise ValueError("an alias refers to a node that contains it (a cycle)")
+        open_nodes.add(key)
+        total = 1
+        if isinstance(node, yaml.SequenceNode):
+            total += sum(size(child) for child in node.value)
+        elif isinstance(node, yaml.MappingNode):
+            total += sum(size(k) + size(v) for k, v in node.value)
+        open_nodes.discard(key)
+        if total > limit:
+            raise ValueError(f"more than {limit} values once its aliases are expanded")
+        sizes[key] = total
+        return total
+
+    return size(root)
+
+
+def _file_kind(mode: int) -> str:
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    if stat.S_ISFIFO(mode):
+        return "a fifo"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    return "not a regular file"
+
+
+def read_yaml(path: Path, what: str = "shape spec") -> Any:
+    """Read a small YAML file safely; any failure is a one-line UserError naming the file. `what` says which
+    kind of file was expected; nothing of a file's text is echoed unless it parsed as YAML."""
     try:
-        size = path.stat().st_size
+        info = os.stat(path)
+    except OSError as err:
+        reason = "not found" if isinstance(err, FileNotFoundError) else f"cannot read: {err.strerror or err}"
+        raise UserError(path, f"{reason} (expected a {what} file)") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise UserError(path, f"is {_file_kind(info.st_mode)}, not a {what} file")
+    if info.st_size > MAX_FILE_BYTES:
+        raise UserError(path, f"file larger than {MAX_FILE_BYTES} bytes (expected a {what} file)")
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_FILE_BYTES + 1)     # stat can under-report (/proc): never read more
     except OSError as err:
         raise UserError(path, f"cannot read: {err.strerror or err}") from None
-    if not path.is_file():
-        raise UserError(path, "not a file")
-    if size > MAX_FILE_BYTES:
-        raise UserError(path, f"file larger than {MAX_FILE_BYTES} bytes")
+    if len(raw) > MAX_FILE_BYTES:
+        raise UserError(path, f"file larger than {MAX_FILE_BYTES} bytes (expected a {what} file)")
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        raise UserError(path, f"cannot read: {err}") from None
+        if b"\0" in raw:
+            raise UnicodeDecodeError("utf-8", raw, 0, 1, "NUL byte")
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise UserError(path, f"is not a text file (expected a {what}: YAML text)") from None
+    loader = _UniqueKeyLoader(text)
     try:
-        return yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 -- a SafeLoader subclass
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _expanded_size(node, MAX_YAML_NODES)
+        return loader.construct_document(node)
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
         where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark is not None else ""
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
-        raise UserError(path, f"invalid YAML{where}: {problem}") from None
+        raise UserError(path, f"invalid YAML{where}: {problem[:80]} (expected a {what} file)") from None
+    except ValueError as err:
+        raise UserError(path, f"refused YAML: {err}") from None
     except RecursionError:
         raise UserError(path, "invalid YAML: nested too deeply") from None
+    finally:
+        loader.dispose()
 
 
 def load_spec(path: str | Path) -> Spec:
@@ -144,24 +229,30 @@ def load_spec(path: str | Path) -> Spec:
 
 def _check_identifier(source: str, key: str, name: Any) -> str:
     if not isinstance(name, str) or not _IDENT.match(name):
-        raise UserError(source, f"{key}: {str(name)[:40]!r} is not an identifier "
+        raise UserError(source, f"{key}: {validate.describe(name)} is not an identifier "
                                 "(a letter, then letters, digits or _, at most 64)")
     if keyword.iskeyword(name) or name in _C_KEYWORDS:
         raise UserError(source, f"{key}: {name!r} is a reserved word in C or Python")
     return name
 
 
-def _finite(source: str, key: str, value: Any) -> float:
-    if isinstance(value, bool):
-        raise UserError(source, f"{key}: must be a finite number, not {value!r}")
-    if isinstance(value, str):
-        try:
-            value = float(value)
-        except ValueError:
-            raise UserError(source, f"{key}: must be a finite number, not {value[:40]!r}") from None
-    if not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise UserError(source, f"{key}: must be a finite number, not {str(value)[:40]!r}")
-    return float(value) if isinstance(value, float) else int(value)
+def reserved_shape_name(name: str) -> str | None:
+    """Why `name` cannot name a shape (it would collide with the runtime, a header or a module), or None."""
+    low = name.lower()
+    if low in _RESERVED_SHAPE_NAMES or low.startswith(_RESERVED_SHAPE_PREFIXES):
+        return "is reserved by implgen (the C runtime's names start ig_, rt_, implgen)"
+    if low in _C_HEADERS or low in {h.stem.lower() for h in runtime_dir().glob("*.h")}:
+        return "is the name of a C header the generated code includes"
+    return None
+
+
+def check_shape_name(source: str, key: str, name: Any) -> str:
+    """A shape name: an identifier that no runtime symbol, header or module can collide with."""
+    _check_identifier(source, key, name)
+    why = reserved_shape_name(name)
+    if why:
+        raise UserError(source, f"{key}: {name!r} {why}")
+    return name
 
 
 def _parse_params(source: str, raw: Any) -> dict[str, float]:
@@ -176,8 +267,15 @@ def _parse_params(source: str, raw: Any) -> dict[str, float]:
         _check_identifier(source, "params", name)
         if name in AXES:
             raise UserError(source, f"params: {name!r} shadows the coordinate {name}")
-        params[name] = _finite(source, f"params.{name}", value)
+        number = validate.number(source, f"params.{name}", value, text_ok=True)
+        params[name] = int(value) if isinstance(value, int) else number
     return params
+
+
+def canonical_equation(f: sympy.Expr, params: Mapping[str, float]) -> str:
+    """f (meaning f = 0) as generated files show it: printed from the expression tree under the user's param
+    names, so the text is the parsed equation, never what was typed."""
+    return format_expression(f, {param_symbol(p): p for p in params})
 
 
 def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[sympy.Expr, int]:
@@ -199,6 +297,10 @@ def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[s
         raise UserError(source, "equation: has no x, y or z (a constant, not a surface)")
     if degree > MAX_DEGREE:
         raise UserError(source, f"equation: degree {degree} is above the highest supported, {MAX_DEGREE}")
+    for coeff in poly.coeffs():
+        if max(abs(int(coeff.numerator)).bit_length(), int(coeff.denominator).bit_length()) > MAX_COEFF_BITS:
+            raise UserError(source, f"equation: a coefficient of the expanded polynomial is beyond 2^{MAX_COEFF_BITS} "
+                                    f"or below 2^-{MAX_COEFF_BITS} in size (not a normal double)")
     return f, degree
 
 
@@ -224,13 +326,15 @@ def _parse_bounds(source: str, raw: Any, params: dict[str, float]) -> dict[str, 
         ends = []
         for item in pair:
             if isinstance(item, bool) or not isinstance(item, (int, float, str)):
-                raise UserError(source, f"bounds.{axis}: {str(item)[:40]!r} is not a number or expression")
+                raise UserError(source, f"bounds.{axis}: {validate.describe(item)} is not a number or expression")
             if isinstance(item, float) and not math.isfinite(item):
                 raise UserError(source, f"bounds.{axis}: must be finite (leave the axis out to leave it open)")
             try:
-                ends.append(parse_expression(str(item), {}, symbols, 0).expr)
+                end = parse_expression(str(item), {}, symbols, 0).expr
             except ParseError as err:
                 raise UserError(source, f"bounds.{axis}: {err}") from None
+            validate.number(source, f"bounds.{axis}", float(end.subs(defaults)))
+            ends.append(end)
         lo, hi = ends
         if not float(lo.subs(defaults)) < float(hi.subs(defaults)):
             raise UserError(source, f"bounds.{axis}: low must be below high (with the default params)")
@@ -240,22 +344,24 @@ def _parse_bounds(source: str, raw: Any, params: dict[str, float]) -> dict[str, 
 
 def parse_spec(data: Any, source: str = "<spec>") -> Spec:
     """Validate an already-loaded mapping (a spec file, or an inline shape in a scene)."""
-    if not isinstance(data, dict):
-        raise UserError(source, "a spec must be a mapping with at least 'name' and 'equation'")
-    unknown = [str(k) for k in data if k not in KEYS]
+    if not isinstance(data, dict) or not any(k in KEYS for k in data):
+        # Possibly not meant as a spec at all (a scene's `shape:` naming some other file): say what was
+        # expected, and echo nothing of the file.
+        raise UserError(source, "not a shape spec (expected a YAML mapping with 'name' and 'equation')")
+    unknown = [k for k in data if k not in KEYS]
     if unknown:
-        raise UserError(source, f"unknown key {unknown[0][:40]!r} (allowed: {', '.join(KEYS)})")
+        raise UserError(source, f"unknown key {validate.describe(unknown[0])} (allowed: {', '.join(KEYS)})")
     for key in ("name", "equation"):
         if key not in data:
             raise UserError(source, f"missing key {key!r}")
-    name = _check_identifier(source, "name", data["name"])
-    if name.lower() in _RESERVED_SHAPE_NAMES:
-        raise UserError(source, f"name: {name!r} is reserved by implgen")
+    name = check_shape_name(source, "name", data["name"])
     params = _parse_params(source, data.get("params"))
     f, degree = _parse_equation(source, data["equation"], params)
     bounds = _parse_bounds(source, data.get("bounds"), params)
     description = data.get("description", "")
     if not isinstance(description, str):
         raise UserError(source, "description: must be text")
-    return Spec(name=name, equation=str(data["equation"]).strip(), params=params, f=f, degree=degree,
+    if len(description) > MAX_DESCRIPTION:
+        raise UserError(source, f"description: longer than {MAX_DESCRIPTION} characters")
+    return Spec(name=name, equation=canonical_equation(f, params), params=params, f=f, degree=degree,
                 bounds=bounds, description=" ".join(description.split()), source=source)

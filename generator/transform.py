@@ -16,26 +16,31 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from . import validate
 from .errors import UserError
 
 IDENTITY = np.hstack([np.eye(3), np.zeros((3, 1))])
+# Documented range of the linear part: scales (and axis vectors) between 1e-6 and 1e6 in size, also once
+# composed, so a transform list cannot multiply its way out of double range.
+MAX_SCALE = 1e6
+MIN_SCALE = 1e-6
 
 
-def _vec3(source: str, key: str, value: Any) -> np.ndarray:
-    if not isinstance(value, (list, tuple)) or len(value) != 3:
-        raise UserError(source, f"{key}: expected a list of three numbers")
-    out = []
-    for v in value:
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise UserError(source, f"{key}: expected a list of three finite numbers")
-        out.append(float(v))
-    return np.array(out)
+def _vec3(source: str, key: str, value: Any, limit: float = validate.MAX_COORDINATE) -> np.ndarray:
+    return np.array(validate.vector(source, key, value, -limit, limit))
 
 
-def _number(source: str, key: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise UserError(source, f"{key}: expected a finite number")
-    return float(value)
+def _number(source: str, key: str, value: Any, limit: float = validate.MAX_COORDINATE) -> float:
+    return validate.number(source, key, value, -limit, limit)
+
+
+def _scale(source: str, key: str, value: Any) -> np.ndarray:
+    sv = _vec3(source, key, value, MAX_SCALE) if isinstance(value, list) else \
+        np.full(3, _number(source, key, value, MAX_SCALE))
+    if np.abs(sv).min() < MIN_SCALE:
+        raise UserError(source, f"{key}: a scale must be at least {MIN_SCALE:g} in size (a zero scale flattens "
+                                "the object)")
+    return sv
 
 
 def affine(linear: np.ndarray, translation: np.ndarray | Sequence[float] = (0.0, 0.0, 0.0)) -> np.ndarray:
@@ -75,6 +80,7 @@ def parse_transform(source: str, key: str, raw: Any) -> np.ndarray:
         m = IDENTITY.copy()
         for i, step in enumerate(raw):
             m = compose(parse_transform(source, f"{key}[{i}]", step), m)
+            check_matrix(source, key, m)      # the composition so far, before it can grow any further
         return m
     if not isinstance(raw, dict):
         raise UserError(source, f"{key}: expected a mapping (scale/rotate/translate or position/axes) or a list")
@@ -87,7 +93,7 @@ def parse_transform(source: str, key: str, raw: Any) -> np.ndarray:
         axes = raw["axes"]
         if not isinstance(axes, list) or len(axes) != 3:
             raise UserError(source, f"{key}.axes: expected three vectors [u, v, w]")
-        cols = [_vec3(source, f"{key}.axes[{i}]", a) for i, a in enumerate(axes)]
+        cols = [_vec3(source, f"{key}.axes[{i}]", a, MAX_SCALE) for i, a in enumerate(axes)]
         pos = _vec3(source, f"{key}.position", raw.get("position", [0, 0, 0]))
         m = affine(np.column_stack(cols), pos)
     else:
@@ -97,17 +103,14 @@ def parse_transform(source: str, key: str, raw: Any) -> np.ndarray:
                                     "or position + axes)")
         lin = np.eye(3)
         if "scale" in raw:
-            s = raw["scale"]
-            sv = np.full(3, _number(source, f"{key}.scale", s)) if not isinstance(s, list) else \
-                _vec3(source, f"{key}.scale", s)
-            lin = np.diag(sv) @ lin
+            lin = np.diag(_scale(source, f"{key}.scale", raw["scale"])) @ lin
         if "rotate" in raw:
             r = raw["rotate"]
             if isinstance(r, dict):
                 extra = set(r) - {"axis", "angle"}
                 if extra or "axis" not in r or "angle" not in r:
                     raise UserError(source, f"{key}.rotate: expected {{axis: [x, y, z], angle: degrees}}")
-                axis = _vec3(source, f"{key}.rotate.axis", r["axis"])
+                axis = _vec3(source, f"{key}.rotate.axis", r["axis"], MAX_SCALE)
                 if not np.linalg.norm(axis) > 0:
                     raise UserError(source, f"{key}.rotate.axis: must not be zero")
                 rot = rotation_axis_angle(axis, _number(source, f"{key}.rotate.angle", r["angle"]))
@@ -116,16 +119,25 @@ def parse_transform(source: str, key: str, raw: Any) -> np.ndarray:
             lin = rot @ lin
         t = _vec3(source, f"{key}.translate", raw["translate"]) if "translate" in raw else np.zeros(3)
         m = affine(lin, t)
-    check_invertible(source, key, m)
+    check_matrix(source, key, m)
     return m
 
 
-def check_invertible(source: str, key: str, m: np.ndarray) -> None:
-    a = m[:, :3]
-    scale = float(np.abs(a).max())
-    if not scale > 0 or abs(float(np.linalg.det(a))) <= 1e-12 * scale**3:
+def check_matrix(source: str, key: str, m: np.ndarray) -> None:
+    """An object -> world matrix the tracer can invert: finite, its linear part's singular values (how much
+    it stretches along any direction) within [MIN_SCALE, MAX_SCALE], its translation within the coordinate
+    range. Also applied to composed transforms (lists, CSG nodes)."""
+    if not np.isfinite(m).all():
+        raise UserError(source, f"{key}: the composed transform is not finite")
+    sigma = np.linalg.svd(m[:, :3], compute_uv=False)
+    if not sigma[-1] > 1e-12 * sigma[0]:
         raise UserError(source, f"{key}: the transform is singular (flattens the object); "
                                 "axes must be linearly independent and scales non-zero")
+    if sigma[0] > MAX_SCALE * (1 + 1e-9) or sigma[-1] < MIN_SCALE * (1 - 1e-9):
+        raise UserError(source, f"{key}: the transform stretches by {sigma[0]:.3g} and shrinks to {sigma[-1]:.3g}"
+                                f"; both must lie within [{MIN_SCALE:g}, {MAX_SCALE:g}]")
+    if np.abs(m[:, 3]).max() > validate.MAX_COORDINATE:
+        raise UserError(source, f"{key}: the transform moves the object beyond {validate.MAX_COORDINATE:g}")
 
 
 def invert(m: np.ndarray) -> np.ndarray:

@@ -27,7 +27,7 @@
 enum { RT_LEAF = 0, RT_UNION = 1, RT_INTERSECTION = 2, RT_DIFFERENCE = 3 };
 
 /* Limits (validated by generator/scene.py too, with the same numbers). */
-#define RT_MAX_CSG_DEPTH 48 /* nesting of CSG nodes below a top-level object */
+#define RT_MAX_CSG_DEPTH 96 /* depth of the binary CSG tree below a top-level object */
 #define RT_MAX_SPANS 64     /* inside-intervals kept per CSG node and ray (the nearest ones) */
 #define RT_MAX_MEDIA 8      /* nested transparent media a ray can be inside at once */
 #define RT_MAX_DEPTH 64     /* hard cap on the recursion depth a render may ask for */

@@ -9,7 +9,8 @@ import numpy as np
 import sympy
 
 from conftest import CShapes, load_python_shape
-from implgen.emit import generate, write_files
+from implgen.emit import generate
+from implgen.outputs import write_text_files
 from implgen.spec import X, Y, Z, param_symbol, parse_spec
 
 NASTY = ["c", "d", "o", "t", "g", "n", "p", "params", "roots", "box", "count", "all", "ox", "dx", "px",
@@ -32,7 +33,7 @@ def _exact_value(spec, point, params) -> float:
 
 def test_params_named_like_internal_identifiers(tmp_path, rng):
     spec = _spec()
-    write_files(generate(spec), tmp_path)
+    write_text_files(generate(spec), tmp_path)
     module = load_python_shape("nasty", tmp_path)
     assert list(module.PARAMS) == NASTY
     cshape = CShapes(["nasty"], folder=tmp_path)
@@ -50,7 +51,7 @@ def test_specialise_folds_params_and_keeps_the_surface(tmp_path, rng):
                        "params": {"R": 1.0, "r": 0.25}, "bounds": {"z": ["-r", "r"]}}, "<test>")
     folded = spec.specialise({"R": 1.5, "r": 0.5}, name="torus_fixed")
     assert folded.params == {} and folded.folded == {"R": 1.5, "r": 0.5} and folded.box()[2] == -0.5
-    write_files(generate(spec) | generate(folded), tmp_path)
+    write_text_files(generate(spec) | generate(folded), tmp_path)
     general = load_python_shape("torus", tmp_path)
     fixed = load_python_shape("torus_fixed", tmp_path)
     o = rng.uniform(-2, 2, (100, 3))

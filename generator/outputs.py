@@ -1,0 +1,94 @@
+"""Where results go: output paths checked before any work, files written atomically with the usual mode.
+
+A file is written under a temporary name in its own folder and renamed into place, so a failure or a crash
+leaves nothing half-written. It is created with mode 0666 less the umask, like any file a program makes
+(`tempfile.mkstemp` would make it 0600).
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+import stat
+from pathlib import Path
+from typing import Callable, Mapping
+
+from .errors import UserError
+
+
+def _folder_of(path: Path) -> Path:
+    return path.parent if str(path.parent) else Path(".")
+
+
+def _kind(path: Path) -> str | None:
+    """'a folder', 'a fifo', ... for an existing non-regular path; None for a regular file or nothing."""
+    try:
+        mode = path.stat().st_mode
+    except OSError:
+        return None
+    if stat.S_ISREG(mode):
+        return None
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    return "a fifo" if stat.S_ISFIFO(mode) else "a device or socket"
+
+
+def _check_writable_folder(option: str, folder: Path) -> None:
+    if not folder.exists():
+        raise UserError(option, f"the folder {folder} does not exist")
+    if not folder.is_dir():
+        raise UserError(option, f"{folder} is not a folder")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise UserError(option, f"cannot write in {folder} (permission denied)")
+
+
+def check_output_file(path: Path, option: str, suffixes: tuple[str, ...]) -> None:
+    """An output file the command will create or replace: right suffix, not a folder or a fifo, in a
+    writable folder. `option` names it in messages as the user typed it (e.g. `-o`)."""
+    label = f"{option} {path}"
+    if path.suffix.lower() not in suffixes:
+        raise UserError(label, f"the output must end in {' or '.join(suffixes)}")
+    kind = _kind(path)
+    if kind:
+        raise UserError(label, f"is {kind}, not a file to write")
+    _check_writable_folder(label, _folder_of(path))
+
+
+def check_output_folder(path: Path, option: str) -> None:
+    """An output folder the command will create if needed: not an existing file, under a writable folder."""
+    label = f"{option} {path}"
+    if path.exists():
+        if not path.is_dir():
+            raise UserError(label, "exists and is not a folder")
+        _check_writable_folder(label, path)
+        return
+    ancestor = path.parent
+    while not ancestor.exists() and ancestor != ancestor.parent:
+        ancestor = ancestor.parent
+    _check_writable_folder(label, ancestor if str(ancestor) else Path("."))
+
+
+def atomic_write(path: Path, write: Callable[[object], None]) -> None:
+    """Create `path` through `write(binary_file)`: a temporary file in the same folder, renamed into place."""
+    path = Path(path)
+    tmp = _folder_of(path) / f".{path.name}.{secrets.token_hex(6)}.tmp"
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)   # the umask applies, as for any file
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            write(fh)
+        os.replace(tmp, path)
+    except BaseException:
+        if tmp.exists():
+            tmp.unlink()
+        raise
+
+
+def write_text_files(files: Mapping[str, str], outdir: Path) -> list[Path]:
+    """Write {file name: text} into `outdir` (created if missing), each file atomically."""
+    outdir.mkdir(parents=True, exist_ok=True)
+    written = []
+    for fname, text in files.items():
+        data = text.encode("utf-8")
+        atomic_write(outdir / fname, lambda fh, data=data: fh.write(data))
+        written.append(outdir / fname)
+    return written
