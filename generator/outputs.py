@@ -46,11 +46,11 @@ def check_output_file(path: Path, option: str, suffixes: tuple[str, ...]) -> Non
     """An output file the command will create or replace: right suffix, not a folder or a fifo, in a
     writable folder. `option` names it in messages as the user typed it (e.g. `-o`)."""
     label = f"{option} {path}"
-    if path.suffix.lower() not in suffixes:
-        raise UserError(label, f"the output must end in {' or '.join(suffixes)}")
     kind = _kind(path)
     if kind:
         raise UserError(label, f"is {kind}, not a file to write")
+    if path.suffix.lower() not in suffixes:
+        raise UserError(label, f"the output must end in {' or '.join(suffixes)}")
     _check_writable_folder(label, _folder_of(path))
 
 
