@@ -6,8 +6,9 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.implgen-installed
 SOURCES := pyproject.toml $(shell find generator templates runtime_c -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' \) 2>/dev/null)
+C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c)
 
-.PHONY: demo test install regen gallery bench clean
+.PHONY: demo test lint tools install regen gallery bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -26,6 +27,19 @@ demo: install
 
 test: install
 	$(BIN)/python -m pytest -q tests
+
+# Style, checked not changed: ruff (lint + format) for Python, clang-format (.clang-format) for the C runtime.
+lint: install
+	$(BIN)/ruff check generator tests bench
+	$(BIN)/ruff format --check generator tests bench
+	@if [ -f .clang-format ]; then \
+	  command -v clang-format >/dev/null || $(MAKE) --no-print-directory tools; \
+	  clang-format --dry-run --Werror $(C_FILES); \
+	fi
+
+# Debian packages the checks need (run as root, as CI does).
+tools:
+	apt-get update -qq && apt-get install -y -qq clang-format >/dev/null
 
 # Regenerate the checked-in generated/ folder from examples/shapes/.
 regen: install

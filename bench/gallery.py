@@ -15,8 +15,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-from implgen.render import RenderInfo, render, write_png
-from implgen.scene import load_scene
+from implgen.scene.load import load_scene
+from implgen.scene.render import RenderInfo, render, write_png
 
 
 def machine() -> str:
@@ -35,16 +35,20 @@ def main() -> int:
     parser.add_argument("--threads", type=int, default=os.cpu_count() or 1)
     args = parser.parse_args()
     args.output.mkdir(parents=True, exist_ok=True)
-    rows = ["| scene | size | samples/pixel | seconds | threads | primary / shadow / secondary rays |",
-            "|---|---|---|---|---|---|"]
+    rows = [
+        "| scene | size | samples/pixel | seconds | threads | primary / shadow / secondary rays |",
+        "|---|---|---|---|---|---|",
+    ]
     for path in sorted(args.scenes.glob("*.yaml")):
         scene = load_scene(path)
         info = RenderInfo()
         image = render(scene, threads=args.threads, progress=sys.stderr.isatty(), info=info)
         write_png(image, args.output / f"{path.stem}.png")
         rays = " / ".join(f"{info.rays.get(k, 0) / 1e6:.2f} M" for k in ("primary", "shadow", "secondary"))
-        rows.append(f"| [{path.name}](../../{path.as_posix()}) | {scene.width}×{scene.height} | {scene.spp} | "
-                    f"{info.seconds:.1f} | {info.threads} | {rays} |")
+        rows.append(
+            f"| [{path.name}](../../{path.as_posix()}) | {scene.width}×{scene.height} | {scene.spp} | "
+            f"{info.seconds:.1f} | {info.threads} | {rays} |"
+        )
         print(rows[-1], flush=True)
     text = f"Rendered by `make gallery` on {machine()}.\n\n" + "\n".join(rows) + "\n"
     (args.output / "times.md").write_text(text, encoding="utf-8")

@@ -34,8 +34,10 @@ def _use_runtime(runtime: Path) -> None:
     """Compile scenes against `runtime` (a runtime_c folder) instead of the installed package's; with
     $PICTURE_DIFF_DEBUG set, with -g too (same code, line-level callgrind annotation)."""
     import os
-    import implgen.build as build
-    import implgen.cbuild as cbuild
+
+    import implgen.clib as cbuild
+    import implgen.scene.build as build
+
     runtime = runtime.resolve()
     build.runtime_dir = lambda: runtime  # type: ignore[assignment]
     if os.environ.get("PICTURE_DIFF_DEBUG") and "-g" not in cbuild.BASE_FLAGS:
@@ -44,8 +46,9 @@ def _use_runtime(runtime: Path) -> None:
 
 def _render_one(scene: Path, runtime: Path, width: int | None, height: int | None, threads: int):
     _use_runtime(runtime)
-    from implgen.render import render
-    from implgen.scene import load_scene
+    from implgen.scene.load import load_scene
+    from implgen.scene.render import render
+
     sc = load_scene(scene)
     w = width or max(200, sc.width // 2)
     h = height or max(1, round(w * sc.height / sc.width))
@@ -53,7 +56,8 @@ def _render_one(scene: Path, runtime: Path, width: int | None, height: int | Non
 
 
 def cmd_render(args: argparse.Namespace) -> int:
-    from implgen.render import write_png
+    from implgen.scene.render import write_png
+
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for scene in SCENES:
@@ -66,7 +70,8 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
-    from implgen.render import to_uint8
+    from implgen.scene.render import to_uint8
+
     a_dir, b_dir = Path(args.a), Path(args.b)
     bad = 0
     for fa in sorted(a_dir.glob("*.npy")):
@@ -94,9 +99,22 @@ def cmd_callgrind(args: argparse.Namespace) -> int:
     # compile outside valgrind first, so the measured run finds the library in the cache
     _render_one(scene, Path(args.runtime), 8, 6, 1)
     out = Path(args.out or f"/tmp/callgrind.{scene.stem}.out")
-    cmd = ["valgrind", "--tool=callgrind", "--toggle-collect=worker", f"--callgrind-out-file={out}",
-           sys.executable, __file__, "_render", str(scene), "--runtime", args.runtime,
-           "--width", str(args.width), "--height", str(args.height)]
+    cmd = [
+        "valgrind",
+        "--tool=callgrind",
+        "--toggle-collect=worker",
+        f"--callgrind-out-file={out}",
+        sys.executable,
+        __file__,
+        "_render",
+        str(scene),
+        "--runtime",
+        args.runtime,
+        "--width",
+        str(args.width),
+        "--height",
+        str(args.height),
+    ]
     res = subprocess.run(cmd, capture_output=True, text=True, check=False)
     m = re.search(r"Collected : (\d+)", res.stderr)
     if res.returncode != 0 or not m:

@@ -44,7 +44,7 @@ IMPLGEN = Path(sys.executable).parent / "implgen"
 def _ensure_current_install() -> None:
     """The venv holds an installed copy of implgen; reinstall it from this tree if it predates the exporter."""
     try:
-        from implgen.povray import scene_pov  # noqa: F401
+        from implgen.export.povray import scene_pov  # noqa: F401
     except ImportError:
         print("installing implgen from", ROOT, "(the installed copy has no scene exporter)")
         subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "-q", str(ROOT)], check=True)
@@ -52,12 +52,12 @@ def _ensure_current_install() -> None:
 
 _ensure_current_install()
 
-from implgen import povray as pv  # noqa: E402
-from implgen.scene import Leaf, load_scene  # noqa: E402
-from implgen.spec import exact_polynomial, param_symbol  # noqa: E402
-
+from implgen.codegen.spec import exact_polynomial, param_symbol  # noqa: E402
+from implgen.export import povray as pv  # noqa: E402
+from implgen.scene.load import load_scene  # noqa: E402
 
 # --------------------------------------------------------------------------------------------- POV-Ray
+
 
 def ensure_povray() -> str:
     exe = shutil.which("povray")
@@ -84,8 +84,7 @@ def povray_version(exe: str) -> str:
 
 def run_povray(exe: str, pov: Path, out: Path, w: int, h: int, threads: int) -> tuple[float, float]:
     """(wall seconds, POV-Ray's own trace time). No antialiasing, no display, linear output."""
-    cmd = [exe, f"+I{pov}", f"+O{out}", f"+W{w}", f"+H{h}", "-A", f"+WT{threads}", "-D", "-P", "+FN",
-           "File_Gamma=1.0"]
+    cmd = [exe, f"+I{pov}", f"+O{out}", f"+W{w}", f"+H{h}", "-A", f"+WT{threads}", "-D", "-P", "+FN", "File_Gamma=1.0"]
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True, check=False, cwd=pov.parent)
     wall = time.perf_counter() - t0
@@ -97,8 +96,21 @@ def run_povray(exe: str, pov: Path, out: Path, w: int, h: int, threads: int) -> 
 
 def run_ours(scene: Path, out: Path, w: int, h: int, threads: int) -> tuple[float, float]:
     """(wall seconds of `implgen render`, the render time it prints)."""
-    cmd = [str(IMPLGEN), "render", str(scene), "-o", str(out), "--width", str(w), "--height", str(h),
-           "--spp", "1", "--threads", str(threads)]
+    cmd = [
+        str(IMPLGEN),
+        "render",
+        str(scene),
+        "-o",
+        str(out),
+        "--width",
+        str(w),
+        "--height",
+        str(h),
+        "--spp",
+        "1",
+        "--threads",
+        str(threads),
+    ]
     env = {**os.environ, "TQDM_DISABLE": "1"}
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
@@ -110,6 +122,7 @@ def run_ours(scene: Path, out: Path, w: int, h: int, threads: int) -> tuple[floa
 
 
 # ------------------------------------------------------------------------------------------ coverage
+
 
 def camera_ray(scene, x: float, y: float, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
     """Primary ray through image point (x, y) (pixel centre = +0.5), as runtime_c/tracer_render.c builds it."""
@@ -128,8 +141,8 @@ def camera_ray(scene, x: float, y: float, w: int, h: int) -> tuple[np.ndarray, n
 
 def our_mask(scene_path: Path, w: int, h: int, threads: int) -> np.ndarray:
     """Hit-or-not per pixel from our tracer itself: flat white unlit objects, no plane, black background."""
-    from implgen.render import render
-    from implgen.spec import read_yaml
+    from implgen.scene.render import render
+    from implgen.yamlfile import read_yaml
 
     raw = read_yaml(scene_path)
     raw["objects"] = [o for o in raw["objects"] if o.get("name") != "ground"]
@@ -162,8 +175,9 @@ class ExactJudge:
                 continue
             subs = {param_symbol(k): sp.Rational(Fraction(float(v))) for k, v in leaf.params.items()}
             poly = exact_polynomial(leaf.spec.f.xreplace(subs), [])
-            terms = [(tuple(int(e) for e in m), Fraction(int(c.numerator), int(c.denominator)))
-                     for m, c in poly.terms()]
+            terms = [
+                (tuple(int(e) for e in m), Fraction(int(c.numerator), int(c.denominator))) for m, c in poly.terms()
+            ]
             m = sp.Matrix(3, 4, [sp.Rational(Fraction(float(v))) for v in np.asarray(leaf.matrix).ravel()])
             inv = m[:, :3].inv()
             self.objects.append((terms, inv, m[:, 3], leaf.spec.degree))
@@ -184,8 +198,10 @@ class ExactJudge:
         ow = sp.Matrix([sp.Rational(Fraction(float(v))) for v in o])
         dw = sp.Matrix([sp.Rational(Fraction(float(v))) for v in d])
         oo, dd = inv * (ow - tr), inv * dw
-        lin = [[Fraction(int(sp.numer(oo[k])), int(sp.denom(oo[k]))),
-                Fraction(int(sp.numer(dd[k])), int(sp.denom(dd[k])))] for k in range(3)]
+        lin = [
+            [Fraction(int(sp.numer(oo[k])), int(sp.denom(oo[k]))), Fraction(int(sp.numer(dd[k])), int(sp.denom(dd[k])))]
+            for k in range(3)
+        ]
         powers = []
         for k in range(3):
             pw = [[Fraction(1)]]
@@ -212,19 +228,21 @@ class ExactJudge:
             return c[0] == 0
         t = sp.Symbol("t")
         poly = sp.Poly([sp.Rational(v.numerator, v.denominator) for v in reversed(c)], t, domain="QQ")
-        return poly.count_roots(0, None) > 0   # Sturm: real roots with t >= 0 (a tangent root counts)
+        return poly.count_roots(0, None) > 0  # Sturm: real roots with t >= 0 (a tangent root counts)
 
 
 # ------------------------------------------------------------------------------------- degree family
 
+
 def degree_family(degrees, rays: int, reps: int) -> list[dict]:
-    from implgen import cbuild
-    from implgen.bench_gen import dense_equation
-    from implgen.derive import derive
-    from implgen.emit import derivation_ops, generate
-    from implgen.resources import runtime_dir
-    from implgen.spec import parse_spec
     import ctypes
+
+    from implgen import clib as cbuild
+    from implgen.bench.gen import dense_equation
+    from implgen.codegen.derive import derive
+    from implgen.codegen.emit import derivation_ops, generate
+    from implgen.codegen.spec import parse_spec
+    from implgen.resources import runtime_dir
 
     rt = runtime_dir()
     rows = []
@@ -238,26 +256,45 @@ def degree_family(degrees, rays: int, reps: int) -> list[dict]:
             files = generate(spec, ("c",), der)
             for fname, text in files.items():
                 (Path(tmp) / fname).write_text(text)
-            sources = [*sorted(p for p in rt.glob("*.c") if p.name.startswith(("roots", "shape"))
-                               and p.name != "roots_bench.c"),
-                       Path(tmp) / f"{name}.c", ROOT / "bench" / "c" / "degree_cost.c"]
-            lib = cbuild.load(cbuild.build_shared(sources, include_dirs=[rt, Path(tmp)],
-                                                  extra_flags=[f"-DSHAPE_SYM={name}_shape"], tag=f"deg{n}"))
+            sources = [
+                *sorted(
+                    p for p in rt.glob("*.c") if p.name.startswith(("roots", "shape")) and p.name != "roots_bench.c"
+                ),
+                Path(tmp) / f"{name}.c",
+                ROOT / "bench" / "c" / "degree_cost.c",
+            ]
+            lib = cbuild.load(
+                cbuild.build_shared(
+                    sources, include_dirs=[rt, Path(tmp)], extra_flags=[f"-DSHAPE_SYM={name}_shape"], tag=f"deg{n}"
+                )
+            )
             out = (ctypes.c_double * 5)()
             lib.degree_cost.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_ulonglong, ctypes.POINTER(ctypes.c_double)]
             if lib.degree_cost(rays, reps, 12345, out) != 0:
                 raise RuntimeError("degree_cost failed")
-            rows.append({"degree": spec.degree, "coeffs_ns": out[0], "solve_ns": out[1], "total_ns": out[2],
-                         "roots_per_ray": out[3], "hit_fraction": out[4],
-                         "ops_coeffs": derivation_ops(der, "coeffs"), "ops_value": derivation_ops(der, "value"),
-                         "ops_gradient": derivation_ops(der, "gradient")})
+            rows.append(
+                {
+                    "degree": spec.degree,
+                    "coeffs_ns": out[0],
+                    "solve_ns": out[1],
+                    "total_ns": out[2],
+                    "roots_per_ray": out[3],
+                    "hit_fraction": out[4],
+                    "ops_coeffs": derivation_ops(der, "coeffs"),
+                    "ops_value": derivation_ops(der, "value"),
+                    "ops_gradient": derivation_ops(der, "gradient"),
+                }
+            )
             r = rows[-1]
-            print(f"  degree {n:2d}: coeffs {r['coeffs_ns']:8.1f} ns  solve {r['solve_ns']:9.1f} ns  "
-                  f"total {r['total_ns']:9.1f} ns  ops {r['ops_coeffs']}")
+            print(
+                f"  degree {n:2d}: coeffs {r['coeffs_ns']:8.1f} ns  solve {r['solve_ns']:9.1f} ns  "
+                f"total {r['total_ns']:9.1f} ns  ops {r['ops_coeffs']}"
+            )
     return rows
 
 
 # -------------------------------------------------------------------------------------------- images
+
 
 def side_by_side(ours: Path, theirs: Path, out: Path, width: int = 800) -> None:
     from PIL import Image, ImageDraw
@@ -284,7 +321,10 @@ def disagreement_image(ours: np.ndarray, theirs: np.ndarray, out: Path) -> None:
 
     def grow(m):
         g = m.copy()
-        g[1:] |= m[:-1]; g[:-1] |= m[1:]; g[:, 1:] |= m[:, :-1]; g[:, :-1] |= m[:, 1:]  # noqa: E702
+        g[1:] |= m[:-1]
+        g[:-1] |= m[1:]
+        g[:, 1:] |= m[:, :-1]
+        g[:, :-1] |= m[:, 1:]  # noqa: E702
         return g
 
     img[grow(only_o)] = (255, 40, 40)
@@ -316,14 +356,19 @@ def degree_plot(rows: list[dict], out: Path) -> None:
 
 # ---------------------------------------------------------------------------------------------- main
 
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="1 run per timing, 400x300, fewer rays (a smoke test)")
     ap.add_argument("-o", "--out", type=Path, default=ROOT / "bench" / "results" / "povray")
     ap.add_argument("--runs", type=int, default=None, help="timed runs per configuration (default 3, quick 1)")
     ap.add_argument("--max-verdicts", type=int, default=1500, help="exact checks per scene (random sample)")
-    ap.add_argument("--edge-checks", type=int, default=300,
-                    help="agreed silhouette pixels checked exactly per scene (random sample)")
+    ap.add_argument(
+        "--edge-checks",
+        type=int,
+        default=300,
+        help="agreed silhouette pixels checked exactly per scene (random sample)",
+    )
     args = ap.parse_args(argv)
     runs = args.runs or (1 if args.quick else 3)
     w, h = (400, 300) if args.quick else (800, 600)
@@ -334,8 +379,15 @@ def main(argv=None) -> int:
     exe = ensure_povray()
     ncpu = os.cpu_count() or 1
     thread_counts = [1] if ncpu == 1 else [1, ncpu]
-    results: dict = {"machine": machine_info(), "povray": povray_version(exe), "width": w, "height": h,
-                     "runs": runs, "threads": thread_counts, "scenes": {}}
+    results: dict = {
+        "machine": machine_info(),
+        "povray": povray_version(exe),
+        "width": w,
+        "height": h,
+        "runs": runs,
+        "threads": thread_counts,
+        "scenes": {},
+    }
     print(f"POV-Ray {results['povray']}; {results['machine']['cpu']} x{ncpu}; {w}x{h}, {runs} run(s) each")
     rng = np.random.default_rng(2024)
 
@@ -346,25 +398,34 @@ def main(argv=None) -> int:
         pov.write_text(pv.scene_pov(scene, w, h))
         povc.write_text(pv.scene_pov(scene, w, h, coverage=True))
         ours_png, pov_png = out / "full" / f"{name}_implgen.png", out / "full" / f"{name}_povray.png"
-        run_ours(path, ours_png, w, h, ncpu)          # warm-up: builds and caches the tracer
-        run_povray(exe, pov, pov_png, w, h, ncpu)     # warm-up: file cache
-        rec: dict = {"degree": max(l.spec.degree for l in scene.leaves()), "timing": {}}
+        run_ours(path, ours_png, w, h, ncpu)  # warm-up: builds and caches the tracer
+        run_povray(exe, pov, pov_png, w, h, ncpu)  # warm-up: file cache
+        rec: dict = {"degree": max(leaf.spec.degree for leaf in scene.leaves()), "timing": {}}
         for th in thread_counts:
             o_wall, o_own, p_wall, p_own = [], [], [], []
-            for _ in range(runs):                      # interleaved so both see the same machine load
+            for _ in range(runs):  # interleaved so both see the same machine load
                 a, b = run_ours(path, ours_png, w, h, th)
-                o_wall.append(a); o_own.append(b)     # noqa: E702
+                o_wall.append(a)
+                o_own.append(b)  # noqa: E702
                 a, b = run_povray(exe, pov, pov_png, w, h, th)
-                p_wall.append(a); p_own.append(b)     # noqa: E702
-            t = {"ours_wall": statistics.median(o_wall), "ours_render": statistics.median(o_own),
-                 "pov_wall": statistics.median(p_wall), "pov_trace": statistics.median(p_own),
-                 "ours_wall_all": o_wall, "pov_wall_all": p_wall}
+                p_wall.append(a)
+                p_own.append(b)  # noqa: E702
+            t = {
+                "ours_wall": statistics.median(o_wall),
+                "ours_render": statistics.median(o_own),
+                "pov_wall": statistics.median(p_wall),
+                "pov_trace": statistics.median(p_own),
+                "ours_wall_all": o_wall,
+                "pov_wall_all": p_wall,
+            }
             t["ratio_wall"] = t["pov_wall"] / t["ours_wall"]
             t["ratio_render"] = t["pov_trace"] / t["ours_render"]
             rec["timing"][str(th)] = t
-            print(f"{name:9s} {th} thread(s): implgen {t['ours_wall']:.3f} s (render {t['ours_render']:.3f}), "
-                  f"POV-Ray {t['pov_wall']:.3f} s (trace {t['pov_trace']:.3f}) -> POV/implgen "
-                  f"{t['ratio_wall']:.2f}x wall, {t['ratio_render']:.2f}x render")
+            print(
+                f"{name:9s} {th} thread(s): implgen {t['ours_wall']:.3f} s (render {t['ours_render']:.3f}), "
+                f"POV-Ray {t['pov_wall']:.3f} s (trace {t['pov_trace']:.3f}) -> POV/implgen "
+                f"{t['ratio_wall']:.2f}x wall, {t['ratio_render']:.2f}x render"
+            )
         side_by_side(ours_png, pov_png, out / f"{name}_side_by_side.png")
 
         # coverage
@@ -386,28 +447,49 @@ def main(argv=None) -> int:
             else:
                 pov_right += 1
             if len(examples) < 5:
-                examples.append({"x": int(xx), "y": int(yy), "exact_hit": truth, "implgen": bool(mo[yy, xx]),
-                                 "povray": bool(mp[yy, xx])})
+                examples.append(
+                    {
+                        "x": int(xx),
+                        "y": int(yy),
+                        "exact_hit": truth,
+                        "implgen": bool(mo[yy, xx]),
+                        "povray": bool(mp[yy, xx]),
+                    }
+                )
         # silhouette pixels both programs agree on: are both right there? (a check on the agreement itself)
         edge = np.zeros_like(mo)
-        edge[1:] |= mo[1:] != mo[:-1]; edge[:-1] |= mo[1:] != mo[:-1]      # noqa: E702
-        edge[:, 1:] |= mo[:, 1:] != mo[:, :-1]; edge[:, :-1] |= mo[:, 1:] != mo[:, :-1]  # noqa: E702
+        edge[1:] |= mo[1:] != mo[:-1]
+        edge[:-1] |= mo[1:] != mo[:-1]  # noqa: E702
+        edge[:, 1:] |= mo[:, 1:] != mo[:, :-1]
+        edge[:, :-1] |= mo[:, 1:] != mo[:, :-1]  # noqa: E702
         agreed_edge = np.argwhere(edge & (mo == mp))
         nedge = min(len(agreed_edge), args.edge_checks)
         esample = agreed_edge[rng.choice(len(agreed_edge), nedge, replace=False)] if nedge else agreed_edge[:0]
         both_wrong = sum(judge.hits(int(xx), int(yy)) != bool(mo[yy, xx]) for yy, xx in esample)
-        rec["coverage"] = {"edge_checked": int(nedge), "edge_both_wrong": int(both_wrong),
-                           "edge_pixels": int(edge.sum()),
-"pixels": w * h, "implgen_hits": int(mo.sum()), "povray_hits": int(mp.sum()),
-                           "disputed": int(len(dis)), "disputed_fraction": len(dis) / (w * h),
-                           "only_implgen": int((mo & ~mp).sum()), "only_povray": int((mp & ~mo).sum()),
-                           "checked": int(len(sample)), "implgen_right": ours_right, "povray_right": pov_right,
-                           "check_seconds": time.perf_counter() - t0, "examples": examples}
+        rec["coverage"] = {
+            "edge_checked": int(nedge),
+            "edge_both_wrong": int(both_wrong),
+            "edge_pixels": int(edge.sum()),
+            "pixels": w * h,
+            "implgen_hits": int(mo.sum()),
+            "povray_hits": int(mp.sum()),
+            "disputed": int(len(dis)),
+            "disputed_fraction": len(dis) / (w * h),
+            "only_implgen": int((mo & ~mp).sum()),
+            "only_povray": int((mp & ~mo).sum()),
+            "checked": int(len(sample)),
+            "implgen_right": ours_right,
+            "povray_right": pov_right,
+            "check_seconds": time.perf_counter() - t0,
+            "examples": examples,
+        }
         c = rec["coverage"]
-        print(f"{name:9s} coverage: {c['disputed']} disputed pixels ({100 * c['disputed_fraction']:.3f} %), "
-              f"checked {c['checked']}: implgen right on {ours_right}, POV-Ray right on {pov_right} "
-              f"({c['check_seconds']:.1f} s); agreed silhouette pixels checked {c['edge_checked']}, "
-              f"both wrong on {c['edge_both_wrong']}")
+        print(
+            f"{name:9s} coverage: {c['disputed']} disputed pixels ({100 * c['disputed_fraction']:.3f} %), "
+            f"checked {c['checked']}: implgen right on {ours_right}, POV-Ray right on {pov_right} "
+            f"({c['check_seconds']:.1f} s); agreed silhouette pixels checked {c['edge_checked']}, "
+            f"both wrong on {c['edge_both_wrong']}"
+        )
         results["scenes"][name] = rec
 
     print("cost against degree (generated C, dense family):")
@@ -428,71 +510,104 @@ def machine_info() -> dict:
                 cpu = line.split(":", 1)[1].strip()
     except OSError:
         pass
-    return {"cpu": cpu, "cores": os.cpu_count(), "system": platform.platform(),
-            "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"), "load_before": os.getloadavg()[0]}
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "system": platform.platform(),
+        "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
+        "load_before": os.getloadavg()[0],
+    }
 
 
 def write_report(r: dict, out: Path) -> None:
     th = r["threads"]
     one, allc = str(th[0]), str(th[-1])
-    L = [f"# implgen against POV-Ray {r['povray']}",
-         "",
-         f"Generated by `bench/povray_compare.py` on {r['machine']['date']}: {r['machine']['cpu']}, "
-         f"{r['machine']['cores']} cores, {r['machine']['system']}. {r['width']}x{r['height']}, 1 sample, "
-         f"median of {r['runs']} interleaved run(s). Load average before the run: "
-         f"{r['machine']['load_before']:.2f} (other jobs may have shared the CPU).",
-         "",
-         "## Render time",
-         "",
-         "Wall = the whole subprocess (`implgen render` includes Python start-up and the cached-build lookup; "
-         "POV-Ray includes parsing). Render = each program's own figure (implgen's render loop; POV-Ray's "
-         "\"Trace Time\"). Ratio = POV-Ray / implgen (> 1: implgen faster).",
-         "",
-         "| scene | degree | threads | implgen wall s | POV-Ray wall s | ratio (wall) | implgen render s | POV-Ray trace s | ratio (render) |",
-         "|---|---|---|---|---|---|---|---|---|"]
+    L = [
+        f"# implgen against POV-Ray {r['povray']}",
+        "",
+        f"Generated by `bench/povray_compare.py` on {r['machine']['date']}: {r['machine']['cpu']}, "
+        f"{r['machine']['cores']} cores, {r['machine']['system']}. {r['width']}x{r['height']}, 1 sample, "
+        f"median of {r['runs']} interleaved run(s). Load average before the run: "
+        f"{r['machine']['load_before']:.2f} (other jobs may have shared the CPU).",
+        "",
+        "## Render time",
+        "",
+        "Wall = the whole subprocess (`implgen render` includes Python start-up and the cached-build lookup; "
+        "POV-Ray includes parsing). Render = each program's own figure (implgen's render loop; POV-Ray's "
+        '"Trace Time"). Ratio = POV-Ray / implgen (> 1: implgen faster).',
+        "",
+        "| scene | degree | threads | implgen wall s | POV-Ray wall s | ratio (wall) | implgen render s "
+        "| POV-Ray trace s | ratio (render) |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for name, s in r["scenes"].items():
         for t in th:
             x = s["timing"][str(t)]
-            L.append(f"| {name} | {s['degree']} | {t} | {x['ours_wall']:.3f} | {x['pov_wall']:.3f} | "
-                     f"{x['ratio_wall']:.2f}x | {x['ours_render']:.3f} | {x['pov_trace']:.3f} | {x['ratio_render']:.2f}x |")
-    L += ["", "## Multi-core speed-up (all cores against one, wall clock)", "",
-          "| scene | implgen | POV-Ray |", "|---|---|---|"]
+            L.append(
+                f"| {name} | {s['degree']} | {t} | {x['ours_wall']:.3f} | {x['pov_wall']:.3f} | "
+                f"{x['ratio_wall']:.2f}x | {x['ours_render']:.3f} | {x['pov_trace']:.3f} | {x['ratio_render']:.2f}x |"
+            )
+    L += [
+        "",
+        "## Multi-core speed-up (all cores against one, wall clock)",
+        "",
+        "| scene | implgen | POV-Ray |",
+        "|---|---|---|",
+    ]
     for name, s in r["scenes"].items():
         a, b = s["timing"][one], s["timing"][allc]
-        L.append(f"| {name} | {a['ours_wall'] / b['ours_wall']:.2f}x (render {a['ours_render'] / b['ours_render']:.2f}x) | "
-                 f"{a['pov_wall'] / b['pov_wall']:.2f}x (trace {a['pov_trace'] / b['pov_trace']:.2f}x) |")
-    L += ["", "## Coverage (object hit or not, per pixel)", "",
-          "Disputed = pixels where one program sees the object and the other does not. Each checked disputed "
-          "pixel is decided exactly (ray mapped to object space in rationals, f(o + t d) expanded over Q, "
-          "Sturm count of roots t >= 0).",
-          "",
-          "Silhouette pixels (a hit next to a miss) on which both agree are also sampled and checked the same "
-          "way, to test the agreement itself.",
-          "",
-          "| scene | implgen hits | POV-Ray hits | disputed | % of image | only implgen | only POV-Ray | checked | implgen right | POV-Ray right | agreed silhouette px checked | both wrong |",
-          "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        L.append(
+            f"| {name} | {a['ours_wall'] / b['ours_wall']:.2f}x (render {a['ours_render'] / b['ours_render']:.2f}x) | "
+            f"{a['pov_wall'] / b['pov_wall']:.2f}x (trace {a['pov_trace'] / b['pov_trace']:.2f}x) |"
+        )
+    L += [
+        "",
+        "## Coverage (object hit or not, per pixel)",
+        "",
+        "Disputed = pixels where one program sees the object and the other does not. Each checked disputed "
+        "pixel is decided exactly (ray mapped to object space in rationals, f(o + t d) expanded over Q, "
+        "Sturm count of roots t >= 0).",
+        "",
+        "Silhouette pixels (a hit next to a miss) on which both agree are also sampled and checked the same "
+        "way, to test the agreement itself.",
+        "",
+        "| scene | implgen hits | POV-Ray hits | disputed | % of image | only implgen | only POV-Ray | checked "
+        "| implgen right | POV-Ray right | agreed silhouette px checked | both wrong |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for name, s in r["scenes"].items():
         c = s["coverage"]
-        L.append(f"| {name} | {c['implgen_hits']} | {c['povray_hits']} | {c['disputed']} | "
-                 f"{100 * c['disputed_fraction']:.3f} | {c['only_implgen']} | {c['only_povray']} | {c['checked']} | "
-                 f"{c['implgen_right']} | {c['povray_right']} | {c['edge_checked']} | {c['edge_both_wrong']} |")
-    L += ["", "Images (left implgen, right POV-Ray) and disagreement maps (red: only implgen hits, blue: only "
-          "POV-Ray hits, dilated by one pixel to be visible):", ""]
+        L.append(
+            f"| {name} | {c['implgen_hits']} | {c['povray_hits']} | {c['disputed']} | "
+            f"{100 * c['disputed_fraction']:.3f} | {c['only_implgen']} | {c['only_povray']} | {c['checked']} | "
+            f"{c['implgen_right']} | {c['povray_right']} | {c['edge_checked']} | {c['edge_both_wrong']} |"
+        )
+    L += [
+        "",
+        "Images (left implgen, right POV-Ray) and disagreement maps (red: only implgen hits, blue: only "
+        "POV-Ray hits, dilated by one pixel to be visible):",
+        "",
+    ]
     for name in r["scenes"]:
         L.append(f"![{name}]({name}_side_by_side.png) ![{name} disagreement]({name}_disagreement.png)")
         L.append("")
-    L += ["## Cost against degree", "",
-          "Generated C for a dense family (product of n/2 offset unit spheres minus 0.01, every monomial present), "
-          "timed in C on one thread over rays aimed into the box; ns per ray, median of the passes. "
-          "Coefficients = the generated `<name>_coeffs`; solve = `ig_real_roots` on those coefficients over the "
-          "clipped interval; total = `ig_shape_roots` (clip, shift, coefficients, solve). Ops = arithmetic "
-          "operations of the generated code (`implgen.emit.derivation_ops`).",
-          "",
-          "| degree | coeffs ns | solve ns | total ns | roots/ray | ops coeffs | ops value | ops gradient |",
-          "|---|---|---|---|---|---|---|---|"]
+    L += [
+        "## Cost against degree",
+        "",
+        "Generated C for a dense family (product of n/2 offset unit spheres minus 0.01, every monomial present), "
+        "timed in C on one thread over rays aimed into the box; ns per ray, median of the passes. "
+        "Coefficients = the generated `<name>_coeffs`; solve = `ig_real_roots` on those coefficients over the "
+        "clipped interval; total = `ig_shape_roots` (clip, shift, coefficients, solve). Ops = arithmetic "
+        "operations of the generated code (`implgen.codegen.emit.derivation_ops`).",
+        "",
+        "| degree | coeffs ns | solve ns | total ns | roots/ray | ops coeffs | ops value | ops gradient |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for d in r["degree"]:
-        L.append(f"| {d['degree']} | {d['coeffs_ns']:.1f} | {d['solve_ns']:.1f} | {d['total_ns']:.1f} | "
-                 f"{d['roots_per_ray']:.2f} | {d['ops_coeffs']} | {d['ops_value']} | {d['ops_gradient']} |")
+        L.append(
+            f"| {d['degree']} | {d['coeffs_ns']:.1f} | {d['solve_ns']:.1f} | {d['total_ns']:.1f} | "
+            f"{d['roots_per_ray']:.2f} | {d['ops_coeffs']} | {d['ops_value']} | {d['ops_gradient']} |"
+        )
     L += ["", "![cost against degree](degree_cost.png)", "", "## Targets", ""]
     for line in targets(r):
         L.append(f"- {line}")
@@ -505,14 +620,20 @@ def targets(r: dict) -> list[str]:
         x = s["timing"]["1"]
         need = 5.0 if s["degree"] >= 6 else 2.0
         ok_w, ok_r = x["ratio_wall"] >= need, x["ratio_render"] >= need
-        out.append(f"{name} (degree {s['degree']}), 1 thread, at least {need:g}x faster: wall {x['ratio_wall']:.2f}x "
-                   f"{'MET' if ok_w else 'MISSED'}; render-only {x['ratio_render']:.2f}x {'MET' if ok_r else 'MISSED'}")
+        out.append(
+            f"{name} (degree {s['degree']}), 1 thread, at least {need:g}x faster: wall {x['ratio_wall']:.2f}x "
+            f"{'MET' if ok_w else 'MISSED'}; render-only {x['ratio_render']:.2f}x {'MET' if ok_r else 'MISSED'}"
+        )
     for name, s in r["scenes"].items():
         c = s["coverage"]
         ours_wrong, pov_wrong = c["povray_right"], c["implgen_right"]
-        out.append(f"{name}: disputed pixels checked {c['checked']}; implgen wrong on {ours_wrong}, POV-Ray wrong on "
-                   f"{pov_wrong}: fewer disagreements with the exact reference "
-                   f"{'MET' if ours_wrong < pov_wrong else ('TIE (not strictly met)' if ours_wrong == pov_wrong else 'MISSED')}")
+        verdict = (
+            "MET" if ours_wrong < pov_wrong else ("TIE (not strictly met)" if ours_wrong == pov_wrong else "MISSED")
+        )
+        out.append(
+            f"{name}: disputed pixels checked {c['checked']}; implgen wrong on {ours_wrong}, POV-Ray wrong on "
+            f"{pov_wrong}: fewer disagreements with the exact reference {verdict}"
+        )
     return out
 
 

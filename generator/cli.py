@@ -12,19 +12,19 @@ from __future__ import annotations
 
 import importlib
 import sys
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
 
-from .errors import UserError
+from implgen.errors import UserError
 
 # Subcommands live in their own modules; imported lazily so `implgen SPEC` stays quick.
 _COMMANDS: dict[str, str] = {
-    "render": "implgen.render:main",
+    "render": "implgen.scene.command:main",
     "demo": "implgen.demo:main",
 }
 _BENCHES: dict[str, str] = {
-    "solvers": "implgen.bench_solvers:main",
-    "gen": "implgen.bench_gen:main",
-    "render": "implgen.bench_render:main",
+    "solvers": "implgen.bench.solvers:main",
+    "gen": "implgen.bench.gen:main",
+    "render": "implgen.bench.render:main",
 }
 
 
@@ -41,7 +41,7 @@ def run(argv: Sequence[str]) -> int:
         if len(argv) < 2 or argv[1] not in _BENCHES:
             raise UserError("bench", f"choose one of: {', '.join(_BENCHES)}")
         return _resolve(_BENCHES[argv[1]])(argv[2:])
-    return _resolve("implgen.generate_cli:main")(argv)
+    return _resolve("implgen.codegen.command:main")(argv)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -6,18 +6,18 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import time
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
-from .cbuild import build_shared
-from .derive import derive
-from .emit import derivation_ops, generate
-from .outputs import write_text_files
-from .errors import UserError
-from .resources import runtime_dir
-from .spec import load_spec
+from implgen.clib import build_shared
+from implgen.codegen.derive import derive
+from implgen.codegen.emit import derivation_ops, generate
+from implgen.codegen.spec import load_spec
+from implgen.errors import UserError
+from implgen.outputs import write_text_files
+from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, runtime_dir, runtime_sources
 
 SHOWCASE = Path("examples/scenes/glassware.yaml")
 
@@ -60,17 +60,20 @@ def main(argv: Sequence[str]) -> int:
         write_text_files(generate(spec, ("c", "python"), derivation), gen_dir)
         ms = (time.perf_counter() - start) * 1000
         rows.append((spec, derivation_ops(derivation, "coeffs"), ms))
-    build_shared([gen_dir / f"{s.name}.c" for s, _, _ in rows] + sorted(runtime_dir().glob("roots*.c"))
-                 + sorted(runtime_dir().glob("shape*.c")), include_dirs=[gen_dir, runtime_dir()], tag="demo")
+    build_shared(
+        [gen_dir / f"{s.name}.c" for s, _, _ in rows] + runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES),
+        include_dirs=[gen_dir, runtime_dir()],
+        tag="demo",
+    )
     for spec, ops, ms in rows:
         module = _import(gen_dir / f"{spec.name}.py")
         hits, total = _ray_fan(module, module.bounds())
         params = ", ".join(f"{k}={v:g}" for k, v in spec.params.items()) or "-"
         print(f"{spec.name:<10} {spec.degree:>6} {params:<18} {ops:>9} {ms:>7.0f} {hits:>4}/{total}")
-    print(f"\nAll generated C compiled with -std=c99 -Wall -Wextra -Werror -pedantic against the runtime.")
+    print("\nAll generated C compiled with -std=c99 -Wall -Wextra -Werror -pedantic against the runtime.")
     if SHOWCASE.exists():
         try:
-            from .render import main as render_main
+            from implgen.scene.command import main as render_main
         except ImportError:
             return 0
         out = args.output / "glassware.png"

@@ -23,5 +23,6 @@ class UserError(Exception):
 def _one_line(text: str) -> str:
     """White space folded to single spaces; anything unprintable (terminal escapes, NUL) shown as \\xNN."""
     text = " ".join(text.split())
-    return "".join(ch if ch.isprintable() else f"\\x{ord(ch):02x}" if ord(ch) < 0x100 else f"\\u{ord(ch):04x}"
-                   for ch in text)
+    return "".join(
+        ch if ch.isprintable() else f"\\x{ord(ch):02x}" if ord(ch) < 0x100 else f"\\u{ord(ch):04x}" for ch in text
+    )

@@ -10,10 +10,10 @@ from __future__ import annotations
 import os
 import secrets
 import stat
+from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Callable, Mapping
 
-from .errors import UserError
+from implgen.errors import UserError
 
 
 def _folder_of(path: Path) -> Path:
@@ -72,7 +72,7 @@ def atomic_write(path: Path, write: Callable[[object], None]) -> None:
     """Create `path` through `write(binary_file)`: a temporary file in the same folder, renamed into place."""
     path = Path(path)
     tmp = _folder_of(path) / f".{path.name}.{secrets.token_hex(6)}.tmp"
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)   # the umask applies, as for any file
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # the umask applies, as for any file
     try:
         with os.fdopen(fd, "wb") as fh:
             write(fh)

@@ -8,12 +8,12 @@ solver; t = ts + s. Computed at a far origin, the coefficients would lose everyt
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .roots import first_root_batch, real_roots_batch
+from implgen.roots.solvers import first_root_batch, real_roots_batch
 
 CoeffsFn = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
@@ -63,8 +63,16 @@ def _shift_point(box: np.ndarray | None, o: np.ndarray, d: np.ndarray, t0: np.nd
     return np.clip(ts, t0, t1)
 
 
-def _solve(coeffs_fn: CoeffsFn, box: ArrayLike | None, o: ArrayLike, d: ArrayLike, tmin: ArrayLike,
-           tmax: ArrayLike, method: str, first: bool = False):
+def _solve(
+    coeffs_fn: CoeffsFn,
+    box: ArrayLike | None,
+    o: ArrayLike,
+    d: ArrayLike,
+    tmin: ArrayLike,
+    tmax: ArrayLike,
+    method: str,
+    first: bool = False,
+):
     """(batch shape, t per ray with NaN padding, counts); first=True asks the solver for the smallest root only
     (first_root_batch: one column, counts 0 or 1)."""
     o = np.asarray(o, dtype=np.float64)
@@ -98,8 +106,15 @@ def _solve(coeffs_fn: CoeffsFn, box: ArrayLike | None, o: ArrayLike, d: ArrayLik
     return batch, t, counts
 
 
-def nearest_hit(coeffs_fn: CoeffsFn, box: ArrayLike | None, o: ArrayLike, d: ArrayLike, tmin: ArrayLike = 0.0,
-                tmax: ArrayLike = np.inf, method: str = "auto") -> np.ndarray:
+def nearest_hit(
+    coeffs_fn: CoeffsFn,
+    box: ArrayLike | None,
+    o: ArrayLike,
+    d: ArrayLike,
+    tmin: ArrayLike = 0.0,
+    tmax: ArrayLike = np.inf,
+    method: str = "auto",
+) -> np.ndarray:
     """Nearest root t in [tmin, tmax] per ray (np.inf for a miss), shape = broadcast batch shape."""
     batch, t, counts = _solve(coeffs_fn, box, o, d, tmin, tmax, method)
     first = t[:, 0] if t.shape[1] else np.full(t.shape[0], np.nan)
@@ -107,16 +122,30 @@ def nearest_hit(coeffs_fn: CoeffsFn, box: ArrayLike | None, o: ArrayLike, d: Arr
     return out.reshape(batch)
 
 
-def first_hit(coeffs_fn: CoeffsFn, box: ArrayLike | None, o: ArrayLike, d: ArrayLike, tmin: ArrayLike = 0.0,
-              tmax: ArrayLike = np.inf, method: str = "auto") -> np.ndarray:
+def first_hit(
+    coeffs_fn: CoeffsFn,
+    box: ArrayLike | None,
+    o: ArrayLike,
+    d: ArrayLike,
+    tmin: ArrayLike = 0.0,
+    tmax: ArrayLike = np.inf,
+    method: str = "auto",
+) -> np.ndarray:
     """nearest_hit through the first-root solver (`ig_first_root`: it stops at the smallest root instead of
     isolating all of them): nearest root t in [tmin, tmax] per ray, np.inf for a miss."""
     batch, t, counts = _solve(coeffs_fn, box, o, d, tmin, tmax, method, first=True)
     return np.where(counts > 0, t[:, 0], np.inf).reshape(batch)
 
 
-def all_hits(coeffs_fn: CoeffsFn, box: ArrayLike | None, o: ArrayLike, d: ArrayLike, tmin: float = 0.0,
-             tmax: float = np.inf, method: str = "auto") -> np.ndarray:
+def all_hits(
+    coeffs_fn: CoeffsFn,
+    box: ArrayLike | None,
+    o: ArrayLike,
+    d: ArrayLike,
+    tmin: float = 0.0,
+    tmax: float = np.inf,
+    method: str = "auto",
+) -> np.ndarray:
     """All distinct roots t in [tmin, tmax] of ONE ray, ascending."""
     o = np.asarray(o, dtype=np.float64).reshape(3)
     d = np.asarray(d, dtype=np.float64).reshape(3)

@@ -1,4 +1,10 @@
-"""Where the package data (templates, C runtime sources) lives once installed."""
+"""Where the package data (templates, C runtime sources) lives once installed, and which runtime sources make
+which library.
+
+The lists are explicit: a scene library links the solvers, the shape layer and the tracer -- never the
+benchmark timing code, which only the solver library behind `implgen.roots` carries. A test checks that every
+C file in runtime_c/ is in exactly one list.
+"""
 
 from __future__ import annotations
 
@@ -6,12 +12,22 @@ from pathlib import Path
 
 _PACKAGE_DIR = Path(__file__).resolve().parent
 
+SOLVER_SOURCES = ("roots.c", "roots_closed.c", "roots_sturm.c", "roots_bernstein.c")
+BENCH_SOURCES = ("roots_bench.c",)  # clock_gettime around every solve: `implgen bench solvers`
+SHAPE_SOURCES = ("shape.c",)
+TRACER_SOURCES = ("tracer_scene.c", "tracer_csg.c", "tracer_shade.c", "tracer_render.c")
+
 
 def templates_dir() -> Path:
-    """Folder holding the Jinja2 templates (`c/`, `python/`)."""
+    """Folder holding the Jinja2 templates (`c/`, `python/`, `scene/`)."""
     return _PACKAGE_DIR / "templates" if (_PACKAGE_DIR / "templates").is_dir() else _PACKAGE_DIR.parent / "templates"
 
 
 def runtime_dir() -> Path:
     """Folder holding the hand-written C runtime sources (`*.c`, `*.h`)."""
     return _PACKAGE_DIR / "runtime_c" if (_PACKAGE_DIR / "runtime_c").is_dir() else _PACKAGE_DIR.parent / "runtime_c"
+
+
+def runtime_sources(*groups: tuple[str, ...]) -> list[Path]:
+    """Paths of the runtime sources in the given groups (e.g. SOLVER_SOURCES, SHAPE_SOURCES), in order."""
+    return [runtime_dir() / name for group in groups for name in group]

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .errors import UserError
+from implgen.errors import UserError
 
 # The documented range of any length or coordinate in a spec or scene (positions, translations, params,
 # bounds): past it, squares and products of the ray's polynomials leave double range at high degree.
@@ -38,8 +38,16 @@ def _range_text(lo: float, hi: float, lo_open: bool) -> str:
     return f"{'(' if lo_open else '['}{lo:g}, {hi:g}]"
 
 
-def number(source: str, key: str, value: Any, lo: float = -MAX_COORDINATE, hi: float = MAX_COORDINATE, *,
-           lo_open: bool = False, text_ok: bool = False) -> float:
+def number(
+    source: str,
+    key: str,
+    value: Any,
+    lo: float = -MAX_COORDINATE,
+    hi: float = MAX_COORDINATE,
+    *,
+    lo_open: bool = False,
+    text_ok: bool = False,
+) -> float:
     """A finite number in [lo, hi] (or (lo, hi] with lo_open). `text_ok` also takes "1.5" written as text
     (YAML reads `1e3`, without a dot, as text)."""
     if text_ok and isinstance(value, str):
@@ -51,7 +59,7 @@ def number(source: str, key: str, value: Any, lo: float = -MAX_COORDINATE, hi: f
         raise _fail(source, key, f"expected a finite number, not {describe(value)}")
     if isinstance(value, float) and not math.isfinite(value):
         raise _fail(source, key, f"expected a finite number, not {value}")
-    if value < lo or value > hi or (lo_open and value == lo):   # exact for ints of any size
+    if value < lo or value > hi or (lo_open and value == lo):  # exact for ints of any size
         raise _fail(source, key, f"{describe(value)} is outside {_range_text(lo, hi, lo_open)}")
     return float(value)
 
@@ -65,8 +73,13 @@ def whole(source: str, key: str, value: Any, lo: int, hi: int) -> int:
     return value
 
 
-def vector(source: str, key: str, value: Any, lo: float = -MAX_COORDINATE, hi: float = MAX_COORDINATE,
-           ) -> tuple[float, float, float]:
+def vector(
+    source: str,
+    key: str,
+    value: Any,
+    lo: float = -MAX_COORDINATE,
+    hi: float = MAX_COORDINATE,
+) -> tuple[float, float, float]:
     """Three finite numbers, each in [lo, hi]."""
     if not isinstance(value, (list, tuple)) or len(value) != 3:
         raise _fail(source, key, "expected a list of three numbers")

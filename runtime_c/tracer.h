@@ -31,6 +31,7 @@ enum { RT_LEAF = 0, RT_UNION = 1, RT_INTERSECTION = 2, RT_DIFFERENCE = 3 };
 #define RT_MAX_SPANS 64     /* inside-intervals kept per CSG node and ray (the nearest ones) */
 #define RT_MAX_MEDIA 8      /* nested transparent media a ray can be inside at once */
 #define RT_MAX_DEPTH 64     /* hard cap on the recursion depth a render may ask for */
+#define RT_MAX_SPP 4096     /* samples per pixel a render may ask for */
 
 /* Material, passed as RT_MATERIAL_DOUBLES packed doubles in this order. */
 typedef struct rt_material {

@@ -13,7 +13,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define RT_MAX_SPP 4096
 
 struct rt_render {
     const rt_scene *s;

@@ -4,12 +4,16 @@ from __future__ import annotations
 
 import ctypes
 import importlib.util
+import os
+import subprocess
 import sys
 from pathlib import Path
 from types import ModuleType
 
 import numpy as np
 import pytest
+
+from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, runtime_sources
 
 ROOT = Path(__file__).resolve().parents[1]
 SHAPES_DIR = ROOT / "examples" / "shapes"
@@ -19,6 +23,34 @@ SHAPE_FILES = sorted(SHAPES_DIR.glob("*.yaml"))
 SHAPE_NAMES = [p.stem for p in SHAPE_FILES]
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+CDIR = ROOT / "tests" / "c"
+C_WARNINGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
+C_SANITIZE = ["-O1", "-g", "-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer"]
+
+
+def compile_c(out: Path, sources, *, include=(), sanitize: bool = True, shared: bool = False, flags=()) -> Path:
+    """Compile C sources into `out` (an executable, or a shared library with shared=True) with the project's
+    warnings as errors, against the runtime, the generated shapes and tests/c; ASan + UBSan unless told not
+    to (any report aborts). The compiler is $CC, else cc (implgen.clib.compiler)."""
+    from implgen.clib import compiler
+
+    cmd = [compiler(), *C_WARNINGS, *(C_SANITIZE if sanitize else ["-O2"]), "-pthread", *flags]
+    cmd += ["-shared", "-fPIC"] if shared else []
+    cmd += [f"-I{d}" for d in (*include, RUNTIME, GENERATED, CDIR)]
+    cmd += ["-o", str(out), *map(str, sources), "-lm"]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+def run_c(exe: Path, *args: str, timeout: float = 300) -> str:
+    """Run a compiled driver; it must exit 0 (a sanitizer report exits non-zero). Returns its stdout."""
+    env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1", UBSAN_OPTIONS="print_stacktrace=1")
+    proc = subprocess.run([str(exe), *args], capture_output=True, text=True, timeout=timeout, env=env)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    return proc.stdout
 
 
 def load_python_shape(name: str, folder: Path = GENERATED) -> ModuleType:
@@ -32,14 +64,14 @@ def load_python_shape(name: str, folder: Path = GENERATED) -> ModuleType:
 
 def runtime_solver_sources() -> list[Path]:
     """The runtime's solver and shape sources (what a generated intersector links against)."""
-    return sorted([*RUNTIME.glob("roots*.c"), *RUNTIME.glob("shape*.c")])
+    return runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES)
 
 
 class CShapes:
     """Generated C shapes compiled into one shared library (through the package's build cache)."""
 
     def __init__(self, names: list[str], folder: Path = GENERATED, with_runtime: bool = True) -> None:
-        from implgen.cbuild import build_shared, load
+        from implgen.clib import build_shared, load
 
         sources = [folder / f"{n}.c" for n in names]
         if with_runtime:
@@ -78,8 +110,14 @@ class CShapes:
     def intersect(self, name: str, o, d, tmin, tmax, params=()) -> np.ndarray:
         out = (ctypes.c_double * 32)()
         fn = self._fn(name, "intersect")
-        fn.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_void_p,
-                       ctypes.c_void_p]
+        fn.argtypes = [
+            ctypes.c_void_p,
+            ctypes.c_void_p,
+            ctypes.c_double,
+            ctypes.c_double,
+            ctypes.c_void_p,
+            ctypes.c_void_p,
+        ]
         count = fn(self._arr(o), self._arr(d), tmin, tmax, self._arr(params), out)
         return np.array(out[:count])
 

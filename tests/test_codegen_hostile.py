@@ -18,31 +18,43 @@ import sympy
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import RUNTIME, SHAPE_FILES, load_python_shape
-from implgen import escape
-from implgen.cbuild import compiler
-from implgen.emit import generate
+from conftest import RUNTIME, SHAPE_FILES, compile_c, load_python_shape
+from implgen.clib import compiler
+from implgen.codegen import escape
+from implgen.codegen.emit import generate
+from implgen.codegen.grammar import format_expression, parse_expression
+from implgen.codegen.names import reserved_shape_name
+from implgen.codegen.spec import VARIABLES, exact_polynomial, load_spec, param_symbol, parse_spec
 from implgen.errors import UserError
 from implgen.outputs import write_text_files
-from implgen.parse import format_expression, parse_expression
-from implgen.spec import VARIABLES, exact_polynomial, load_spec, param_symbol, parse_spec, reserved_shape_name
 
 ROOT = Path(__file__).resolve().parent.parent
-NASTY = ['*/ int pwned = 1; /*', '"""\nimport os; os.system("touch PWNED")\n"""', "??/\n*/", "\\\n*/",
-         "a\x00b\x1b[31m", "x² − ½ ​", "'''", "\r*/\r", "/*/", "*", "/", "\\", '"', "\U0001f600"]
+NASTY = [
+    "*/ int pwned = 1; /*",
+    '"""\nimport os; os.system("touch PWNED")\n"""',
+    "??/\n*/",
+    "\\\n*/",
+    "a\x00b\x1b[31m",
+    "x² − ½ ​",
+    "'''",
+    "\r*/\r",
+    "/*/",
+    "*",
+    "/",
+    "\\",
+    '"',
+    "\U0001f600",
+]
 text = st.text(alphabet=st.characters(codec="utf-8"), max_size=40) | st.sampled_from(NASTY)
 
 
 # ------------------------------------------------------------------------------------------ escaping
 
+
 def _compile_c(tmp_path: Path, source: str, name: str) -> Path:
     c = tmp_path / f"{name}.c"
     c.write_text(source, encoding="utf-8")
-    lib = tmp_path / f"lib{name}.so"
-    proc = subprocess.run([compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-shared", "-fPIC",
-                           "-o", str(lib), str(c)], capture_output=True, text=True)
-    assert proc.returncode == 0, proc.stderr
-    return lib
+    return compile_c(tmp_path / f"lib{name}.so", [c], sanitize=False, shared=True)
 
 
 def test_c_comment_and_string_survive_a_compiler(tmp_path):
@@ -56,8 +68,9 @@ def test_c_comment_and_string_survive_a_compiler(tmp_path):
     for i, t in enumerate(NASTY):
         got = ctypes.c_char_p(ctypes.addressof(ctypes.c_char.in_dll(lib, f"s{i}"))).value
         assert got == t.encode("utf-8").split(b"\0")[0]
-    symbols = subprocess.run(["nm", "-g", "--defined-only", str(tmp_path / "libesc.so")], capture_output=True,
-                             text=True).stdout
+    symbols = subprocess.run(
+        ["nm", "-g", "--defined-only", str(tmp_path / "libesc.so")], capture_output=True, text=True
+    ).stdout
     assert sorted(line.split()[-1] for line in symbols.splitlines()) == sorted(f"s{i}" for i in range(len(NASTY)))
 
 
@@ -90,6 +103,7 @@ def test_c_string_is_printable_ascii_without_trigraphs(t):
 
 # ------------------------------------------------------------------------------ what generated files show
 
+
 @pytest.mark.parametrize("path", SHAPE_FILES, ids=[p.stem for p in SHAPE_FILES])
 def test_canonical_equation_parses_back_to_the_same_polynomial(path):
     spec = load_spec(path)
@@ -107,20 +121,35 @@ def test_hostile_file_name_and_description_stay_text(tmp_path, monkeypatch):
     name = 'h"""x*\\y??\n z.yaml'
     payload = '*/ int pwned; /* """ ; import os; os.system("touch PWNED") ; """'
     path = tmp_path / name
-    path.write_text(f"name: hostile\nequation: x^2 + y^2 + z^2 - a^2\nparams: {{a: 1}}\n"
-                    f"description: '{payload}'\n")
+    path.write_text(f"name: hostile\nequation: x^2 + y^2 + z^2 - a^2\nparams: {{a: 1}}\ndescription: '{payload}'\n")
     spec = load_spec(path)
     out = tmp_path / "out"
     files = generate(spec)
     for text_ in files.values():
         assert payload not in text_ and name not in text_ and "pwned" not in text_
     write_text_files(files, out)
-    proc = subprocess.run([compiler(), "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-c",
-                           f"-I{RUNTIME}", f"-I{out}", "-o", str(tmp_path / "h.o"), str(out / "hostile.c")],
-                          capture_output=True, text=True)
+    proc = subprocess.run(
+        [
+            compiler(),
+            "-std=c99",
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            "-pedantic",
+            "-c",
+            f"-I{RUNTIME}",
+            f"-I{out}",
+            "-o",
+            str(tmp_path / "h.o"),
+            str(out / "hostile.c"),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 0, proc.stderr
-    syms = subprocess.run(["nm", "-g", "--defined-only", str(tmp_path / "h.o")], capture_output=True,
-                          text=True).stdout.split()
+    syms = subprocess.run(
+        ["nm", "-g", "--defined-only", str(tmp_path / "h.o")], capture_output=True, text=True
+    ).stdout.split()
     assert not [s for s in syms if "pwned" in s]
     module = load_python_shape("hostile", out)
     assert module.NAME == "hostile" and module.value([1.0, 0, 0], a=1.0) == 0.0
@@ -135,8 +164,19 @@ def test_format_expression_uses_the_users_names():
 
 # ------------------------------------------------------------------------------------------- names
 
-GENERATED_SYMBOLS = ("{n}_coeffs", "{n}_value", "{n}_gradient", "{n}_bounds", "{n}_intersect", "{n}_first_hit",
-                     "{n}_normal", "{n}_shape", "{N}_DEGREE", "{N}_NPARAMS", "IMPLGEN_GENERATED_{N}_H")
+GENERATED_SYMBOLS = (
+    "{n}_coeffs",
+    "{n}_value",
+    "{n}_gradient",
+    "{n}_bounds",
+    "{n}_intersect",
+    "{n}_first_hit",
+    "{n}_normal",
+    "{n}_shape",
+    "{N}_DEGREE",
+    "{N}_NPARAMS",
+    "IMPLGEN_GENERATED_{N}_H",
+)
 
 
 def _names_that_make(symbol: str) -> set[str]:
@@ -155,8 +195,8 @@ def _runtime_symbols(tmp_path: Path) -> set[str]:
     """Globals of a built scene library (runtime + glue; the test shape's own left out), every identifier in
     the templates and the runtime headers they include, directly or not (what shares a translation unit with
     generated code), the macros of the system headers, and libc/libm's exports."""
-    from implgen.build import build_scene
-    from implgen.scene import parse_scene
+    from implgen.scene.build import build_scene
+    from implgen.scene.load import parse_scene
 
     scene = parse_scene({"objects": [{"equation": "x^2 + y^2 + z^2 - 1", "name": "ball"}]}, "<t>")
     lib = build_scene(scene).library
@@ -173,16 +213,20 @@ def _runtime_symbols(tmp_path: Path) -> set[str]:
     assert {"shape.h", "roots.h"} <= seen
     for t in texts:
         symbols |= set(re.findall(r"\b[A-Za-z_]\w*\b", t))
-    includes = "".join(f"#include <{h}>\n" for h in ("math.h", "string.h", "stdlib.h", "stdio.h", "float.h",
-                                                     "limits.h", "stdint.h", "time.h", "pthread.h"))
-    macros = subprocess.run([compiler(), "-std=c99", "-dM", "-E", "-x", "c", "-"], input=includes,
-                            capture_output=True, text=True).stdout
+    includes = "".join(
+        f"#include <{h}>\n"
+        for h in ("math.h", "string.h", "stdlib.h", "stdio.h", "float.h", "limits.h", "stdint.h", "time.h", "pthread.h")
+    )
+    macros = subprocess.run(
+        [compiler(), "-std=c99", "-dM", "-E", "-x", "c", "-"], input=includes, capture_output=True, text=True
+    ).stdout
     symbols |= set(re.findall(r"^#define (\w+)", macros, re.M))
     for name in ("libc.so.6", "libm.so.6"):
         path = subprocess.run([compiler(), f"-print-file-name={name}"], capture_output=True, text=True).stdout.strip()
         if Path(path).exists():
-            dyn = subprocess.run(["nm", "-D", "--defined-only", str(Path(path).resolve())], capture_output=True,
-                                 text=True).stdout
+            dyn = subprocess.run(
+                ["nm", "-D", "--defined-only", str(Path(path).resolve())], capture_output=True, text=True
+            ).stdout
             symbols |= {line.split()[-1].split("@")[0] for line in dyn.splitlines()}
     return symbols
 
@@ -209,8 +253,9 @@ def test_headers_the_generated_code_includes_are_not_shape_names():
             assert reserved_shape_name(h.upper()) is not None, h
 
 
-@pytest.mark.parametrize("name", ["rt_scene", "ig", "ig_shape", "RT_foo", "Ig_x", "rt", "math", "Stdio",
-                                  "implgen_x", "pthread", "tracer"])
+@pytest.mark.parametrize(
+    "name", ["rt_scene", "ig", "ig_shape", "RT_foo", "Ig_x", "rt", "math", "Stdio", "implgen_x", "pthread", "tracer"]
+)
 def test_reserved_names_are_refused_in_specs_and_scenes(name):
     with pytest.raises(UserError, match="reserved|header"):
         parse_spec({"name": name, "equation": "x"}, "<t>")

@@ -1,8 +1,8 @@
-"""First-root mode (`implgen.roots.first_root`, `ig_first_root`) and the generated `first_hit`, checked against
+"""First-root mode (`implgen.roots.solvers.first_root`, `ig_first_root`) and the generated `first_hit`, checked against
 two independent things: the full root list of the same method (`real_roots`), and exact real-root isolation on
-the rationals of the double coefficients (`implgen.roots_reference`, scored with that module's tolerances).
+the rationals of the double coefficients (`implgen.roots.reference`, scored with that module's tolerances).
 
-The case sets are those of the solver report (`implgen.bench_solvers.CASE_SETS`): random polynomials, ray
+The case sets are those of the solver report (`implgen.roots.cases.CASE_SETS`): random polynomials, ray
 polynomials of the catalogue shapes (near, far at 1e4, inside and grazing rays, box-clipped and shifted) and
 the built hard set.
 """
@@ -10,21 +10,21 @@ the built hard set.
 from __future__ import annotations
 
 import math
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 import pytest
 
 from conftest import SHAPE_FILES, load_python_shape
-from implgen.bench_solvers import CASE_SETS, hard_set
+from implgen.codegen.spec import load_spec
 from implgen.errors import UserError
-from implgen.roots import METHODS, first_root, first_root_batch, real_roots, real_roots_batch
-from implgen.roots_reference import Score, reference, score_one
-from implgen.spec import load_spec
+from implgen.roots.cases import CASE_SETS, hard_set
+from implgen.roots.reference import Score, reference, score_one
+from implgen.roots.solvers import METHODS, first_root, first_root_batch, real_roots, real_roots_batch
 
 SET_NAMES = [cs.name for cs in CASE_SETS]
-N_LIST = 2000       # polynomials per set compared with real_roots
-N_REF = 60          # the first N_REF of each set go to the exact reference
+N_LIST = 2000  # polynomials per set compared with real_roots
+N_REF = 60  # the first N_REF of each set go to the exact reference
 
 
 def first_root_score(c: np.ndarray, lo: float, hi: float, x: float | None, ref) -> Score:
@@ -133,8 +133,7 @@ TARGETED = [
     ("first root 1e-30, degree 5", _poly(1e-30, 1, 1.5, 2, -3), 0.0, INF, 1e-30, 1e-14),
     ("coefficients ~1e150", _poly(-0.5, 0.25, 1.5, 3, scale=1e150), -INF, INF, -0.5, 1e-15),
     ("coefficients ~1e-150", _poly(-0.5, 0.25, 1.5, 3, scale=1e-150), -INF, INF, -0.5, 1e-15),
-    ("coefficients ~1e150, degree 7, lo = 0", _poly(-0.5, 0.25, 1.5, 3, -7, 5, 6, scale=1e150), 0.0, INF, 0.25,
-     1e-15),
+    ("coefficients ~1e150, degree 7, lo = 0", _poly(-0.5, 0.25, 1.5, 3, -7, 5, 6, scale=1e150), 0.0, INF, 0.25, 1e-15),
     ("NaN coefficient", [1.0, math.nan, 1.0], -INF, INF, None, 0.0),
     ("Inf coefficient", [-1.0, INF, 1.0], -INF, INF, None, 0.0),
     ("-Inf leading coefficient", [-1.0, 0.0, -INF], -INF, INF, None, 0.0),
@@ -156,10 +155,16 @@ TARGETED = [
 # and the ill-conditioned pair at 1 (its first root is 2 there; not a "missed" root by the reference's rules).
 STURM_MISSES = {"pair 2^-30, 2^-29 (1e-9 apart near 0)", "pair 2^-30 apart, whole line"}
 TARGETED_PARAMS = [
-    pytest.param(case, m, id=f"{case[0]}-{m}",
-                 marks=[pytest.mark.xfail(strict=True, reason="Sturm misses this root")]
-                 if (case[0] in STURM_MISSES and m == "sturm") else [])
-    for case in TARGETED for m in METHODS
+    pytest.param(
+        case,
+        m,
+        id=f"{case[0]}-{m}",
+        marks=[pytest.mark.xfail(strict=True, reason="Sturm misses this root")]
+        if (case[0] in STURM_MISSES and m == "sturm")
+        else [],
+    )
+    for case in TARGETED
+    for m in METHODS
 ]
 
 
@@ -183,7 +188,7 @@ def test_targeted_first_roots(case, method: str) -> None:
         assert s.missed == 0 and s.phantom == 0, s
 
 
-@lru_cache(maxsize=None)
+@cache
 def _exact(c: tuple) -> list:
     """The exact reference of one polynomial, once per session (the 1e150 degree-7 case takes seconds)."""
     return reference(np.array([c]))[0]
@@ -207,10 +212,12 @@ def test_bernstein_on_the_hard_set_is_no_worse_than_bracketing(hard_bernstein_br
             firsts.add(first_root_score(c[i], lo[i], hi[i], float(first[i]) if fcounts[i] else None, ref[i]))
         scores[m] = (full, firsts)
     b, k = scores["bernstein"], scores["bracket"]
-    msg = (f"hard set, {len(c)} polynomials, {b[0].ref_simple} required simple roots: "
-           f"bernstein missed {b[0].missed} phantom {b[0].phantom} (first root: missed {b[1].missed} phantom "
-           f"{b[1].phantom}); bracket missed {k[0].missed} phantom {k[0].phantom} (first root: missed "
-           f"{k[1].missed} phantom {k[1].phantom})")
+    msg = (
+        f"hard set, {len(c)} polynomials, {b[0].ref_simple} required simple roots: "
+        f"bernstein missed {b[0].missed} phantom {b[0].phantom} (first root: missed {b[1].missed} phantom "
+        f"{b[1].phantom}); bracket missed {k[0].missed} phantom {k[0].phantom} (first root: missed "
+        f"{k[1].missed} phantom {k[1].phantom})"
+    )
     print(msg)
     assert b[0].ref_simple > 150, msg
     assert b[0].missed <= k[0].missed and b[0].phantom <= k[0].phantom, msg
@@ -242,8 +249,11 @@ def test_generated_python_first_hit_is_intersect(path) -> None:
     mod = load_python_shape(spec.name)
     rng = np.random.default_rng(len(spec.name))
     box = mod.bounds()
-    box = np.array([-2.0, -2.0, -2.0, 2.0, 2.0, 2.0]) if box is None else np.where(
-        np.isfinite(box), box, [-2.0, -2.0, -2.0, 2.0, 2.0, 2.0])
+    box = (
+        np.array([-2.0, -2.0, -2.0, 2.0, 2.0, 2.0])
+        if box is None
+        else np.where(np.isfinite(box), box, [-2.0, -2.0, -2.0, 2.0, 2.0, 2.0])
+    )
     n = 3000
     target = box[:3] + rng.random((n, 3)) * (box[3:] - box[:3])
     d = rng.normal(size=(n, 3)) * 10.0 ** rng.uniform(-1, 1, (n, 1))

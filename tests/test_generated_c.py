@@ -3,16 +3,12 @@
 from __future__ import annotations
 
 import ctypes
-import shutil
-import subprocess
 
 import numpy as np
 import pytest
 
-from conftest import GENERATED, RUNTIME, SHAPE_NAMES, CShapes, runtime_solver_sources
-from implgen.spec import load_spec
-
-SAN = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all"]
+from conftest import CDIR, GENERATED, SHAPE_NAMES, CShapes, compile_c, run_c, runtime_solver_sources
+from implgen.codegen.spec import load_spec
 
 
 @pytest.fixture(scope="module")
@@ -31,8 +27,11 @@ def test_torus_four_hits_along_its_plane(lib):
     t = lib.intersect("torus_z", [-5, 0, 0], [1, 0, 0], 0, np.inf, [1.0, 0.25])
     assert np.allclose(t, [3.75, 4.25, 5.75, 6.25], rtol=1e-14)
     # Suffern's torus about y, a ray along x in the plane y = 0 and one grazing the tube's top (y = b).
-    assert np.allclose(lib.intersect("torus_y", [-5, 0, 0], [2, 0, 0], 0, np.inf, [1.0, 0.25]),
-                       [1.875, 2.125, 2.875, 3.125], rtol=1e-14)
+    assert np.allclose(
+        lib.intersect("torus_y", [-5, 0, 0], [2, 0, 0], 0, np.inf, [1.0, 0.25]),
+        [1.875, 2.125, 2.875, 3.125],
+        rtol=1e-14,
+    )
     graze = lib.intersect("torus_y", [-5, 0.25, 0], [1, 0, 0], 0, np.inf, [1.0, 0.25])
     assert np.allclose(graze, [4.0, 6.0], rtol=1e-6)  # double roots at x = -1 and x = 1: tangent hits
 
@@ -57,8 +56,7 @@ def _first_hit(lib: CShapes, name: str, o, d, tmin, tmax, params=()) -> tuple[in
     """<name>_first_hit through ctypes: (return value, t); t starts as a sentinel the function must not touch
     on a miss."""
     fn = getattr(lib.lib, f"{name}_first_hit")
-    fn.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_void_p,
-                   ctypes.c_void_p]
+    fn.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double, ctypes.c_double, ctypes.c_void_p, ctypes.c_void_p]
     t = ctypes.c_double(-12345.0)
     got = fn(lib._arr(o), lib._arr(d), tmin, tmax, lib._arr(params), ctypes.byref(t))
     return got, t.value
@@ -131,26 +129,23 @@ def _params_literal(values) -> str:
 
 
 def test_every_generated_shape_under_sanitizers(tmp_path):
-    cc = shutil.which("cc") or shutil.which("gcc")
     specs = [load_spec(p) for p in sorted((GENERATED.parent / "examples" / "shapes").glob("*.yaml"))]
-    table = ["#include \"shape.h\""]
-    table += [f"#include \"{s.name}.h\"" for s in specs]
+    table = ['#include "shape.h"']
+    table += [f'#include "{s.name}.h"' for s in specs]
     table += [f"static const double params_{s.name}[] = {_params_literal(s.params.values())};" for s in specs]
-    table.append("typedef int (*gen_ray_fn)(const double o[3], const double d[3], double tmin, double tmax, "
-                 "const double *params, double *t);")
-    table.append("typedef struct { const ig_shape *shape; const double *params; gen_ray_fn intersect, first_hit; } "
-                 "gen_shape_entry;")
+    table.append(
+        "typedef int (*gen_ray_fn)(const double o[3], const double d[3], double tmin, double tmax, "
+        "const double *params, double *t);"
+    )
+    table.append(
+        "typedef struct { const ig_shape *shape; const double *params; gen_ray_fn intersect, first_hit; } "
+        "gen_shape_entry;"
+    )
     table.append("static const gen_shape_entry gen_shapes[] = {")
     table += [f"    {{&{s.name}_shape, params_{s.name}, {s.name}_intersect, {s.name}_first_hit}}," for s in specs]
     table.append("};")
     (tmp_path / "gen_shapes_table.h").write_text("\n".join(table) + "\n")
-    exe = tmp_path / "gen_check"
-    cmd = [cc, "-std=c99", "-O1", "-g", "-Wall", "-Wextra", "-Werror", "-pedantic", *SAN,
-           f"-I{tmp_path}", f"-I{GENERATED}", f"-I{RUNTIME}", "-o", str(exe),
-           str(GENERATED.parent / "tests" / "c" / "gen_shapes_check.c"),
-           *[str(GENERATED / f"{s.name}.c") for s in specs], *map(str, runtime_solver_sources()), "-lm"]
-    subprocess.run(cmd, check=True, capture_output=True, text=True)
-    proc = subprocess.run([str(exe)], capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert f"{len(specs)} passed, 0 failed" in proc.stdout
-    print(proc.stdout)
+    sources = [CDIR / "gen_shapes_check.c", *[GENERATED / f"{s.name}.c" for s in specs], *runtime_solver_sources()]
+    out = run_c(compile_c(tmp_path / "gen_check", sources, include=[tmp_path]))
+    assert f"{len(specs)} passed, 0 failed" in out
+    print(out)

@@ -56,7 +56,7 @@ CASES = [
     ("list-comprehension", "name: s\nequation: '[x for x in y]'\n", "character '[' at position 1 is not allowed"),
     ("statement", "name: s\nequation: 'x; import os'\n", "character ';' at position 2 is not allowed"),
     ("double-equals", "name: s\nequation: x == 1\n", "single '='"),
-    ("string-literal", "name: s\nequation: \"x + 'a'\"\n", "character \"'\" at position 5 is not allowed"),
+    ("string-literal", "name: s\nequation: \"x + 'a'\"\n", 'character "\'" at position 5 is not allowed'),
     ("bounds-axis", GOOD + "bounds: {w: [0, 1]}\n", "unknown axis"),
     ("bounds-order", GOOD + "bounds: {x: [1, -1]}\n", "low must be below high"),
     ("bounds-symbol", GOOD + "bounds: {x: [-y, 1]}\n", "unknown symbol"),

@@ -10,8 +10,8 @@ import pytest
 import sympy
 
 from conftest import GENERATED, SHAPE_FILES, SHAPE_NAMES, CShapes, load_python_shape, random_rays
-from implgen.emit import generate
-from implgen.spec import X, Y, Z, load_spec, param_symbol
+from implgen.codegen.emit import generate
+from implgen.codegen.spec import X, Y, Z, load_spec, param_symbol
 
 EXACT_RAYS = 12
 
@@ -59,8 +59,12 @@ def test_c_and_python_agree(path, rng, all_c):
     assert np.max(np.abs(py_c - c_c) / scale) < 1e-13
     p = o
     assert np.allclose(module.value(p), [all_c.value(spec.name, q, params) for q in p], rtol=1e-13, atol=0)
-    assert np.allclose(module.gradient(p), [all_c.gradient(spec.name, q, params) for q in p], rtol=1e-12,
-                       atol=1e-12 * np.max(np.abs(module.gradient(p))))
+    assert np.allclose(
+        module.gradient(p),
+        [all_c.gradient(spec.name, q, params) for q in p],
+        rtol=1e-12,
+        atol=1e-12 * np.max(np.abs(module.gradient(p))),
+    )
     flag, box = all_c.bounds(spec.name, params)
     if spec.bounds is None:
         assert flag == 0 and module.bounds() is None and np.all(np.isinf(box))
@@ -109,8 +113,9 @@ def test_generation_is_byte_identical_on_rerun(tmp_path):
     for seed in ("1", "2"):
         out = tmp_path / seed
         env = {**os.environ, "PYTHONHASHSEED": seed}
-        subprocess.run([sys.executable, "-m", "implgen.cli", *map(str, SHAPE_FILES), "-q", "-o", str(out)],
-                       check=True, env=env)
+        subprocess.run(
+            [sys.executable, "-m", "implgen.cli", *map(str, SHAPE_FILES), "-q", "-o", str(out)], check=True, env=env
+        )
         outs.append({p.name: p.read_bytes() for p in out.iterdir()})
     assert outs[0] == outs[1]
 

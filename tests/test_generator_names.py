@@ -9,19 +9,46 @@ import numpy as np
 import sympy
 
 from conftest import CShapes, load_python_shape
-from implgen.emit import generate
+from implgen.codegen.emit import generate
+from implgen.codegen.spec import X, Y, Z, param_symbol, parse_spec
 from implgen.outputs import write_text_files
-from implgen.spec import X, Y, Z, param_symbol, parse_spec
 
-NASTY = ["c", "d", "o", "t", "g", "n", "p", "params", "roots", "box", "count", "all", "ox", "dx", "px",
-         "w0", "q0", "k_c", "shape", "math", "np", "coeffs", "value", "NAME", "DEGREE", "PARAMS"]
+NASTY = [
+    "c",
+    "d",
+    "o",
+    "t",
+    "g",
+    "n",
+    "p",
+    "params",
+    "roots",
+    "box",
+    "count",
+    "all",
+    "ox",
+    "dx",
+    "px",
+    "w0",
+    "q0",
+    "k_c",
+    "shape",
+    "math",
+    "np",
+    "coeffs",
+    "value",
+    "NAME",
+    "DEGREE",
+    "PARAMS",
+]
 
 
 def _spec():
     equation = "x^2 + y^2 + z^2 - 1 + " + " + ".join(f"{n}*x*y/{i + 2}" for i, n in enumerate(NASTY))
     params = {n: 0.01 * (i + 1) for i, n in enumerate(NASTY)}
-    return parse_spec({"name": "nasty", "equation": equation, "params": params,
-                       "bounds": {"x": ["-2 - c", "2 + d"]}}, "<test>")
+    return parse_spec(
+        {"name": "nasty", "equation": equation, "params": params, "bounds": {"x": ["-2 - c", "2 + d"]}}, "<test>"
+    )
 
 
 def _exact_value(spec, point, params) -> float:
@@ -47,8 +74,15 @@ def test_params_named_like_internal_identifiers(tmp_path, rng):
 
 
 def test_specialise_folds_params_and_keeps_the_surface(tmp_path, rng):
-    spec = parse_spec({"name": "torus", "equation": "(x^2 + y^2 + z^2 + R^2 - r^2)^2 - 4*R^2*(x^2 + y^2)",
-                       "params": {"R": 1.0, "r": 0.25}, "bounds": {"z": ["-r", "r"]}}, "<test>")
+    spec = parse_spec(
+        {
+            "name": "torus",
+            "equation": "(x^2 + y^2 + z^2 + R^2 - r^2)^2 - 4*R^2*(x^2 + y^2)",
+            "params": {"R": 1.0, "r": 0.25},
+            "bounds": {"z": ["-r", "r"]},
+        },
+        "<test>",
+    )
     folded = spec.specialise({"R": 1.5, "r": 0.5}, name="torus_fixed")
     assert folded.params == {} and folded.folded == {"R": 1.5, "r": 0.5} and folded.box()[2] == -0.5
     write_text_files(generate(spec) | generate(folded), tmp_path)

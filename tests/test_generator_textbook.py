@@ -30,13 +30,16 @@ def suffern_torus(o, d, a, b):
     e = x1 * x1 + y1 * y1 + z1 * z1 - a * a - b * b
     f = x1 * d1 + y1 * d2 + z1 * d3
     four_a_sqrd = 4.0 * a * a
-    return np.stack([
-        e * e - four_a_sqrd * (b * b - y1 * y1),
-        4.0 * f * e + 2.0 * four_a_sqrd * y1 * d2,
-        2.0 * sum_d_sqrd * e + 4.0 * f * f + four_a_sqrd * d2 * d2,
-        4.0 * sum_d_sqrd * f,
-        sum_d_sqrd * sum_d_sqrd,
-    ], axis=-1)
+    return np.stack(
+        [
+            e * e - four_a_sqrd * (b * b - y1 * y1),
+            4.0 * f * e + 2.0 * four_a_sqrd * y1 * d2,
+            2.0 * sum_d_sqrd * e + 4.0 * f * f + four_a_sqrd * d2 * d2,
+            4.0 * sum_d_sqrd * f,
+            sum_d_sqrd * sum_d_sqrd,
+        ],
+        axis=-1,
+    )
 
 
 def suffern_torus_eq_19_22(o, d, a, b):
@@ -46,13 +49,16 @@ def suffern_torus_eq_19_22(o, d, a, b):
     dd = dx**2 + dy**2 + dz**2
     od = ox * dx + oy * dy + oz * dz
     oo = ox**2 + oy**2 + oz**2 - (a**2 + b**2)
-    return np.stack([
-        oo**2 - 4 * a**2 * (b**2 - oy**2),
-        4 * oo * od + 8 * a**2 * oy * dy,
-        2 * dd * oo + 4 * od**2 + 4 * a**2 * dy**2,
-        4 * dd * od,
-        dd**2,
-    ], axis=-1)
+    return np.stack(
+        [
+            oo**2 - 4 * a**2 * (b**2 - oy**2),
+            4 * oo * od + 8 * a**2 * oy * dy,
+            2 * dd * oo + 4 * od**2 + 4 * a**2 * dy**2,
+            4 * dd * od,
+            dd**2,
+        ],
+        axis=-1,
+    )
 
 
 def rtn_torus(o, d, R, r):
@@ -61,8 +67,11 @@ def rtn_torus(o, d, R, r):
     xd, yd, zd = d.T
     A = (xd**2 + yd**2 + zd**2) ** 2
     B = 4 * (x0 * xd + y0 * yd + z0 * zd) * (xd**2 + yd**2 + zd**2)
-    C = (2 * (xd**2 + yd**2 + zd**2) * (x0**2 + y0**2 + z0**2 - R**2 - r**2)
-         + 4 * (x0 * xd + y0 * yd + z0 * zd) ** 2 + 4 * R**2 * zd**2)
+    C = (
+        2 * (xd**2 + yd**2 + zd**2) * (x0**2 + y0**2 + z0**2 - R**2 - r**2)
+        + 4 * (x0 * xd + y0 * yd + z0 * zd) ** 2
+        + 4 * R**2 * zd**2
+    )
     D = 4 * (x0 * xd + y0 * yd + z0 * zd) * (x0**2 + y0**2 + z0**2 - R**2 - r**2) + 8 * R**2 * z0 * zd
     E = (x0**2 + y0**2 + z0**2 - R**2 - r**2) ** 2 - 4 * R**2 * (r**2 - z0**2)
     return np.stack([E, D, C, B, A], axis=-1)

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-import numpy as np
 import pytest
 import sympy
 
 from conftest import SHAPE_FILES, SHAPE_NAMES
-from implgen.povray import polynomial_object, polynomial_terms
-from implgen.spec import X, Y, Z, load_spec, param_symbol
+from implgen.codegen.spec import X, Y, Z, load_spec, param_symbol
+from implgen.export.povray import polynomial_object, polynomial_terms
 
 
 @pytest.mark.parametrize("path", SHAPE_FILES, ids=SHAPE_NAMES)
@@ -31,9 +30,9 @@ def test_object_text_for_the_torus():
     spec = load_spec([p for p in SHAPE_FILES if p.stem == "torus_z"][0])
     text = polynomial_object(spec, {"R": 2.0, "r": 0.5})
     assert text.startswith("polynomial { 4,") and text.rstrip().endswith("}") and "sturm" in text
-    assert "xyz(4,0,0):1," in text          # x^4
-    assert "xyz(0,0,0):14.0625" in text     # (R^2 + r^2)^2 - 4 R^2 r^2 = (R^2 - r^2)^2 = 3.75^2
-    assert "xyz(0,0,2):7.5," in text        # -2(R^2 + r^2) + 4 R^2 = 2 R^2 - 2 r^2
+    assert "xyz(4,0,0):1," in text  # x^4
+    assert "xyz(0,0,0):14.0625" in text  # (R^2 + r^2)^2 - 4 R^2 r^2 = (R^2 - r^2)^2 = 3.75^2
+    assert "xyz(0,0,2):7.5," in text  # -2(R^2 + r^2) + 4 R^2 = 2 R^2 - 2 r^2
 
 
 def test_torus_constant_and_z2_terms_match_hand_expansion():

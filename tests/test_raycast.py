@@ -20,8 +20,16 @@ def torus_coeffs(o: np.ndarray, d: np.ndarray) -> np.ndarray:
     e = (o * o).sum(-1) - A * A - B * B
     f = (o * d).sum(-1)
     fa = 4 * A * A
-    return np.stack([e * e - fa * (B * B - o[..., 1] ** 2), 4 * f * e + 2 * fa * o[..., 1] * d[..., 1],
-                     2 * dd * e + 4 * f * f + fa * d[..., 1] ** 2, 4 * dd * f, dd * dd], axis=-1)
+    return np.stack(
+        [
+            e * e - fa * (B * B - o[..., 1] ** 2),
+            4 * f * e + 2 * fa * o[..., 1] * d[..., 1],
+            2 * dd * e + 4 * f * f + fa * d[..., 1] ** 2,
+            4 * dd * f,
+            dd * dd,
+        ],
+        axis=-1,
+    )
 
 
 def exact_nearest(o: np.ndarray, d: np.ndarray) -> float:
@@ -69,7 +77,7 @@ def test_far_rays_reproduce_near_rays() -> None:
     pf = far[hit] + tf[hit, None] * d[hit]
     assert np.abs(pn - pf).max() <= 1e-9
     # and the shift is what makes it work: expanded at the far origin, the same rays go wrong
-    from implgen.roots import real_roots_batch
+    from implgen.roots.solvers import real_roots_batch
 
     r, k = real_roots_batch(torus_coeffs(far, d), 0.0, np.inf)
     assert ((k > 0) != hit).sum() > 100

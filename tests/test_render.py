@@ -3,18 +3,19 @@
 from __future__ import annotations
 
 import math
-import os
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from implgen import build, cbuild
+from implgen import clib
 from implgen.cli import main as cli_main
 from implgen.errors import UserError
-from implgen.render import CScene, RenderInfo, render
-from implgen.scene import load_scene, parse_scene
-from implgen.transform import invert, parse_transform
+from implgen.scene import build
+from implgen.scene.load import load_scene, parse_scene
+from implgen.scene.render import RenderInfo, render
+from implgen.scene.tracer import CScene
+from implgen.scene.transform import invert, parse_transform
 
 ROOT = Path(__file__).resolve().parent.parent
 SHAPES = ROOT / "examples" / "shapes"
@@ -27,8 +28,14 @@ def base_scene(**over):
         "camera": {"position": [0, 2, 6], "look_at": [0, 0.5, 0], "fov": 40},
         "background": [0.2, 0.4, 0.9],
         "lights": [{"position": [0, 10, 0]}],
-        "materials": {"floor": {"checker": {"colors": [[1, 1, 1], [0, 0, 0]], "scale": 1.0},
-                                "ambient": 0.1, "diffuse": 0.9, "specular": 0}},
+        "materials": {
+            "floor": {
+                "checker": {"colors": [[1, 1, 1], [0, 0, 0]], "scale": 1.0},
+                "ambient": 0.1,
+                "diffuse": 0.9,
+                "specular": 0,
+            }
+        },
         "objects": [{"equation": "y", "name": "ground", "material": "floor"}],
     }
     sc.update(over)
@@ -45,23 +52,29 @@ def scene_at(tmp_path: Path, data: dict, name: str = "s.yaml") -> Path:
 
 # ------------------------------------------------------------------------------------- validation
 
-@pytest.mark.parametrize("patch, key", [
-    ({"camera": {"position": [0, 0, 1], "look_at": [0, 0, 1]}}, "camera.look_at"),
-    ({"image": {"width": 0}}, "image.width"),
-    ({"image": {"spp": 1.5}}, "image.spp"),
-    ({"lights": [{"position": [0, 1]}]}, "lights[0].position"),
-    ({"objects": [{"equation": "y", "material": "nope"}]}, "objects[0].material"),
-    ({"objects": [{"shape": "missing.yaml"}]}, "objects[0].shape"),
-    ({"objects": [{"equation": "y", "transform": {"scale": [1, 0, 1]}}]}, "objects[0].transform"),
-    ({"objects": [{"equation": "y", "transform": {"rotate": [0, 0]}}]}, "objects[0].transform.rotate"),
-    ({"objects": [{"union": [{"equation": "y"}]}]}, "objects[0].union"),
-    ({"objects": [{"equation": "y", "colour": 1}]}, "objects[0].colour"),
-    ({"materials": {"m": {"transparency": 2}}}, "materials.m.transparency"),
-    ({"objects": [{"shape": str(SHAPES / "sphere.yaml"), "params": {"q": 1}}]}, "objects[0].params.q"),
-    ({"objects": [{"equation": "y", "name": "p"}, {"equation": "x +* y"}]}, "objects[1]"),
-    ({"objects": [{"difference": [{"equation": "y"}, {"equation": "x", "transform": {"axes": [[1, 0, 0]]}}]}]},
-     "objects[0].difference[1].transform"),
-])
+
+@pytest.mark.parametrize(
+    "patch, key",
+    [
+        ({"camera": {"position": [0, 0, 1], "look_at": [0, 0, 1]}}, "camera.look_at"),
+        ({"image": {"width": 0}}, "image.width"),
+        ({"image": {"spp": 1.5}}, "image.spp"),
+        ({"lights": [{"position": [0, 1]}]}, "lights[0].position"),
+        ({"objects": [{"equation": "y", "material": "nope"}]}, "objects[0].material"),
+        ({"objects": [{"shape": "missing.yaml"}]}, "objects[0].shape"),
+        ({"objects": [{"equation": "y", "transform": {"scale": [1, 0, 1]}}]}, "objects[0].transform"),
+        ({"objects": [{"equation": "y", "transform": {"rotate": [0, 0]}}]}, "objects[0].transform.rotate"),
+        ({"objects": [{"union": [{"equation": "y"}]}]}, "objects[0].union"),
+        ({"objects": [{"equation": "y", "colour": 1}]}, "objects[0].colour"),
+        ({"materials": {"m": {"transparency": 2}}}, "materials.m.transparency"),
+        ({"objects": [{"shape": str(SHAPES / "sphere.yaml"), "params": {"q": 1}}]}, "objects[0].params.q"),
+        ({"objects": [{"equation": "y", "name": "p"}, {"equation": "x +* y"}]}, "objects[1]"),
+        (
+            {"objects": [{"difference": [{"equation": "y"}, {"equation": "x", "transform": {"axes": [[1, 0, 0]]}}]}]},
+            "objects[0].difference[1].transform",
+        ),
+    ],
+)
 def test_bad_scene_names_file_and_key(tmp_path: Path, patch: dict, key: str) -> None:
     path = scene_at(tmp_path, base_scene(**patch))
     with pytest.raises(UserError) as err:
@@ -93,20 +106,21 @@ def test_transforms() -> None:
 
 # ------------------------------------------------------------------------------------- build cache
 
+
 def test_cache_second_build_compiles_nothing(tmp_path: Path, monkeypatch) -> None:
     monkeypatch.setenv("IMPLGEN_CACHE", str(tmp_path / "cache"))
     sc = parse_scene(base_scene(objects=[{"equation": "y + 0.25*x", "name": "tilted"}]), tmp_path / "a.yaml")
     first = build.build_scene(sc)
     assert first.generated == 1 and first.library.exists()
     calls = []
-    real = cbuild.subprocess.run
+    real = clib.subprocess.run
 
     def spy(cmd, *a, **k):
         if "-shared" in cmd:
             calls.append(cmd)
         return real(cmd, *a, **k)
 
-    monkeypatch.setattr(cbuild.subprocess, "run", spy)
+    monkeypatch.setattr(clib.subprocess, "run", spy)
     sc2 = parse_scene(base_scene(objects=[{"equation": "y + 0.25*x", "name": "tilted"}]), tmp_path / "a.yaml")
     second = build.build_scene(sc2)
     assert second.library == first.library and second.generated == 0 and calls == []
@@ -125,20 +139,27 @@ def test_only_the_scenes_shapes_are_compiled(tmp_path: Path, monkeypatch) -> Non
 
 # ------------------------------------------------------------------------------------- renders
 
+
 def torus_scene() -> dict:
     return base_scene(
         camera={"position": [0, 6, 0.001], "look_at": [0, 0, 0], "fov": 50},
-        objects=[{"shape": str(SHAPES / "torus_y.yaml"), "params": {"a": 1.0, "b": 0.3},
-                  "material": {"color": [1, 0, 0]}, "transform": {"translate": [0, 1, 0]}}],
+        objects=[
+            {
+                "shape": str(SHAPES / "torus_y.yaml"),
+                "params": {"a": 1.0, "b": 0.3},
+                "material": {"color": [1, 0, 0]},
+                "transform": {"translate": [0, 1, 0]},
+            }
+        ],
     )
 
 
 def test_torus_hole_shows_background() -> None:
     img = render(parse_scene(torus_scene()), width=64, height=64, threads=2)
     bg = np.array([0.2, 0.4, 0.9], dtype=np.float32)
-    assert np.allclose(img[32, 32], bg)            # looking down the axis through the hole
-    assert img[32, 32 + 13, 0] > 0.5               # the tube (radius 1 at ~13 px from the centre) is red
-    assert np.allclose(img[1, 1], bg)              # the corner is outside the torus too
+    assert np.allclose(img[32, 32], bg)  # looking down the axis through the hole
+    assert img[32, 32 + 13, 0] > 0.5  # the tube (radius 1 at ~13 px from the centre) is red
+    assert np.allclose(img[1, 1], bg)  # the corner is outside the torus too
     assert np.isfinite(img).all()
 
 
@@ -146,9 +167,15 @@ def test_shadow_darker_than_lit_ground() -> None:
     sc = base_scene(
         camera={"position": [0, 8, 0.001], "look_at": [0, 0, 0], "fov": 60},
         materials={"g": {"color": [1, 1, 1], "ambient": 0.1, "diffuse": 0.9, "specular": 0}},
-        objects=[{"equation": "y", "name": "ground", "material": "g"},
-                 {"shape": str(SHAPES / "sphere.yaml"), "params": {"r": 0.5},
-                  "transform": {"translate": [2, 2, 0]}, "material": "g"}],
+        objects=[
+            {"equation": "y", "name": "ground", "material": "g"},
+            {
+                "shape": str(SHAPES / "sphere.yaml"),
+                "params": {"r": 0.5},
+                "transform": {"translate": [2, 2, 0]},
+                "material": "g",
+            },
+        ],
         lights=[{"position": [2, 10, 0]}],
     )
     parsed = parse_scene(sc)
@@ -167,20 +194,36 @@ def test_glass_sphere_flips_checkerboard() -> None:
     sc = base_scene(
         camera={"position": [0, 0, 8], "look_at": [0, 0, 0], "fov": 30},
         lights=[{"position": [0, 0, 8]}],
-        materials={"wall": {"checker": {"colors": [[1, 1, 1], [0, 0, 0]], "scale": 100.0},
-                            "ambient": 1.0, "diffuse": 0, "specular": 0}},
-        objects=[{"equation": "z + 4", "name": "wall", "material": "wall",
-                  "transform": {"translate": [0.0, 50.0, 0]}},
-                 {"shape": str(SHAPES / "sphere.yaml"), "params": {"r": 1.0},
-                  "material": {"color": [1, 1, 1], "ambient": 0, "diffuse": 0, "specular": 0,
-                               "transparency": 1.0, "ior": 1.5}}],
+        materials={
+            "wall": {
+                "checker": {"colors": [[1, 1, 1], [0, 0, 0]], "scale": 100.0},
+                "ambient": 1.0,
+                "diffuse": 0,
+                "specular": 0,
+            }
+        },
+        objects=[
+            {"equation": "z + 4", "name": "wall", "material": "wall", "transform": {"translate": [0.0, 50.0, 0]}},
+            {
+                "shape": str(SHAPES / "sphere.yaml"),
+                "params": {"r": 1.0},
+                "material": {
+                    "color": [1, 1, 1],
+                    "ambient": 0,
+                    "diffuse": 0,
+                    "specular": 0,
+                    "transparency": 1.0,
+                    "ior": 1.5,
+                },
+            },
+        ],
     )
     parsed = parse_scene(sc)
     c = CScene(parsed, build.build_scene(parsed))
     eye = [0, 0, 8]
-    direct_left = c.trace(eye, [-1.5, 0.2, -8 - 4])     # misses the ball: x < 0 -> cell floor(x/100) = -1
+    direct_left = c.trace(eye, [-1.5, 0.2, -8 - 4])  # misses the ball: x < 0 -> cell floor(x/100) = -1
     direct_right = c.trace(eye, [1.5, 0.2, -8 - 4])
-    through_left = c.trace(eye, [-0.5, 0.05, -8])        # passes through the ball's left half
+    through_left = c.trace(eye, [-0.5, 0.05, -8])  # passes through the ball's left half
     through_right = c.trace(eye, [0.5, 0.05, -8])
     assert not np.allclose(direct_left, direct_right)
     assert np.allclose(through_left, direct_right, atol=0.1) and np.allclose(through_right, direct_left, atol=0.1)
@@ -192,16 +235,32 @@ def test_example_scenes_render_without_nan(scene: str) -> None:
     info = RenderInfo()
     img = render(SCENES / scene, width=48, height=36, spp=1, threads=2, info=info)
     assert img.shape == (36, 48, 3) and np.isfinite(img).all()
-    assert info.nonfinite == 0          # no sample came out NaN (the renderer would have masked it)
-    assert img.std() > 0.01   # not a blank image
+    assert info.nonfinite == 0  # no sample came out NaN (the renderer would have masked it)
+    assert img.std() > 0.01  # not a blank image
 
 
 def test_cli_writes_png(tmp_path: Path) -> None:
     from PIL import Image
 
     out = tmp_path / "t.png"
-    assert cli_main(["render", str(SCENES / "torus_shadow.yaml"), "-o", str(out), "--width", "40",
-                     "--height", "30", "--spp", "1", "-q"]) == 0
+    assert (
+        cli_main(
+            [
+                "render",
+                str(SCENES / "torus_shadow.yaml"),
+                "-o",
+                str(out),
+                "--width",
+                "40",
+                "--height",
+                "30",
+                "--spp",
+                "1",
+                "-q",
+            ]
+        )
+        == 0
+    )
     with Image.open(out) as im:
         assert im.size == (40, 30) and im.mode == "RGB"
     assert [p.name for p in tmp_path.iterdir()] == ["t.png"]
@@ -232,15 +291,23 @@ def test_stratified_samples_measure_pixel_coverage() -> None:
     # wall z = 0 seen head on from (2, 0, 10); tan(fov/2) = 0.5 and 8x2 pixels: pixel k covers x in
     # [-18 + 5k, -13 + 5k]; the checker edge x = 0 splits pixel 3 into 3/5 (x < 0) and 2/5 (x > 0)
     fov = 2 * math.degrees(math.atan(0.5))
-    sc = parse_scene(base_scene(
-        image={"width": 8, "height": 2, "spp": 16},
-        camera={"position": [2, 0, 10], "look_at": [2, 0, 0], "fov": fov},
-        lights=[],
-        materials={"w": {"checker": {"colors": [[1, 1, 1], [0, 0, 0]], "scale": 1000.0},
-                         "ambient": 1.0, "diffuse": 0, "specular": 0}},
-        objects=[{"equation": "z", "name": "wall", "material": "w", "transform": {"translate": [0, 500, 0]}}],
-    ))
-    left = render(sc, spp=1, threads=1)[0, 0, 0]            # x < 0 side colour
+    sc = parse_scene(
+        base_scene(
+            image={"width": 8, "height": 2, "spp": 16},
+            camera={"position": [2, 0, 10], "look_at": [2, 0, 0], "fov": fov},
+            lights=[],
+            materials={
+                "w": {
+                    "checker": {"colors": [[1, 1, 1], [0, 0, 0]], "scale": 1000.0},
+                    "ambient": 1.0,
+                    "diffuse": 0,
+                    "specular": 0,
+                }
+            },
+            objects=[{"equation": "z", "name": "wall", "material": "w", "transform": {"translate": [0, 500, 0]}}],
+        )
+    )
+    left = render(sc, spp=1, threads=1)[0, 0, 0]  # x < 0 side colour
     right = render(sc, spp=1, threads=1)[0, 7, 0]
     assert {float(left), float(right)} == {0.0, 1.0}
     for spp in (4, 16, 64):
@@ -252,8 +319,11 @@ def test_stratified_samples_measure_pixel_coverage() -> None:
 def test_python_ray_queries_and_spawn_offset() -> None:
     """CScene.intersect/spawn: a unit sphere scaled by 1e3 far from the origin; the spawned origin sits off the
     surface by the hit's error bound, on the side the new ray goes to, and a ray from it re-finds the far side."""
-    sc = parse_scene(base_scene(objects=[{"shape": str(SHAPES / "sphere.yaml"),
-                                          "transform": {"scale": 1e3, "translate": [5e3, 0, 0]}}]))
+    sc = parse_scene(
+        base_scene(
+            objects=[{"shape": str(SHAPES / "sphere.yaml"), "transform": {"scale": 1e3, "translate": [5e3, 0, 0]}}]
+        )
+    )
     c = CScene(sc, build.build_scene(sc))
     h = c.intersect([5e3, 0, -1e4], [0, 0, 1])
     assert h is not None and abs(h.t - 9e3) < 1e-9 * 9e3 and h.entering == 1

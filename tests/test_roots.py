@@ -1,5 +1,5 @@
-"""implgen.roots against the exact reference (SymPy root isolation on the exact rationals of the double
-coefficients, implgen.roots_reference), plus the API contract."""
+"""implgen.roots.solvers against the exact reference (SymPy root isolation on the exact rationals of the double
+coefficients, implgen.roots.reference), plus the API contract."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from conftest import SHAPES_DIR
-from implgen.bench_solvers import hard_set, random_set, shape_set
 from implgen.errors import UserError
-from implgen.roots import METHODS, real_roots, real_roots_batch
-from implgen.roots_reference import Score, exact_roots, score_one
+from implgen.roots.cases import hard_set, random_set, shape_set
+from implgen.roots.reference import Score, exact_roots, score_one
+from implgen.roots.solvers import METHODS, real_roots, real_roots_batch
 
 
 def _check(c: np.ndarray, lo: np.ndarray, hi: np.ndarray, method: str, ref=None) -> Score:
@@ -55,8 +55,10 @@ def test_hard_cases_against_exact_reference(hard_polys, method: str) -> None:
     assert max(s.errors_well) <= 1e-12
 
 
-@pytest.mark.parametrize("shapes", [["torus_y", "torus_z"], ["sphere", "cylinder", "cone", "piriform"],
-                                    ["heart", "barth6", "chmutov8", "blobs10"]])
+@pytest.mark.parametrize(
+    "shapes",
+    [["torus_y", "torus_z"], ["sphere", "cylinder", "cone", "piriform"], ["heart", "barth6", "chmutov8", "blobs10"]],
+)
 def test_ray_polynomials_against_exact_reference(shapes: list[str]) -> None:
     c, lo, hi = shape_set(shapes, 24, np.random.default_rng(3), shapes_dir=SHAPES_DIR)
     s = _check(c, lo, hi, "auto")
@@ -83,7 +85,7 @@ def test_batch_matches_single_and_pads_with_nan() -> None:
     assert roots.shape == (50, 6)
     for i in range(50):
         np.testing.assert_array_equal(roots[i, : counts[i]], real_roots(c[i]))
-        assert np.all(np.isnan(roots[i, counts[i]:]))
+        assert np.all(np.isnan(roots[i, counts[i] :]))
 
 
 def test_bad_input_is_reported() -> None:
@@ -102,8 +104,13 @@ def test_bad_input_is_reported() -> None:
 NEWTON_STOPS = {
     "A": (np.poly([1e-18, 1e20, 3e22])[::-1], -np.inf, np.inf),
     "B": (np.array([-2.540122111869743e-08, 577219158706172.9, 6.476999573662965e27, 1.0]), -np.inf, np.inf),
-    "C": (np.array([-2.1822413576320305, 4.677637960067744, 0.33653307245514874, -6.879595268151007,
-                    -1.185614761784202, 1.0]), -1.75, -0.75),
+    "C": (
+        np.array(
+            [-2.1822413576320305, 4.677637960067744, 0.33653307245514874, -6.879595268151007, -1.185614761784202, 1.0]
+        ),
+        -1.75,
+        -0.75,
+    ),
 }
 
 

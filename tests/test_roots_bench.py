@@ -10,10 +10,21 @@ import numpy as np
 import pytest
 
 from conftest import SHAPES_DIR
-from implgen.bench_solvers import (BENCH_SHAPES, CASE_SETS, FIRST, FIRST_METHODS, HIGH_RAYS, KINDS, METHODS, RAYS_HIGH,
-                                   RAYS_LOW, TORUS, bench_first_batch, main, ray_polys, shape_module, shape_set)
-from implgen.roots import bench_solve_batch, first_root_batch, real_roots_batch
-from implgen.roots_reference import exact_roots, score_first
+from implgen.bench.solvers import FIRST, FIRST_METHODS, METHODS, main
+from implgen.roots.cases import (
+    BENCH_SHAPES,
+    CASE_SETS,
+    HIGH_RAYS,
+    KINDS,
+    RAYS_HIGH,
+    RAYS_LOW,
+    TORUS,
+    ray_polys,
+    shape_module,
+    shape_set,
+)
+from implgen.roots.reference import exact_roots, score_first
+from implgen.roots.solvers import bench_first_batch, bench_solve_batch, first_root_batch, real_roots_batch
 
 RAY_SETS = [cs.name for cs in CASE_SETS if "rays" in cs.name]
 
@@ -24,8 +35,9 @@ def test_every_example_shape_is_in_a_ray_set() -> None:
     assert set(RAY_SETS) == {"torus rays", "torus rays (no exact grazing)", "rays deg 2-4", HIGH_RAYS}
 
 
-@pytest.mark.parametrize("name", ["sphere", "cylinder", "piriform", "torus_y", "torus_z", "heart", "chmutov8",
-                                  "blobs10"])
+@pytest.mark.parametrize(
+    "name", ["sphere", "cylinder", "piriform", "torus_y", "torus_z", "heart", "chmutov8", "blobs10"]
+)
 def test_ray_polynomials_are_the_generated_intersectors_own(name: str) -> None:
     """Bench polynomial + shift back gives bit for bit what the generated module's intersect() returns (its
     box clip and origin shift, implgen.raycast, are the twin of runtime_c/shape.c)."""
@@ -35,8 +47,9 @@ def test_ray_polynomials_are_the_generated_intersectors_own(name: str) -> None:
     assert np.all(r.lo <= r.hi) and np.all(np.isfinite(r.lo)) and np.all(np.isfinite(r.hi))
     s, counts = first_root_batch(r.c, r.lo, r.hi)
     ours = np.where(counts > 0, np.clip(r.ts + s, r.ts + r.lo, r.ts + r.hi), np.inf)
-    theirs = np.array([module.intersect(r.o[i], r.d[i], 0.0, np.inf, **{**defaults, **r.params[i]})
-                       for i in range(120)])
+    theirs = np.array(
+        [module.intersect(r.o[i], r.d[i], 0.0, np.inf, **{**defaults, **r.params[i]}) for i in range(120)]
+    )
     np.testing.assert_array_equal(ours, theirs)
     assert np.isfinite(ours).sum() > 40  # they hit, not just pass by
 
@@ -87,14 +100,14 @@ def test_score_first() -> None:
     ref = exact_roots(c)
     ok = score_first(c, -np.inf, np.inf, np.array([1.0]), ref)
     assert (ok.ref_simple, ok.missed, ok.phantom, ok.errors_well) == (1, 0, 0, [0.0])
-    assert score_first(c, -np.inf, np.inf, np.array([2.0]), ref).missed == 1      # skipped the nearest root
-    assert score_first(c, -np.inf, np.inf, np.array([]), ref).missed == 1         # saw through the surface
-    bad = score_first(c, -np.inf, np.inf, np.array([0.5]), ref)                   # a hit where there is none
+    assert score_first(c, -np.inf, np.inf, np.array([2.0]), ref).missed == 1  # skipped the nearest root
+    assert score_first(c, -np.inf, np.inf, np.array([]), ref).missed == 1  # saw through the surface
+    bad = score_first(c, -np.inf, np.inf, np.array([0.5]), ref)  # a hit where there is none
     assert (bad.phantom, bad.missed) == (1, 0)
-    assert score_first(c, 1.5, 10.0, np.array([2.0]), ref).missed == 0           # nearest in [lo, hi]
+    assert score_first(c, 1.5, 10.0, np.array([2.0]), ref).missed == 0  # nearest in [lo, hi]
     none = score_first(c, 3.5, 10.0, np.array([]), ref)
     assert (none.ref_simple, none.missed) == (0, 0)
-    tangent = np.poly([1.0, 1.0, 3.0])[::-1]                                      # a grazing root first
+    tangent = np.poly([1.0, 1.0, 3.0])[::-1]  # a grazing root first
     assert score_first(tangent, 0.0, 10.0, np.array([1.0]), exact_roots(tangent)).missed == 0
 
 
@@ -149,10 +162,16 @@ def test_bench_solvers_quick(tmp_path: Path) -> None:
     assert re.search(r"- No missed/phantom simple roots: auto (MET|NOT MET)", targets)
     assert re.search(r"- Rel\. error <= 1e-12 .*: max \S+ (MET|NOT MET)", targets)
     for case in ("torus rays", "torus rays (no exact grazing)"):
-        assert re.search(rf"- auto within 2x the fastest closed-form quartic \(closed(_plain)?\) on "
-                         rf"{re.escape(case)}: \d+ vs \d+ ns = [\d.]+x.*: (MET|NOT MET)\.", targets)
-    assert re.search(rf"- Bracketing >= 3x faster than Sturm on degree 6-12 ray polynomials \({HIGH_RAYS}.*"
-                     r"= [\d.]+x.*: (MET|NOT MET)\.", targets)
+        assert re.search(
+            rf"- auto within 2x the fastest closed-form quartic \(closed(_plain)?\) on "
+            rf"{re.escape(case)}: \d+ vs \d+ ns = [\d.]+x.*: (MET|NOT MET)\.",
+            targets,
+        )
+    assert re.search(
+        rf"- Bracketing >= 3x faster than Sturm on degree 6-12 ray polynomials \({HIGH_RAYS}.*"
+        r"= [\d.]+x.*: (MET|NOT MET)\.",
+        targets,
+    )
     first = re.search(r"- First-root mode .*torus rays [\d.]+x.*rays deg 2-4 [\d.]+x.*: (MET|NOT MET)\.", targets)
     assert first, targets
     assert (tmp_path / "solvers.png").stat().st_size > 10_000

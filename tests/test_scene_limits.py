@@ -15,13 +15,14 @@ import pytest
 from implgen import validate
 from implgen.cli import main as cli_main
 from implgen.errors import UserError
-from implgen.render import CScene
-from implgen.build import build_scene
-from implgen.scene import MAX_CSG_NESTING, Csg, load_scene, parse_scene
-from implgen.spec import MAX_YAML_NODES, read_yaml
+from implgen.scene.build import build_scene
+from implgen.scene.load import MAX_CSG_NESTING, load_scene, parse_scene
+from implgen.scene.model import Csg
+from implgen.scene.tracer import CScene
+from implgen.yamlfile import MAX_YAML_NODES, read_yaml
 
 ROOT = Path(__file__).resolve().parent.parent
-SPHERE = str(ROOT / "examples" / "shapes" / "sphere.yaml")   # x^2 + y^2 + z^2 - r^2, r = 1
+SPHERE = str(ROOT / "examples" / "shapes" / "sphere.yaml")  # x^2 + y^2 + z^2 - r^2, r = 1
 
 
 def _spheres(n: int, spacing: float = 3.0) -> list[dict]:
@@ -41,10 +42,11 @@ def _sphere_hit(o, d, centre, r=1.0) -> float:
 
 # ---------------------------------------------------------------------------------------------- CSG
 
+
 def test_a_sixty_object_union_is_one_level_and_shallow():
     scene = parse_scene({"objects": [{"union": _spheres(60)}]}, "<t>")
     root = scene.objects[0]
-    assert isinstance(root, Csg) and root.depth == 6 and len(scene.leaves()) == 60   # ceil(log2 60)
+    assert isinstance(root, Csg) and root.depth == 6 and len(scene.leaves()) == 60  # ceil(log2 60)
 
 
 def test_balanced_union_hits_where_the_nearest_sphere_is():
@@ -68,15 +70,25 @@ def test_balanced_union_hits_where_the_nearest_sphere_is():
 def test_difference_list_subtracts_every_later_object():
     """difference [A, B, C] = A - B - C: a ray along x through three overlapping unit spheres enters A, is cut
     by B and C, and comes out of A where the last subtracted sphere ends."""
-    scene = parse_scene({"objects": [{"difference": [
-        {"shape": SPHERE, "transform": {"scale": 2}},
-        {"shape": SPHERE, "transform": {"translate": [-1.5, 0, 0]}},
-        {"shape": SPHERE, "transform": {"translate": [1.5, 0, 0]}}]}]}, "<t>")
+    scene = parse_scene(
+        {
+            "objects": [
+                {
+                    "difference": [
+                        {"shape": SPHERE, "transform": {"scale": 2}},
+                        {"shape": SPHERE, "transform": {"translate": [-1.5, 0, 0]}},
+                        {"shape": SPHERE, "transform": {"translate": [1.5, 0, 0]}},
+                    ]
+                }
+            ]
+        },
+        "<t>",
+    )
     cs = CScene(scene, build_scene(scene))
     try:
-        hit = cs.intersect([-10.0, 0, 0], [1.0, 0, 0])        # A from -2, B covers [-2.5, -0.5]: enter at -0.5
+        hit = cs.intersect([-10.0, 0, 0], [1.0, 0, 0])  # A from -2, B covers [-2.5, -0.5]: enter at -0.5
         assert hit is not None and hit.t == pytest.approx(9.5, rel=1e-12)
-        hit = cs.intersect([-10.0, 0.5, 0], [1.0, 0, 0])      # off axis: B's chord ends at -1.5 + sqrt(0.75)
+        hit = cs.intersect([-10.0, 0.5, 0], [1.0, 0, 0])  # off axis: B's chord ends at -1.5 + sqrt(0.75)
         assert hit.t == pytest.approx(10 - 1.5 + math.sqrt(0.75), rel=1e-12)
     finally:
         cs.close()
@@ -86,12 +98,13 @@ def test_nesting_limit_is_about_nesting_as_written():
     node: dict = {"shape": SPHERE}
     for _ in range(MAX_CSG_NESTING):
         node = {"union": [node, {"shape": SPHERE}]}
-    parse_scene({"objects": [node]}, "<t>")                   # exactly the limit: fine
+    parse_scene({"objects": [node]}, "<t>")  # exactly the limit: fine
     with pytest.raises(UserError, match=f"nested more than {MAX_CSG_NESTING} deep as written"):
         parse_scene({"objects": [{"union": [node, {"shape": SPHERE}]}]}, "<t>")
 
 
 # --------------------------------------------------------------------------------------- YAML expansion
+
 
 def _bomb(levels: int) -> str:
     lines = ["objects:", "  - &n0 {equation: 'x^2 + y^2 + z^2 - 1', name: ball}"]
@@ -117,8 +130,10 @@ def test_recursive_alias_is_refused(tmp_path):
 
 def test_modest_aliases_still_work(tmp_path):
     path = tmp_path / "ok.yaml"
-    path.write_text("materials: {m: &m {color: [1, 0, 0]}}\n"
-                    "objects: [{shape: " + SPHERE + ", material: *m}, {shape: " + SPHERE + ", material: *m}]\n")
+    path.write_text(
+        "materials: {m: &m {color: [1, 0, 0]}}\n"
+        "objects: [{shape: " + SPHERE + ", material: *m}, {shape: " + SPHERE + ", material: *m}]\n"
+    )
     assert len(load_scene(path).leaves()) == 2
     assert read_yaml(path, "scene")["objects"][0]["material"] == {"color": [1, 0, 0]}
 
@@ -131,8 +146,20 @@ def test_yaml_12_floats_are_numbers(tmp_path):
 
 # --------------------------------------------------------------------------------------------- numbers
 
-@pytest.mark.parametrize("value, ok", [(16384, True), (16385, False), (10**400, False), (-(10**400), False),
-                                       (16384.0, False), (True, False), ("12", False), (float("nan"), False)])
+
+@pytest.mark.parametrize(
+    "value, ok",
+    [
+        (16384, True),
+        (16385, False),
+        (10**400, False),
+        (-(10**400), False),
+        (16384.0, False),
+        (True, False),
+        ("12", False),
+        (float("nan"), False),
+    ],
+)
 def test_whole_numbers_compare_exactly(value, ok):
     if ok:
         assert validate.whole("f", "image.width", value, 1, 16384) == value
@@ -149,14 +176,17 @@ def test_huge_integers_are_refused_without_converting_them():
         validate.number("f", "k", 10**9 + 1)
 
 
-@pytest.mark.parametrize("transform, fragment", [
-    ({"scale": 1e-7}, "at least 1e-06"),
-    ({"scale": 2e6}, "outside"),
-    ([{"scale": 1e3}, {"scale": 1e3}, {"scale": 10}], r"stretches by 1e\+07"),
-    ({"translate": [2e9, 0, 0]}, "outside"),
-    ([{"translate": [9e8, 0, 0]}, {"translate": [9e8, 0, 0]}], r"beyond 1e\+09"),
-    ({"axes": [[1, 0, 0], [0, 1, 0], [1, 1, 0]]}, "singular"),
-])
+@pytest.mark.parametrize(
+    "transform, fragment",
+    [
+        ({"scale": 1e-7}, "at least 1e-06"),
+        ({"scale": 2e6}, "outside"),
+        ([{"scale": 1e3}, {"scale": 1e3}, {"scale": 10}], r"stretches by 1e\+07"),
+        ({"translate": [2e9, 0, 0]}, "outside"),
+        ([{"translate": [9e8, 0, 0]}, {"translate": [9e8, 0, 0]}], r"beyond 1e\+09"),
+        ({"axes": [[1, 0, 0], [0, 1, 0], [1, 1, 0]]}, "singular"),
+    ],
+)
 def test_transforms_stay_in_range_once_composed(transform, fragment):
     with pytest.raises(UserError, match=fragment):
         parse_scene({"objects": [{"shape": SPHERE, "transform": transform}]}, "<t>")
@@ -170,6 +200,7 @@ def test_csg_node_transform_is_checked_on_the_composed_matrix():
 
 # ---------------------------------------------------------------------------------------------- output
 
+
 def test_png_and_generated_files_get_the_umask_mode(tmp_path):
     scene = tmp_path / "s.yaml"
     scene.write_text(f"image: {{width: 8, height: 6}}\nobjects: [{{shape: {SPHERE}}}]\n")
@@ -181,17 +212,21 @@ def test_png_and_generated_files_get_the_umask_mode(tmp_path):
         os.umask(old)
     assert (tmp_path / "out.png").stat().st_mode & 0o777 == 0o640
     assert {p.stat().st_mode & 0o777 for p in (tmp_path / "gen").iterdir()} == {0o640}
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["gen", "out.png", "s.yaml"]   # no temporaries left
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["gen", "out.png", "s.yaml"]  # no temporaries left
 
 
 def test_output_is_checked_before_any_work(tmp_path, capsys, monkeypatch):
     """The scene is never read when the output cannot be written: a scene that would take long to load
     (a missing file, here) is not even looked at."""
     called = []
-    monkeypatch.setattr("implgen.render.load_scene", lambda p: called.append(p))
+    monkeypatch.setattr("implgen.scene.command.load_scene", lambda p: called.append(p))
     (tmp_path / "afile").write_text("")
-    for out, fragment in [(tmp_path, "is a folder"), (tmp_path / "nope" / "o.png", "does not exist"),
-                          (tmp_path / "afile" / "o.png", "is not a folder"), (tmp_path / "o.jpg", "end in .png")]:
+    for out, fragment in [
+        (tmp_path, "is a folder"),
+        (tmp_path / "nope" / "o.png", "does not exist"),
+        (tmp_path / "afile" / "o.png", "is not a folder"),
+        (tmp_path / "o.jpg", "end in .png"),
+    ]:
         assert cli_main(["render", str(tmp_path / "missing.yaml"), "-o", str(out)]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and fragment in err and err.startswith("implgen: error: -o "), err

@@ -7,24 +7,18 @@ form). tracer_offsets.c measures secondary-ray robustness on every example shape
 
 from __future__ import annotations
 
-import os
 import re
-import subprocess
 from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
-RUNTIME = ROOT / "runtime_c"
-GENERATED = ROOT / "generated"
-CDIR = ROOT / "tests" / "c"
-SAN = ["-fsanitize=address,undefined", "-fno-sanitize-recover=all"]
-WARN = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-pthread"]
+from conftest import CDIR, GENERATED, ROOT, compile_c, run_c
+from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, TRACER_SOURCES, runtime_sources
 
 
-def runtime_sources() -> list[Path]:
-    """The runtime's C files (roots, shape, tracer)."""
-    return sorted(RUNTIME.glob("*.c"))
+def runtime_c_sources() -> list[Path]:
+    """The runtime's C files a scene library links (solvers, shape layer, tracer)."""
+    return runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES, TRACER_SOURCES)
 
 
 def example_shapes() -> list[str]:
@@ -35,26 +29,15 @@ def example_shapes() -> list[str]:
     return names
 
 
-def compile_driver(out: Path, sources: list[Path], flags: list[str]) -> Path:
-    cc = os.environ.get("CC", "cc")
-    cmd = [cc, *WARN, *flags, f"-I{RUNTIME}", f"-I{GENERATED}", f"-I{CDIR}", "-o", str(out)]
-    cmd += [str(s) for s in sources] + ["-lm"]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    assert proc.returncode == 0, proc.stderr
-    return out
-
-
 def run(exe: Path, *args: str, timeout: float = 300) -> str:
-    env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1", UBSAN_OPTIONS="print_stacktrace=1")
-    proc = subprocess.run([str(exe), *args], capture_output=True, text=True, timeout=timeout, env=env)
-    print(proc.stdout)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    return proc.stdout
+    out = run_c(exe, *args, timeout=timeout)
+    print(out)
+    return out
 
 
 def test_ray_level_analytic(tmp_path: Path) -> None:
     shapes = [GENERATED / f"{n}.c" for n in ("sphere", "torus_z", "piriform")]
-    exe = compile_driver(tmp_path / "rays", [CDIR / "tracer_rays.c", *runtime_sources(), *shapes], ["-g", "-O1", *SAN])
+    exe = compile_c(tmp_path / "rays", [CDIR / "tracer_rays.c", *runtime_c_sources(), *shapes])
     out = run(exe)
     assert "0 failures" in out
     assert re.search(r"sphere: 20000 random rays, hit/miss disagreements 0", out)
@@ -63,7 +46,7 @@ def test_ray_level_analytic(tmp_path: Path) -> None:
 
 def shape_table(path: Path, names: list[str]) -> Path:
     """A glue file listing the example shapes with their default params (from the specs)."""
-    from implgen.spec import load_spec
+    from implgen.codegen.spec import load_spec
 
     lines = ['#include "shape.h"']
     lines += [f'#include "{n}.h"' for n in names]
@@ -99,9 +82,9 @@ def offsets_exes(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, 
         pytest.skip("no generated example shapes")
     tmp = tmp_path_factory.mktemp("offsets")
     table = shape_table(tmp / "table.c", names)
-    srcs = [CDIR / "tracer_offsets.c", table, *runtime_sources(), *(GENERATED / f"{n}.c" for n in names)]
-    san = compile_driver(tmp / "offsets_san", srcs, ["-g", "-O1", *SAN])
-    fast = compile_driver(tmp / "offsets_fast", srcs, ["-O2"])
+    srcs = [CDIR / "tracer_offsets.c", table, *runtime_c_sources(), *(GENERATED / f"{n}.c" for n in names)]
+    san = compile_c(tmp / "offsets_san", srcs)
+    fast = compile_c(tmp / "offsets_fast", srcs, sanitize=False)
     return san, fast, names
 
 

@@ -35,7 +35,7 @@ def c_comment(text: str) -> str:
         if ch not in _PRINTABLE or ch in "\\?":
             out.append(_py_escape(ch))
         elif ch in "*/" and (edge or (out and out[-1][-1:] in "*/" and out[-1][-1:] != ch)):
-            out.append(_py_escape(ch))     # `*/` would close the comment, `/*` open a nested one
+            out.append(_py_escape(ch))  # `*/` would close the comment, `/*` open a nested one
         else:
             out.append(ch)
     return "".join(out)

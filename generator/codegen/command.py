@@ -9,13 +9,13 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
-from .emit import LANGS, generate
-from .errors import UserError
-from .outputs import check_output_folder, write_text_files
-from .spec import load_spec
+from implgen.codegen.emit import LANGS, generate
+from implgen.codegen.spec import load_spec
+from implgen.errors import UserError
+from implgen.outputs import check_output_folder, write_text_files
 
 
 class _Parser(argparse.ArgumentParser):
@@ -24,9 +24,12 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="implgen", description="Generate C and Python ray intersectors from implicit surface specs. "
-                "Other commands: implgen render SCENE.yaml -o OUT.png | implgen bench solvers|gen|render | "
-                "implgen demo")
+    p = _Parser(
+        prog="implgen",
+        description="Generate C and Python ray intersectors from implicit surface specs. "
+        "Other commands: implgen render SCENE.yaml -o OUT.png | implgen bench solvers|gen|render | "
+        "implgen demo",
+    )
     p.add_argument("specs", nargs="+", type=Path, metavar="SPEC.yaml")
     p.add_argument("--lang", choices=["c", "python", "all"], default="all")
     p.add_argument("-o", "--output", type=Path, default=Path("generated"), metavar="DIR")
@@ -53,6 +56,9 @@ def main(argv: Sequence[str]) -> int:
     write_text_files(outputs, args.output)
     if not args.quiet:
         for spec, seconds, names in summary:
-            print(f"{spec.name:<14} degree {spec.degree:>2}  {seconds * 1000:7.1f} ms  -> "
-                  + ", ".join(str(args.output / n) for n in names), file=sys.stdout)
+            print(
+                f"{spec.name:<14} degree {spec.degree:>2}  {seconds * 1000:7.1f} ms  -> "
+                + ", ".join(str(args.output / n) for n in names),
+                file=sys.stdout,
+            )
     return 0

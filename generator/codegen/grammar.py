@@ -21,18 +21,18 @@ from __future__ import annotations
 import ast
 import re
 import string
+from collections.abc import Mapping
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Mapping
 
 import sympy
 from sympy.printing.str import StrPrinter
 
 MAX_TEXT_LENGTH = 20_000
-MAX_NESTING = 100          # parentheses / operator nesting a user could mean
-MAX_CONST_BITS = 256       # numerators and denominators of constants stay below 2^256 (about 1e77)
-MAX_DIGITS = 80           # digits in one number as written
-_LONG_NUMBER = re.compile(r"[0-9_]{%d,}" % (MAX_DIGITS + 1))
+MAX_NESTING = 100  # parentheses / operator nesting a user could mean
+MAX_CONST_BITS = 256  # numerators and denominators of constants stay below 2^256 (about 1e77)
+MAX_DIGITS = 80  # digits in one number as written
+_LONG_NUMBER = re.compile(rf"[0-9_]{{{MAX_DIGITS + 1},}}")
 ALPHABET = frozenset(string.ascii_letters + string.digits + " \t\n._+-*/^()=")
 
 
@@ -43,7 +43,7 @@ class ParseError(ValueError):
 @dataclass(frozen=True)
 class Parsed:
     expr: sympy.Expr
-    degree_bound: int      # upper bound of the total degree in the "variables"
+    degree_bound: int  # upper bound of the total degree in the "variables"
     param_degree_bound: int
 
 
@@ -59,8 +59,14 @@ def _paren_depth(text: str) -> int:
 
 
 class _Builder:
-    def __init__(self, text: str, variables: Mapping[str, sympy.Symbol], params: Mapping[str, sympy.Symbol],
-                 max_degree: int, max_param_degree: int) -> None:
+    def __init__(
+        self,
+        text: str,
+        variables: Mapping[str, sympy.Symbol],
+        params: Mapping[str, sympy.Symbol],
+        max_degree: int,
+        max_param_degree: int,
+    ) -> None:
         self.text = text
         self.variables = variables
         self.params = params
@@ -132,11 +138,19 @@ class _Builder:
         right = self.build(node.right, depth + 1)
         if isinstance(op, (ast.Add, ast.Sub)):
             expr = left.expr + right.expr if isinstance(op, ast.Add) else left.expr - right.expr
-            return self._constant_checked(Parsed(expr, max(left.degree_bound, right.degree_bound),
-                                                 max(left.param_degree_bound, right.param_degree_bound)))
+            return self._constant_checked(
+                Parsed(
+                    expr,
+                    max(left.degree_bound, right.degree_bound),
+                    max(left.param_degree_bound, right.param_degree_bound),
+                )
+            )
         if isinstance(op, ast.Mult):
-            return self._checked(left.expr * right.expr, left.degree_bound + right.degree_bound,
-                                 left.param_degree_bound + right.param_degree_bound)
+            return self._checked(
+                left.expr * right.expr,
+                left.degree_bound + right.degree_bound,
+                left.param_degree_bound + right.param_degree_bound,
+            )
         # Division: by a non-zero constant only.
         if right.degree_bound or right.param_degree_bound or not right.expr.is_Rational:
             segment = ast.get_source_segment(self.text, node.right) or "?"
@@ -158,8 +172,8 @@ class _Builder:
             bits = max(abs(base.expr.p).bit_length(), abs(base.expr.q).bit_length(), 1)
             if k > 1 and bits * k > 2 * MAX_CONST_BITS:
                 raise ParseError(f"constant power too large: exponent {k}")
-            return Parsed(_bounded(base.expr ** k), 0, 0)
-        return self._checked(base.expr ** k, base.degree_bound * k, base.param_degree_bound * k)
+            return Parsed(_bounded(base.expr**k), 0, 0)
+        return self._checked(base.expr**k, base.degree_bound * k, base.param_degree_bound * k)
 
     def _checked(self, expr: sympy.Expr, degree: int, param_degree: int) -> Parsed:
         if degree > self.max_degree:
@@ -178,8 +192,9 @@ class _Builder:
 
 def _bounded(value: sympy.Rational) -> sympy.Rational:
     if max(abs(value.p).bit_length(), abs(value.q).bit_length()) > MAX_CONST_BITS:
-        raise ParseError(f"constant too large: numerator and denominator must stay below 2^{MAX_CONST_BITS} "
-                         "(about 1e77)")
+        raise ParseError(
+            f"constant too large: numerator and denominator must stay below 2^{MAX_CONST_BITS} (about 1e77)"
+        )
     return value
 
 
@@ -191,12 +206,19 @@ def check_alphabet(text: str) -> None:
     """Refuse the first character outside the grammar's alphabet (comments, quotes, escapes, non-ASCII)."""
     for i, ch in enumerate(text):
         if ch not in ALPHABET:
-            raise ParseError(f"character {_show(ch)} at position {i + 1} is not allowed (an equation uses "
-                             "letters, digits, spaces, . _ + - * / ^ ( ) and one =)")
+            raise ParseError(
+                f"character {_show(ch)} at position {i + 1} is not allowed (an equation uses "
+                "letters, digits, spaces, . _ + - * / ^ ( ) and one =)"
+            )
 
 
-def parse_expression(text: str, variables: Mapping[str, sympy.Symbol], params: Mapping[str, sympy.Symbol],
-                     max_degree: int, max_param_degree: int = 64) -> Parsed:
+def parse_expression(
+    text: str,
+    variables: Mapping[str, sympy.Symbol],
+    params: Mapping[str, sympy.Symbol],
+    max_degree: int,
+    max_param_degree: int = 64,
+) -> Parsed:
     """Parse one side of an equation. `variables` count towards the degree; `params` do not."""
     if not isinstance(text, str):
         raise ParseError("expression must be text")
@@ -256,5 +278,5 @@ def format_expression(expr: sympy.Expr, names: Mapping[sympy.Symbol, str]) -> st
     """`expr` printed in the equation grammar (it parses back to the same polynomial), symbols renamed by
     `names`. Its text comes from the expression tree, never from what a user typed."""
     text = _GrammarPrinter(names).doprint(expr)
-    check_alphabet(text)          # identifiers, digits, operators: nothing else can come out
+    check_alphabet(text)  # identifiers, digits, operators: nothing else can come out
     return text

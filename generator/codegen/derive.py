@@ -13,14 +13,14 @@ value, gradient, bounds); each generated function then takes the shared temporar
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import sympy
 from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
-from .spec import AXES, Spec, X, Y, Z
+from implgen.codegen.spec import AXES, Spec, X, Y, Z
 
 # Names used inside generated code. User params are always prefixed `k_` (see spec.param_symbol), and cse
 # temporaries are `w0, w1, ...`, so none of these can collide with a user's name.
@@ -114,6 +114,7 @@ def exact_ray_coefficients(spec: Spec) -> list:
 @dataclass(frozen=True)
 class Block:
     """Straight-line code for one generated function: temporaries, then outputs."""
+
     temps: list[tuple[sympy.Symbol, sympy.Expr]]
     outputs: list[sympy.Expr]
     inputs: list[sympy.Symbol]  # the ray/point/param symbols the block reads
@@ -136,8 +137,9 @@ class Derivation:
         return sum(b.op_count for b in (self.coeffs, self.value, self.gradient))
 
 
-def _split(temps: Sequence[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sympy.Expr],
-           inputs: set[sympy.Symbol]) -> Block:
+def _split(
+    temps: Sequence[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sympy.Expr], inputs: set[sympy.Symbol]
+) -> Block:
     """The temporaries (in order) that `outputs` need, directly or through other temporaries."""
     needed: set[sympy.Symbol] = set()
     for e in outputs:
@@ -185,8 +187,10 @@ def _chain_powers(temps: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sy
         return sympy.Mul(*factors, evaluate=False) if len(factors) > 1 else factors[0]
 
     def rewrite(e: sympy.Expr) -> sympy.Expr:
-        return e.replace(lambda a: a.is_Pow and a.base in squares and a.exp.is_Integer and a.exp >= 2,
-                         lambda a: product(a.base, int(a.exp)))
+        return e.replace(
+            lambda a: a.is_Pow and a.base in squares and a.exp.is_Integer and a.exp >= 2,
+            lambda a: product(a.base, int(a.exp)),
+        )
 
     defined: set[sympy.Expr] = set()
     out: list[tuple[sympy.Symbol, sympy.Expr]] = []
@@ -225,7 +229,7 @@ def derive(spec: Spec) -> Derivation:
     return Derivation(
         spec=spec,
         coeffs=_split(temps, reduced[:k], inputs),
-        value=_split(temps, reduced[k:k + 1], inputs),
-        gradient=_split(temps, reduced[k + 1:k + 4], inputs),
-        bounds=_split(temps, reduced[k + 4:], inputs) if box else None,
+        value=_split(temps, reduced[k : k + 1], inputs),
+        gradient=_split(temps, reduced[k + 1 : k + 4], inputs),
+        bounds=_split(temps, reduced[k + 4 :], inputs) if box else None,
     )

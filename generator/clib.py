@@ -1,6 +1,6 @@
 """Compile C sources into a shared library, cached by content hash, and load it with ctypes.
 
-Used for the root-solver library behind `implgen.roots` and for each scene's tracer. The cache key covers
+Used for the root-solver library behind `implgen.roots.solvers` and for each scene's tracer. The cache key covers
 the source texts, the flags and the compiler's version, so an unchanged input compiles nothing the second
 time and any change rebuilds. The cache folder is `$IMPLGEN_CACHE`, else `$XDG_CACHE_HOME/implgen`, else
 `~/.cache/implgen`. Builds go to a temporary name and are renamed into place, so parallel processes never
@@ -15,11 +15,11 @@ import os
 import shutil
 import subprocess
 import tempfile
-from functools import lru_cache
+from collections.abc import Sequence
+from functools import cache
 from pathlib import Path
-from typing import Sequence
 
-from .errors import UserError
+from implgen.errors import UserError
 
 BASE_FLAGS: tuple[str, ...] = ("-std=c99", "-O3", "-fPIC", "-Wall", "-Wextra", "-Werror", "-pedantic")
 
@@ -44,7 +44,7 @@ def compiler() -> str:
     return cc
 
 
-@lru_cache(maxsize=None)
+@cache
 def _compiler_version(cc: str) -> str:
     out = subprocess.run([cc, "--version"], capture_output=True, text=True, check=False)
     return out.stdout.strip()

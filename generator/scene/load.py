@@ -1,4 +1,5 @@
-"""Scene files: YAML -> validated dataclasses. The format is documented in README.md, "Rendering scenes".
+"""Scene files: YAML -> the validated scene model (scene/model.py). The format is documented in
+docs/formats.md.
 
 Every error is a UserError naming the scene file and the key at fault (`objects[2].transform.rotate`), so
 the CLI prints one line and exits with status 2 before anything is compiled or written.
@@ -7,131 +8,41 @@ the CLI prints one line and exits with status 2 before anything is compiled or w
 from __future__ import annotations
 
 import heapq
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
 import numpy as np
 
-from . import transform as tf
-from . import validate
-from .errors import UserError
-from .spec import Spec, load_spec, parse_spec, read_yaml
+from implgen import abi, validate
+from implgen.codegen.spec import Spec, load_spec, parse_spec
+from implgen.errors import UserError
+from implgen.scene import transform as tf
+from implgen.scene.model import Camera, Csg, Leaf, Light, Material, Node, Scene, depth
+from implgen.yamlfile import read_yaml
 
-MAX_CSG_DEPTH = 96     # = RT_MAX_CSG_DEPTH in runtime_c/tracer.h: depth of the binary tree the tracer gets
-MAX_CSG_NESTING = 32   # CSG operations nested inside each other, as written in the scene
+MAX_CSG_DEPTH = abi.value("RT_MAX_CSG_DEPTH")  # depth of the binary tree the tracer takes
+MAX_CSG_NESTING = 32  # CSG operations nested inside each other, as written in the scene
 MAX_CSG_CHILDREN = 1024  # objects in one CSG list (a list becomes a balanced binary tree)
-MAX_SHAPES = 256       # distinct shapes (spec files and inline equations) in one scene
-MAX_DEPTH = 64         # = RT_MAX_DEPTH
-MAX_SPP = 4096         # = RT_MAX_SPP in tracer_render.c
-MAX_SIZE = 16384       # image width and height
+MAX_SHAPES = 256  # distinct shapes (spec files and inline equations) in one scene
+MAX_DEPTH = abi.value("RT_MAX_DEPTH")
+MAX_SPP = abi.value("RT_MAX_SPP")
+MAX_SIZE = 16384  # image width and height
 CSG_OPS = ("union", "intersection", "difference")
 
 # Documented ranges of colours and material terms ([lo, hi]; lengths and positions use
 # validate.MAX_COORDINATE). Light colour x intensity stays below 100 x 1e4.
 COLOR_MAX = 100.0
 INTENSITY_MAX = 1e4
-MATERIAL_RANGES = {"ambient": (0.0, 100.0), "diffuse": (0.0, 100.0), "specular": (0.0, 100.0),
-                   "shininess": (0.0, 1e4), "reflectivity": (0.0, 1.0), "transparency": (0.0, 1.0)}
+MATERIAL_RANGES = {
+    "ambient": (0.0, 100.0),
+    "diffuse": (0.0, 100.0),
+    "specular": (0.0, 100.0),
+    "shininess": (0.0, 1e4),
+    "reflectivity": (0.0, 1.0),
+    "transparency": (0.0, 1.0),
+}
 IOR_MAX = 10.0
 ABSORPTION_MAX = 1e6
-
-
-@dataclass
-class Material:
-    color: tuple[float, float, float] = (0.8, 0.8, 0.8)
-    color2: tuple[float, float, float] = (0.2, 0.2, 0.2)
-    checker_scale: float = 0.0
-    ambient: float = 0.1
-    diffuse: float = 0.8
-    specular: float = 0.3
-    shininess: float = 50.0
-    reflectivity: float = 0.0
-    transparency: float = 0.0
-    ior: float = 1.5
-    absorption: tuple[float, float, float] = (0.0, 0.0, 0.0)
-
-    def packed(self) -> list[float]:
-        """RT_MATERIAL_DOUBLES values in the order of rt_material (tracer.h)."""
-        return [*self.color, *self.color2, self.checker_scale, self.ambient, self.diffuse, self.specular,
-                self.shininess, self.reflectivity, self.transparency, self.ior, *self.absorption, 0.0, 0.0]
-
-
-@dataclass
-class Leaf:
-    spec: Spec
-    params: dict[str, float]          # every param of the spec, in its declared order
-    matrix: np.ndarray                # 3x4 object -> world
-    material: Material | None
-    where: str                        # key path in the scene, for messages
-
-
-@dataclass
-class Csg:
-    op: str
-    left: "Node"
-    right: "Node"
-    material: Material | None
-    where: str
-    depth: int = field(init=False)   # of this binary node: 1 + the deeper child's
-
-    def __post_init__(self) -> None:
-        self.depth = 1 + max(_depth(self.left), _depth(self.right))
-
-
-Node = Union[Leaf, Csg]
-
-
-def _depth(node: Node) -> int:
-    return node.depth if isinstance(node, Csg) else 0
-
-
-@dataclass
-class Light:
-    position: tuple[float, float, float]
-    color: tuple[float, float, float]     # colour x intensity
-
-
-@dataclass
-class Camera:
-    position: tuple[float, float, float] = (0.0, 1.0, 6.0)
-    look_at: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    up: tuple[float, float, float] = (0.0, 1.0, 0.0)
-    fov: float = 40.0
-
-
-@dataclass
-class Scene:
-    source: str
-    width: int = 640
-    height: int = 480
-    spp: int = 1
-    max_depth: int = 8
-    camera: Camera = field(default_factory=Camera)
-    background: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    lights: list[Light] = field(default_factory=list)
-    objects: list[Node] = field(default_factory=list)
-
-    def leaves(self) -> list[Leaf]:
-        out: list[Leaf] = []
-
-        def walk(n: Node) -> None:
-            if isinstance(n, Leaf):
-                out.append(n)
-            else:
-                walk(n.left)
-                walk(n.right)
-
-        for o in self.objects:
-            walk(o)
-        return out
-
-    def specs(self) -> list[Spec]:
-        """The distinct shapes the scene uses (what gets generated and compiled, nothing else)."""
-        seen: dict[int, Spec] = {}
-        for leaf in self.leaves():
-            seen.setdefault(id(leaf.spec), leaf.spec)
-        return list(seen.values())
 
 
 # ----------------------------------------------------------------------------------------------- helpers
@@ -140,8 +51,18 @@ TOP_KEYS = ("image", "camera", "background", "lights", "materials", "objects")
 IMAGE_KEYS = ("width", "height", "spp", "max_depth")
 CAMERA_KEYS = ("position", "look_at", "up", "fov")
 LIGHT_KEYS = ("position", "color", "intensity")
-MATERIAL_KEYS = ("color", "checker", "ambient", "diffuse", "specular", "shininess", "reflectivity",
-                 "transparency", "ior", "absorption")
+MATERIAL_KEYS = (
+    "color",
+    "checker",
+    "ambient",
+    "diffuse",
+    "specular",
+    "shininess",
+    "reflectivity",
+    "transparency",
+    "ior",
+    "absorption",
+)
 LEAF_KEYS = ("shape", "equation", "name", "params", "bounds", "transform", "material")
 
 
@@ -170,8 +91,14 @@ def _mapping(ctx: _Ctx, key: str, value: Any, allowed: tuple[str, ...]) -> dict:
     return value
 
 
-def _num(ctx: _Ctx, key: str, value: Any, lo: float = -validate.MAX_COORDINATE,
-         hi: float = validate.MAX_COORDINATE, lo_open: bool = False) -> float:
+def _num(
+    ctx: _Ctx,
+    key: str,
+    value: Any,
+    lo: float = -validate.MAX_COORDINATE,
+    hi: float = validate.MAX_COORDINATE,
+    lo_open: bool = False,
+) -> float:
     return validate.number(ctx.source, key, value, lo, hi, lo_open=lo_open)
 
 
@@ -179,8 +106,9 @@ def _int(ctx: _Ctx, key: str, value: Any, lo: int, hi: int) -> int:
     return validate.whole(ctx.source, key, value, lo, hi)
 
 
-def _vec(ctx: _Ctx, key: str, value: Any, lo: float = -validate.MAX_COORDINATE,
-         hi: float = validate.MAX_COORDINATE) -> tuple[float, float, float]:
+def _vec(
+    ctx: _Ctx, key: str, value: Any, lo: float = -validate.MAX_COORDINATE, hi: float = validate.MAX_COORDINATE
+) -> tuple[float, float, float]:
     return validate.vector(ctx.source, key, value, lo, hi)
 
 
@@ -227,7 +155,7 @@ def _resolve_shape_path(ctx: _Ctx, key: str, value: Any) -> Path:
     candidates = [p] if p.is_absolute() else [ctx.path.parent / p, Path.cwd() / p]
     for c in candidates:
         if c.exists():
-            return c.resolve()       # whatever it is: read_yaml says what is wrong with it
+            return c.resolve()  # whatever it is: read_yaml says what is wrong with it
     tried = " or ".join(str(c) for c in candidates)
     raise ctx.fail(key, f"spec file not found (tried {tried})")
 
@@ -235,8 +163,11 @@ def _resolve_shape_path(ctx: _Ctx, key: str, value: Any) -> Path:
 def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
     _mapping(ctx, key, raw, LEAF_KEYS)
     if ("shape" in raw) == ("equation" in raw):
-        raise ctx.fail(key, "give exactly one of 'shape' (a spec file) or 'equation' (an inline shape), "
-                            f"or a CSG operation ({', '.join(CSG_OPS)})")
+        raise ctx.fail(
+            key,
+            "give exactly one of 'shape' (a spec file) or 'equation' (an inline shape), "
+            f"or a CSG operation ({', '.join(CSG_OPS)})",
+        )
     if "shape" in raw:
         for k in ("name", "bounds"):
             if k in raw:
@@ -304,7 +235,7 @@ def _node(ctx: _Ctx, key: str, raw: Any, named: dict[str, Material], depth: int)
 def _balanced(op: str, nodes: list[Node], where: str) -> Csg:
     """One associative operation over a list as the shallowest binary tree: always join the two shallowest
     subtrees (Huffman's merge on depth), ties in list order. A long flat list stays a few levels deep."""
-    heap = [(_depth(n), i, n) for i, n in enumerate(nodes)]
+    heap = [(depth(n), i, n) for i, n in enumerate(nodes)]
     heapq.heapify(heap)
     order = len(nodes)
     while len(heap) > 1:
@@ -374,15 +305,16 @@ def parse_scene(data: Any, source: str | Path = "<scene>") -> Scene:
         raise ctx.fail("materials", "expected a mapping name -> material")
     for name, raw in mats.items():
         if not isinstance(name, str) or not 0 < len(name) <= 64 or not name.isprintable():
-            raise ctx.fail("materials", f"{validate.describe(name)} is not a material name (text, 1 to 64 "
-                                        "printable characters)")
+            raise ctx.fail(
+                "materials", f"{validate.describe(name)} is not a material name (text, 1 to 64 printable characters)"
+            )
         named[name] = _material(ctx, f"materials.{name}", raw)
     objs = data.get("objects")
     if not isinstance(objs, list) or not objs:
         raise ctx.fail("objects", "expected a non-empty list")
     sc.objects = [_node(ctx, f"objects[{i}]", raw, named, 0) for i, raw in enumerate(objs)]
     for obj in sc.objects:
-        if _depth(obj) > MAX_CSG_DEPTH:   # cannot happen within the documented limits; the tracer's own
+        if depth(obj) > MAX_CSG_DEPTH:  # cannot happen within the documented limits; the tracer's own
             raise ctx.fail(getattr(obj, "where", "objects"), f"CSG tree deeper than {MAX_CSG_DEPTH}")
     for leaf in sc.leaves():
         tf.check_matrix(ctx.source, f"{leaf.where}.transform", leaf.matrix)

@@ -12,12 +12,13 @@ A list of such mappings composes them, the first applied first.
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
-from . import validate
-from .errors import UserError
+from implgen import validate
+from implgen.errors import UserError
 
 IDENTITY = np.hstack([np.eye(3), np.zeros((3, 1))])
 # Documented range of the linear part: scales (and axis vectors) between 1e-6 and 1e6 in size, also once
@@ -35,11 +36,15 @@ def _number(source: str, key: str, value: Any, limit: float = validate.MAX_COORD
 
 
 def _scale(source: str, key: str, value: Any) -> np.ndarray:
-    sv = _vec3(source, key, value, MAX_SCALE) if isinstance(value, list) else \
-        np.full(3, _number(source, key, value, MAX_SCALE))
+    sv = (
+        _vec3(source, key, value, MAX_SCALE)
+        if isinstance(value, list)
+        else np.full(3, _number(source, key, value, MAX_SCALE))
+    )
     if np.abs(sv).min() < MIN_SCALE:
-        raise UserError(source, f"{key}: a scale must be at least {MIN_SCALE:g} in size (a zero scale flattens "
-                                "the object)")
+        raise UserError(
+            source, f"{key}: a scale must be at least {MIN_SCALE:g} in size (a zero scale flattens the object)"
+        )
     return sv
 
 
@@ -80,7 +85,7 @@ def parse_transform(source: str, key: str, raw: Any) -> np.ndarray:
         m = IDENTITY.copy()
         for i, step in enumerate(raw):
             m = compose(parse_transform(source, f"{key}[{i}]", step), m)
-            check_matrix(source, key, m)      # the composition so far, before it can grow any further
+            check_matrix(source, key, m)  # the composition so far, before it can grow any further
         return m
     if not isinstance(raw, dict):
         raise UserError(source, f"{key}: expected a mapping (scale/rotate/translate or position/axes) or a list")
@@ -99,8 +104,9 @@ def parse_transform(source: str, key: str, raw: Any) -> np.ndarray:
     else:
         extra = set(raw) - {"scale", "rotate", "translate"}
         if extra:
-            raise UserError(source, f"{key}.{sorted(extra)[0]}: unknown key (allowed: scale, rotate, translate, "
-                                    "or position + axes)")
+            raise UserError(
+                source, f"{key}.{sorted(extra)[0]}: unknown key (allowed: scale, rotate, translate, or position + axes)"
+            )
         lin = np.eye(3)
         if "scale" in raw:
             lin = np.diag(_scale(source, f"{key}.scale", raw["scale"])) @ lin
@@ -131,11 +137,17 @@ def check_matrix(source: str, key: str, m: np.ndarray) -> None:
         raise UserError(source, f"{key}: the composed transform is not finite")
     sigma = np.linalg.svd(m[:, :3], compute_uv=False)
     if not sigma[-1] > 1e-12 * sigma[0]:
-        raise UserError(source, f"{key}: the transform is singular (flattens the object); "
-                                "axes must be linearly independent and scales non-zero")
+        raise UserError(
+            source,
+            f"{key}: the transform is singular (flattens the object); "
+            "axes must be linearly independent and scales non-zero",
+        )
     if sigma[0] > MAX_SCALE * (1 + 1e-9) or sigma[-1] < MIN_SCALE * (1 - 1e-9):
-        raise UserError(source, f"{key}: the transform stretches by {sigma[0]:.3g} and shrinks to {sigma[-1]:.3g}"
-                                f"; both must lie within [{MIN_SCALE:g}, {MAX_SCALE:g}]")
+        raise UserError(
+            source,
+            f"{key}: the transform stretches by {sigma[0]:.3g} and shrinks to {sigma[-1]:.3g}"
+            f"; both must lie within [{MIN_SCALE:g}, {MAX_SCALE:g}]",
+        )
     if np.abs(m[:, 3]).max() > validate.MAX_COORDINATE:
         raise UserError(source, f"{key}: the transform moves the object beyond {validate.MAX_COORDINATE:g}")
 

@@ -6,7 +6,7 @@
     first_root_batch(coeffs_2d, lo, hi, method) -> (roots, NaN where none; counts 0/1)
 
 Coefficients are lowest power first. The C library is compiled on first use into the content-hash build
-cache (`implgen.cbuild`), so a plain `pip install` needs no build step.
+cache (`implgen.clib`), so a plain `pip install` needs no build step.
 """
 
 from __future__ import annotations
@@ -17,29 +17,31 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import cbuild
-from .errors import UserError
-from .resources import runtime_dir
+from implgen import abi, clib
+from implgen.errors import UserError
+from implgen.resources import BENCH_SOURCES, SOLVER_SOURCES, runtime_dir, runtime_sources
 
-MAX_DEGREE = 24
-METHODS: dict[str, int] = {"auto": 0, "closed": 1, "sturm": 2, "bracket": 3, "bernstein": 4}
+MAX_DEGREE = abi.value("IG_MAX_DEGREE")
+METHODS: dict[str, int] = {
+    name: abi.value(f"IG_ROOTS_{name.upper()}") for name in ("auto", "closed", "sturm", "bracket", "bernstein")
+}
 #: bench-only: the classic unpolished closed forms (Schwarze-style), the speed baseline of the report
-BENCH_METHODS: dict[str, int] = {**METHODS, "closed_plain": 10}
+BENCH_METHODS: dict[str, int] = {**METHODS, "closed_plain": abi.value("IG_ROOTS_CLOSED_PLAIN")}
 
 _DP = ctypes.POINTER(ctypes.c_double)
 _IP = ctypes.POINTER(ctypes.c_int)
 
 
 def solver_sources() -> list:
-    """The C sources of the root solvers (everything `roots*.c` in the installed runtime)."""
-    return sorted(runtime_dir().glob("roots*.c"))
+    """The C sources of the solver library: the solvers and their benchmark timing entry points."""
+    return runtime_sources(SOLVER_SOURCES, BENCH_SOURCES)
 
 
 @lru_cache(maxsize=1)
 def library() -> ctypes.CDLL:
     """The compiled solver library (built once, then loaded from the cache)."""
-    path = cbuild.build_shared(solver_sources(), include_dirs=[runtime_dir()], tag="roots")
-    lib = cbuild.load(path)
+    path = clib.build_shared(solver_sources(), include_dirs=[runtime_dir()], tag="roots")
+    lib = clib.load(path)
     lib.ig_real_roots_any.restype = ctypes.c_int
     lib.ig_real_roots_any.argtypes = [_DP, ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_int, _DP]
     lib.ig_real_roots_batch.restype = None
@@ -74,8 +76,9 @@ def _bounds(value: ArrayLike, count: int) -> np.ndarray:
     return np.ascontiguousarray(np.broadcast_to(np.asarray(value, dtype=np.float64), (count,)))
 
 
-def _batch(entry: str, coeffs: ArrayLike, lo: ArrayLike, hi: ArrayLike, method: str, first: bool,
-           timed: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+def _batch(
+    entry: str, coeffs: ArrayLike, lo: ArrayLike, hi: ArrayLike, method: str, first: bool, timed: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """Call one of the C batch entry points: (roots, counts, ns per solve, untimed total ns). first: one root per
     polynomial (NaN where none), else a row of degree entries padded with NaN; timed: the bench entry points,
     which also fill ns and return the total (else ns is left empty and the total is 0)."""
@@ -88,8 +91,16 @@ def _batch(entry: str, coeffs: ArrayLike, lo: ArrayLike, hi: ArrayLike, method: 
     ns = np.empty(count, dtype=np.float64)
     total = 0.0
     if count:
-        args = [c.ctypes.data_as(_DP), n, count, lo_a.ctypes.data_as(_DP), hi_a.ctypes.data_as(_DP), mid,
-                roots.ctypes.data_as(_DP), counts.ctypes.data_as(_IP)]
+        args = [
+            c.ctypes.data_as(_DP),
+            n,
+            count,
+            lo_a.ctypes.data_as(_DP),
+            hi_a.ctypes.data_as(_DP),
+            mid,
+            roots.ctypes.data_as(_DP),
+            counts.ctypes.data_as(_IP),
+        ]
         if timed:
             args.append(ns.ctypes.data_as(_DP))
         total = getattr(library(), entry)(*args) or 0.0

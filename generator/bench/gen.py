@@ -12,14 +12,14 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
-from typing import Sequence
+from collections.abc import Sequence
 
 import sympy
 
-from .derive import derive, exact_ray_coefficients
-from .emit import derivation_ops, generate
-from .errors import UserError
-from .spec import MAX_DEGREE, parse_spec
+from implgen.codegen.derive import derive, exact_ray_coefficients
+from implgen.codegen.emit import derivation_ops, generate
+from implgen.codegen.spec import MAX_DEGREE, parse_spec
+from implgen.errors import UserError
 
 DEGREES = (2, 4, 6, 8, 12, 16, 20, 24)
 
@@ -58,14 +58,21 @@ def _expanded_ops(equation: str) -> tuple[float, int]:
 def main(argv: Sequence[str]) -> int:
     parser = argparse.ArgumentParser(prog="implgen bench gen", description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--compare", type=int, default=8, metavar="N",
-                        help="also time the expanded form up to degree N (0 to skip; default 8)")
+    parser.add_argument(
+        "--compare",
+        type=int,
+        default=8,
+        metavar="N",
+        help="also time the expanded form up to degree N (0 to skip; default 8)",
+    )
     parser.add_argument("--degrees", type=int, nargs="*", default=list(DEGREES))
     args = parser.parse_args(list(argv))
     if any(not 1 <= n <= MAX_DEGREE for n in args.degrees) or args.repeats < 1:
         raise UserError("bench gen", f"degrees must be within 1..{MAX_DEGREE} and repeats at least 1")
-    print(f"Generation time (parse + derive + emit C and Python; median of {args.repeats}) "
-          f"and operations in the generated coefficient code. Highest supported degree: {MAX_DEGREE}.\n")
+    print(
+        f"Generation time (parse + derive + emit C and Python; median of {args.repeats}) "
+        f"and operations in the generated coefficient code. Highest supported degree: {MAX_DEGREE}.\n"
+    )
     header = "| degree | dense: time | dense: ops | sparse: time | sparse: ops |"
     if args.compare:
         header += " dense expanded+cse: time | ops |"

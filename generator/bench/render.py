@@ -4,7 +4,8 @@ Renders each scene (default: examples/scenes/*.yaml) on 1 thread and on all thre
 default 3: other work on the machine only ever adds time), and prints a Markdown table of the wall time and
 rays per second by kind (primary, shadow, secondary). The library is
 built before timing, so compilation is not measured. With --fold-compare it also renders every scene with
-the shape params folded into the generated code as constants, to see whether that pays (1 thread, interleaved, best of 3).
+the shape params folded into the generated code as constants, to see whether that pays (1 thread,
+interleaved, best of 3).
 """
 
 from __future__ import annotations
@@ -12,13 +13,13 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
-from .build import build_scene
-from .errors import UserError
-from .render import RenderInfo, render
-from .scene import load_scene
+from implgen.errors import UserError
+from implgen.scene.build import build_scene
+from implgen.scene.load import load_scene
+from implgen.scene.render import RenderInfo, render
 
 
 def _default_scenes() -> list[Path]:
@@ -63,8 +64,10 @@ def main(argv: Sequence[str]) -> int:
                 render(sc, width=args.width, height=args.height, spp=args.spp, threads=threads, info=info)
                 t = min(t, info.seconds)
             r = info.rays
-            print(f"| {path.stem} | {threads} | {t:.2f} | {r['primary'] / t / 1e6:.2f} | "
-                  f"{r['shadow'] / t / 1e6:.2f} | {r['secondary'] / t / 1e6:.2f} | {sum(r.values()) / t / 1e6:.2f} |")
+            print(
+                f"| {path.stem} | {threads} | {t:.2f} | {r['primary'] / t / 1e6:.2f} | "
+                f"{r['shadow'] / t / 1e6:.2f} | {r['secondary'] / t / 1e6:.2f} | {sum(r.values()) / t / 1e6:.2f} |"
+            )
         if args.fold_compare:
             # interleaved, best of 3 each, so a load change on the machine hits both variants alike
             build_scene(load_scene(path), fold=True)
@@ -72,8 +75,15 @@ def main(argv: Sequence[str]) -> int:
             for _ in range(3):
                 for fold in (False, True):
                     info = RenderInfo()
-                    render(load_scene(path), width=args.width, height=args.height, spp=args.spp, threads=1,
-                           fold=fold, info=info)
+                    render(
+                        load_scene(path),
+                        width=args.width,
+                        height=args.height,
+                        spp=args.spp,
+                        threads=1,
+                        fold=fold,
+                        info=info,
+                    )
                     best[fold] = min(best[fold], info.seconds)
             fold_rows.append((path.stem, best[False], best[True]))
     if fold_rows:

@@ -41,9 +41,9 @@ _X = sp.Symbol("x")
 
 @dataclass
 class RefRoot:
-    value: float          # nearest double to the exact root
-    mult: int             # multiplicity in the exact polynomial
-    kappa: float          # relative condition number (inf for multiple roots)
+    value: float  # nearest double to the exact root
+    mult: int  # multiplicity in the exact polynomial
+    kappa: float  # relative condition number (inf for multiple roots)
     exact: mpmath.mpf = field(repr=False, default=None)
 
 
@@ -90,9 +90,9 @@ def _batch(rows: list[np.ndarray]) -> list[list[RefRoot]]:
 
 
 def _cache_file(coeffs: np.ndarray) -> Path:
-    from .cbuild import cache_dir
+    from implgen.clib import cache_dir
 
-    h = hashlib.sha256(b"ref-v2" + np.ascontiguousarray(coeffs, dtype=np.float64).tobytes()).hexdigest()[:24]
+    h = hashlib.sha256(b"ref-v3" + np.ascontiguousarray(coeffs, dtype=np.float64).tobytes()).hexdigest()[:24]
     d = cache_dir() / "roots_reference"
     d.mkdir(parents=True, exist_ok=True)
     return d / f"{h}.pkl"
@@ -103,8 +103,11 @@ def reference(coeffs: np.ndarray, workers: int | None = None, use_cache: bool = 
     coeffs = np.ascontiguousarray(coeffs, dtype=np.float64)
     path = _cache_file(coeffs)
     if use_cache and path.exists():
-        with open(path, "rb") as fh:
-            return pickle.load(fh)
+        try:  # plain tuples (value, mult, kappa): independent of where RefRoot lives
+            with open(path, "rb") as fh:
+                return [[RefRoot(v, m, k) for v, m, k in roots] for roots in pickle.load(fh)]
+        except (OSError, pickle.UnpicklingError, EOFError, TypeError, ValueError):
+            pass  # unreadable: compute again
     rows = list(coeffs)
     workers = workers or min(os.cpu_count() or 1, 4)
     if workers > 1 and len(rows) > 50:
@@ -120,9 +123,9 @@ def reference(coeffs: np.ndarray, workers: int | None = None, use_cache: bool = 
         for r in roots:
             r.exact = None
     if use_cache:
-        tmp = path.with_suffix(".tmp%d" % os.getpid())
+        tmp = path.with_suffix(f".tmp{os.getpid()}")
         with open(tmp, "wb") as fh:
-            pickle.dump(result, fh)
+            pickle.dump([[(r.value, r.mult, r.kappa) for r in roots] for roots in result], fh)
         os.replace(tmp, path)
     return result
 
@@ -130,14 +133,14 @@ def reference(coeffs: np.ndarray, workers: int | None = None, use_cache: bool = 
 @dataclass
 class Score:
     polys: int = 0
-    ref_simple: int = 0        # simple well-separated reference roots in range (the ones that must be found)
+    ref_simple: int = 0  # simple well-separated reference roots in range (the ones that must be found)
     missed: int = 0
     phantom: int = 0
-    near_tangent: int = 0      # reported where p is zero to working precision but the exact root is not there
-    errors_well: list = field(default_factory=list)   # rel. errors on well-conditioned roots
-    errors_all: list = field(default_factory=list)    # rel. errors on every matched root
+    near_tangent: int = 0  # reported where p is zero to working precision but the exact root is not there
+    errors_well: list = field(default_factory=list)  # rel. errors on well-conditioned roots
+    errors_all: list = field(default_factory=list)  # rel. errors on every matched root
 
-    def add(self, other: "Score") -> None:
+    def add(self, other: Score) -> None:
         self.polys += other.polys
         self.ref_simple += other.ref_simple
         self.missed += other.missed
@@ -194,7 +197,7 @@ def _required(r: RefRoot, tol: float, lo: float, hi: float) -> bool:
 
 def _error(x: float, r: RefRoot, sc: Score) -> None:
     if r.mult == 1:
-        err = float(abs((mpmath.mpf(float(x)) - mpmath.mpf(r.value))) / abs(r.value)) if r.value else abs(x)
+        err = float(abs(mpmath.mpf(float(x)) - mpmath.mpf(r.value)) / abs(r.value)) if r.value else abs(x)
         sc.errors_all.append(err)
         if r.kappa <= WELL_KAPPA:
             sc.errors_well.append(err)

@@ -1,0 +1,85 @@
+"""One backend per target language: a SymPy code printer and the templates it fills, with their file names.
+
+Adding a language means adding a printer here, its templates under templates/<lang>/ and one BACKENDS entry;
+emit.py has no per-language branches. Every printer writes only finite double constants: a constant beyond
+double range (from an equation's coefficients) raises ConstantRangeError, which generation turns into a
+one-line error naming the spec.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+import sympy
+from sympy.codegen.rewriting import create_expand_pow_optimization
+from sympy.printing.c import C99CodePrinter
+from sympy.printing.codeprinter import CodePrinter
+from sympy.printing.pycode import PythonCodePrinter
+
+EXPAND_POW = create_expand_pow_optimization(3)  # b**2, b**3 -> b*b, b*b*b; higher powers are chained
+_EXACT_INT = 2**53
+
+
+class ConstantRangeError(ValueError):
+    """A constant of the generated code is not a finite double (the spec's coefficients are too large)."""
+
+
+def _finite_double(p: int, q: int = 1) -> float:
+    try:
+        return float(Fraction(p, q))
+    except OverflowError:
+        raise ConstantRangeError(
+            f"a constant of the generated code ({'beyond' if abs(p) > q else 'below'} "
+            "double range) comes from the equation's coefficients"
+        ) from None
+
+
+class CPrinter(C99CodePrinter):
+    """C99 printer: integers that a C `int`/`long` might not hold exactly are written as doubles."""
+
+    def _print_Integer(self, expr: sympy.Integer) -> str:  # noqa: N802 -- SymPy's naming
+        value = int(expr)
+        if abs(value) < 2**31:
+            return str(value)
+        return repr(_finite_double(value)) if abs(value) < _EXACT_INT else f"{_finite_double(value):.17g}"
+
+    def _print_Rational(self, expr: sympy.Rational) -> str:  # noqa: N802
+        _finite_double(int(expr.p), int(expr.q))
+        return super()._print_Rational(expr)
+
+    def _print_Infinity(self, expr: sympy.Expr) -> str:  # noqa: N802
+        return "INFINITY"
+
+    def _print_NegativeInfinity(self, expr: sympy.Expr) -> str:  # noqa: N802
+        return "-INFINITY"
+
+
+class PyPrinter(PythonCodePrinter):
+    """Python printer for NumPy-broadcasting arithmetic (plain operators, floats for huge integers)."""
+
+    def _print_Integer(self, expr: sympy.Integer) -> str:  # noqa: N802
+        value = int(expr)
+        return str(value) if abs(value) < _EXACT_INT else f"{_finite_double(value):.17g}"
+
+    def _print_Rational(self, expr: sympy.Rational) -> str:  # noqa: N802
+        _finite_double(int(expr.p), int(expr.q))
+        return super()._print_Rational(expr)
+
+    def _print_Infinity(self, expr: sympy.Expr) -> str:  # noqa: N802
+        return "math.inf"
+
+    def _print_NegativeInfinity(self, expr: sympy.Expr) -> str:  # noqa: N802
+        return "-math.inf"
+
+
+@dataclass(frozen=True)
+class Backend:
+    printer: type[CodePrinter]
+    files: tuple[tuple[str, str], ...]  # (template under templates/, file name pattern with {name})
+
+
+BACKENDS: dict[str, Backend] = {
+    "c": Backend(CPrinter, (("c/shape.h.j2", "{name}.h"), ("c/shape.c.j2", "{name}.c"))),
+    "python": Backend(PyPrinter, (("python/shape.py.j2", "{name}.py"),)),
+}

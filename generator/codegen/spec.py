@@ -1,0 +1,226 @@
+"""Shape spec files: YAML (safe_load) -> validated `Spec`.
+
+    name: piriform                      # identifier; names the generated files and functions
+    equation: x^4 - x^3 + y^2 + z^2     # `expr` (meaning expr = 0) or `lhs = rhs`
+    params: {a: 1.0}                    # optional ordered mapping name -> default number
+    bounds: {x: [0, 1], y: [-0.5, 0.5]} # optional object-space box; numbers or expressions in params;
+                                        # an axis left out is unbounded
+    description: a peg top              # optional
+
+Inside is f < 0 with f = lhs - rhs; the outward normal is grad f / |grad f|.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import sympy
+from sympy.polys.domains import QQ
+from sympy.polys.rings import ring
+
+from implgen import abi, validate
+from implgen.codegen.grammar import ParseError, format_expression, parse_expression, split_equation
+from implgen.codegen.names import check_identifier, check_shape_name
+from implgen.errors import UserError
+from implgen.yamlfile import read_yaml
+
+MAX_DEGREE = abi.value("IG_MAX_DEGREE")  # the solvers' limit, read from runtime_c/roots.h
+MAX_PARAMS = 64
+MAX_DESCRIPTION = 2_000
+MAX_COEFF_BITS = 900  # |numerator|, |denominator| of every expanded coefficient (2^900 ~ 8e270: room
+# for the multinomial factors the ray coefficients multiply them by)
+AXES = ("x", "y", "z")
+KEYS = ("name", "equation", "params", "bounds", "description")
+X, Y, Z = sympy.symbols("x y z", real=True)
+VARIABLES = {"x": X, "y": Y, "z": Z}
+
+
+def param_symbol(name: str) -> sympy.Symbol:
+    """Internal symbol for a user param: prefixed, so a param called `c`, `d`, `o` or `t` cannot collide
+    with the names the generated code uses itself."""
+    return sympy.Symbol(f"k_{name}", real=True)
+
+
+@dataclass(frozen=True)
+class Spec:
+    name: str
+    equation: str  # f printed back from the parsed tree (never the raw text)
+    params: dict[str, float]  # ordered: the order the generated code takes them in
+    f: sympy.Expr  # lhs - rhs, structure as written; x, y, z and k_* symbols
+    degree: int  # exact total degree in x, y, z
+    bounds: dict[str, tuple[sympy.Expr, sympy.Expr]] | None = None  # axis -> (lo, hi) in k_* symbols
+    description: str = ""
+    source: str = "<spec>"
+    folded: dict[str, float] = field(default_factory=dict)  # params folded into constants by specialise()
+
+    @property
+    def param_symbols(self) -> list[sympy.Symbol]:
+        return [param_symbol(p) for p in self.params]
+
+    def box(self, values: Mapping[str, float] | None = None) -> list[float] | None:
+        """The numeric box {xmin, ymin, zmin, xmax, ymax, zmax} for these param values (defaults else)."""
+        if self.bounds is None:
+            return None
+        subs = {param_symbol(k): v for k, v in {**self.params, **(values or {})}.items()}
+        lo = [float(self.bounds[a][0].subs(subs)) if a in self.bounds else -math.inf for a in AXES]
+        hi = [float(self.bounds[a][1].subs(subs)) if a in self.bounds else math.inf for a in AXES]
+        return lo + hi
+
+    def specialise(self, values: Mapping[str, float], name: str | None = None) -> Spec:
+        """The same shape with the given params folded into the equation as constants."""
+        unknown = set(values) - set(self.params)
+        if unknown:
+            raise UserError(self.source, f"unknown params {sorted(unknown)} for shape {self.name!r}")
+        new_name = name or self.name
+        check_shape_name(self.source, "name", new_name)
+        subs = {
+            param_symbol(k): sympy.nsimplify(validate.number(self.source, f"params.{k}", v), rational=True)
+            for k, v in values.items()
+        }
+        bounds = None
+        if self.bounds is not None:
+            bounds = {a: (lo.subs(subs), hi.subs(subs)) for a, (lo, hi) in self.bounds.items()}
+        rest = {k: v for k, v in self.params.items() if k not in values}
+        f = self.f.subs(subs)
+        return replace(
+            self,
+            name=new_name,
+            f=f,
+            equation=canonical_equation(f, rest),
+            params=rest,
+            bounds=bounds,
+            folded={**self.folded, **{k: float(v) for k, v in values.items()}},
+        )
+
+
+def load_spec(path: str | Path) -> Spec:
+    """Load and validate a spec file."""
+    path = Path(path)
+    return parse_spec(read_yaml(path), str(path))
+
+
+def _parse_params(source: str, raw: Any) -> dict[str, float]:
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict):
+        raise UserError(source, "params: must be a mapping of name to default number")
+    if len(raw) > MAX_PARAMS:
+        raise UserError(source, f"params: more than {MAX_PARAMS}")
+    params: dict[str, float] = {}
+    for name, value in raw.items():
+        check_identifier(source, "params", name)
+        if name in AXES:
+            raise UserError(source, f"params: {name!r} shadows the coordinate {name}")
+        number = validate.number(source, f"params.{name}", value, text_ok=True)
+        params[name] = int(value) if isinstance(value, int) else number
+    return params
+
+
+def canonical_equation(f: sympy.Expr, params: Mapping[str, float]) -> str:
+    """f (meaning f = 0) as generated files show it: printed from the expression tree under the user's param
+    names, so the text is the parsed equation, never what was typed."""
+    return format_expression(f, {param_symbol(p): p for p in params})
+
+
+def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[sympy.Expr, int]:
+    if not isinstance(text, (str, int, float)) or isinstance(text, bool):
+        raise UserError(source, "equation: must be text such as 'x^2 + y^2 + z^2 - 1'")
+    symbols = {p: param_symbol(p) for p in params}
+    try:
+        lhs_text, rhs_text = split_equation(str(text))
+        lhs = parse_expression(lhs_text, VARIABLES, symbols, MAX_DEGREE)
+        rhs = parse_expression(rhs_text, VARIABLES, symbols, MAX_DEGREE)
+    except ParseError as err:
+        raise UserError(source, f"equation: {err}") from None
+    f = lhs.expr - rhs.expr
+    poly = exact_polynomial(f, list(symbols.values()))
+    if poly == 0:
+        raise UserError(source, "equation: is identically zero (every point would be on the surface)")
+    degree = max(sum(m[:3]) for m in poly.monoms())
+    if degree == 0:
+        raise UserError(source, "equation: has no x, y or z (a constant, not a surface)")
+    if degree > MAX_DEGREE:
+        raise UserError(source, f"equation: degree {degree} is above the highest supported, {MAX_DEGREE}")
+    for coeff in poly.coeffs():
+        if max(abs(int(coeff.numerator)).bit_length(), int(coeff.denominator).bit_length()) > MAX_COEFF_BITS:
+            raise UserError(
+                source,
+                f"equation: a coefficient of the expanded polynomial is beyond 2^{MAX_COEFF_BITS} "
+                f"or below 2^-{MAX_COEFF_BITS} in size (not a normal double)",
+            )
+    return f, degree
+
+
+def exact_polynomial(f: sympy.Expr, params: list[sympy.Symbol]):
+    """f as an element of the polynomial ring QQ[x, y, z, params] (exact rational arithmetic)."""
+    R, *_ = ring([X, Y, Z, *params], QQ)
+    return R.from_expr(f) if f != 0 else R.zero
+
+
+def _parse_bounds(source: str, raw: Any, params: dict[str, float]) -> dict[str, tuple[sympy.Expr, sympy.Expr]] | None:
+    if raw is None:
+        return None
+    if not isinstance(raw, dict) or not raw:
+        raise UserError(source, "bounds: must be a mapping such as {x: [-1, 1], y: [-1, 1], z: [-1, 1]}")
+    symbols = {p: param_symbol(p) for p in params}
+    defaults = {param_symbol(k): v for k, v in params.items()}
+    bounds: dict[str, tuple[sympy.Expr, sympy.Expr]] = {}
+    for axis, pair in raw.items():
+        if axis not in AXES:
+            raise UserError(source, f"bounds: unknown axis {str(axis)[:20]!r} (use x, y, z)")
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise UserError(source, f"bounds.{axis}: must be a pair [low, high]")
+        ends = []
+        for item in pair:
+            if isinstance(item, bool) or not isinstance(item, (int, float, str)):
+                raise UserError(source, f"bounds.{axis}: {validate.describe(item)} is not a number or expression")
+            if isinstance(item, float) and not math.isfinite(item):
+                raise UserError(source, f"bounds.{axis}: must be finite (leave the axis out to leave it open)")
+            try:
+                end = parse_expression(str(item), {}, symbols, 0).expr
+            except ParseError as err:
+                raise UserError(source, f"bounds.{axis}: {err}") from None
+            validate.number(source, f"bounds.{axis}", float(end.subs(defaults)))
+            ends.append(end)
+        lo, hi = ends
+        if not float(lo.subs(defaults)) < float(hi.subs(defaults)):
+            raise UserError(source, f"bounds.{axis}: low must be below high (with the default params)")
+        bounds[axis] = (lo, hi)
+    return bounds
+
+
+def parse_spec(data: Any, source: str = "<spec>") -> Spec:
+    """Validate an already-loaded mapping (a spec file, or an inline shape in a scene)."""
+    if not isinstance(data, dict) or not any(k in KEYS for k in data):
+        # Possibly not meant as a spec at all (a scene's `shape:` naming some other file): say what was
+        # expected, and echo nothing of the file.
+        raise UserError(source, "not a shape spec (expected a YAML mapping with 'name' and 'equation')")
+    unknown = [k for k in data if k not in KEYS]
+    if unknown:
+        raise UserError(source, f"unknown key {validate.describe(unknown[0])} (allowed: {', '.join(KEYS)})")
+    for key in ("name", "equation"):
+        if key not in data:
+            raise UserError(source, f"missing key {key!r}")
+    name = check_shape_name(source, "name", data["name"])
+    params = _parse_params(source, data.get("params"))
+    f, degree = _parse_equation(source, data["equation"], params)
+    bounds = _parse_bounds(source, data.get("bounds"), params)
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise UserError(source, "description: must be text")
+    if len(description) > MAX_DESCRIPTION:
+        raise UserError(source, f"description: longer than {MAX_DESCRIPTION} characters")
+    return Spec(
+        name=name,
+        equation=canonical_equation(f, params),
+        params=params,
+        f=f,
+        degree=degree,
+        bounds=bounds,
+        description=" ".join(description.split()),
+        source=source,
+    )

@@ -1,0 +1,32 @@
+"""The standalone C drivers of the root solvers and the shape intersection (tests/c/), built with ASan +
+UBSan (any report aborts) and run; and every runtime source compiles clean on its own with -O2."""
+
+from __future__ import annotations
+
+import pytest
+
+from conftest import CDIR, RUNTIME, compile_c, run_c
+from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, TRACER_SOURCES, runtime_sources
+
+SOLVERS = runtime_sources(SOLVER_SOURCES)
+
+
+def test_roots_hard_cases_under_sanitizers(tmp_path):
+    out = run_c(compile_c(tmp_path / "test_roots", [CDIR / "test_roots.c", *SOLVERS]))
+    assert "all cases passed" in out
+
+
+def test_refinement_batched_equals_single_under_sanitizers(tmp_path):
+    out = run_c(compile_c(tmp_path / "test_refine", [CDIR / "test_refine.c", *SOLVERS]))
+    assert "all refinement checks passed" in out
+
+
+def test_far_torus_matches_near_torus_under_sanitizers(tmp_path):
+    sources = [CDIR / "test_shape_torus.c", CDIR / "shape_torus_fixture.c", *runtime_sources(SHAPE_SOURCES), *SOLVERS]
+    assert "all checks passed" in run_c(compile_c(tmp_path / "test_shape_torus", sources))
+
+
+@pytest.mark.parametrize("src", sorted(RUNTIME.glob("*.c")), ids=lambda p: p.name)
+def test_runtime_sources_compile_clean(tmp_path, src):
+    assert src.name in (*SOLVER_SOURCES, *SHAPE_SOURCES, *TRACER_SOURCES, "roots_bench.c")
+    compile_c(tmp_path / "x.o", [src], sanitize=False, flags=["-c"])
