@@ -7,7 +7,7 @@ exist too. Plain text parsing only: no network, no Markdown library; runs in wel
 from __future__ import annotations
 
 import re
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 from urllib.parse import unquote
 
@@ -19,10 +19,10 @@ ROOT = Path(__file__).resolve().parent.parent
 # nowhere for now; everything else must resolve. Take an entry out once its file exists (a test below fails
 # until you do). Only bench/results/ files belong here.
 PENDING = {
-    "bench/results/gen.md",            # `implgen bench gen`: generation time and ops against degree
-    "bench/results/render.md",         # `implgen bench render`: render speed by ray kind
-    "bench/results/fold.md",           # `implgen bench render --fold-compare`: params folded or not
-    "bench/results/build_cache.md",    # bench/build_cache.py: a cold and a warm `implgen render`
+    "bench/results/gen.md",  # `implgen bench gen`: generation time and ops against degree
+    "bench/results/render.md",  # `implgen bench render`: render speed by ray kind
+    "bench/results/fold.md",  # `implgen bench render --fold-compare`: params folded or not
+    "bench/results/build_cache.md",  # bench/build_cache.py: a cold and a warm `implgen render`
     "bench/results/spawn_offsets.md",  # bench/spawn_offsets.py: secondary-ray self-hits per seed and factor
 }
 
@@ -75,8 +75,8 @@ def links(text: str) -> list[str]:
 
 def slug(heading: str) -> str:
     """GitHub's anchor for a heading: the text as rendered, lower case, punctuation dropped, spaces to '-'."""
-    text = re.sub(r"!?\[([^\]]*)\]\([^)]*\)", r"\1", heading)   # links and images: their text
-    text = re.sub(r"<[^>]+>", "", text)                            # inline HTML
+    text = re.sub(r"!?\[([^\]]*)\]\([^)]*\)", r"\1", heading)  # links and images: their text
+    text = re.sub(r"<[^>]+>", "", text)  # inline HTML
     text = text.replace("`", "")
     text = re.sub(r"(\*{1,3}|_{1,3})(\S(?:.*?\S)?)\1", r"\2", text)  # emphasis
     text = text.strip().lower()
@@ -84,7 +84,7 @@ def slug(heading: str) -> str:
     return text.replace(" ", "-")
 
 
-@lru_cache(maxsize=None)
+@cache
 def anchors(path: Path) -> frozenset[str]:
     """Every anchor GitHub makes in this Markdown file: heading slugs (repeats get -1, -2, ...) and HTML ids."""
     raw = path.read_text(encoding="utf-8")
@@ -97,9 +97,14 @@ def anchors(path: Path) -> frozenset[str]:
         heading = None
         if m:
             heading = re.sub(r"[ \t]+#+$", "", m.group(1) or "")
-        elif i + 1 < len(lines) and line.strip() and re.match(r"^ {0,3}(=+|-+)[ \t]*$", lines[i + 1]) \
-                and not re.match(r"^ {0,3}([-*+]|\d+[.)])\s", line) and "|" not in line:
-            heading = line.strip()                                  # setext heading
+        elif (
+            i + 1 < len(lines)
+            and line.strip()
+            and re.match(r"^ {0,3}(=+|-+)[ \t]*$", lines[i + 1])
+            and not re.match(r"^ {0,3}([-*+]|\d+[.)])\s", line)
+            and "|" not in line
+        ):
+            heading = line.strip()  # setext heading
         if heading is None:
             continue
         base = slug(heading)
@@ -113,7 +118,7 @@ def anchors(path: Path) -> frozenset[str]:
 def check_target(source: Path, target: str) -> str | None:
     """None if `target` (as written in `source`) resolves, else why not."""
     if re.match(r"^[a-zA-Z][a-zA-Z0-9+.-]*:|^//", target):
-        return None                                                 # http:, mailto: ...: not checked here
+        return None  # http:, mailto: ...: not checked here
     path_part, _, fragment = target.partition("#")
     path_part = unquote(path_part)
     dest = (source.parent / path_part).resolve() if path_part else source.resolve()
@@ -133,6 +138,7 @@ def check_target(source: Path, target: str) -> str | None:
 
 # --- the tests ---------------------------------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("doc", doc_files(), ids=rel)
 def test_every_link_in_the_docs_resolves(doc: Path) -> None:
     problems = [p for t in links(doc.read_text(encoding="utf-8")) if (p := check_target(doc, t))]
@@ -146,7 +152,7 @@ def test_docs_named_in_the_sources_exist() -> None:
     problems = []
     for src in source_files():
         for target in DOC_MENTION.findall(src.read_text(encoding="utf-8", errors="replace")):
-            if (p := check_target(ROOT / "README.md", target)):   # paths in sources are from the repository root
+            if p := check_target(ROOT / "README.md", target):  # paths in sources are from the repository root
                 problems.append(f"{rel(src)}: {p}")
     assert not problems, "sources name missing docs:\n  " + "\n  ".join(problems)
 
@@ -166,6 +172,7 @@ def test_pending_results_are_still_pending() -> None:
 
 
 # --- the checker checks itself -------------------------------------------------------------------------------------
+
 
 def test_slugs_follow_github() -> None:
     assert slug("Ray level: clip and shift") == "ray-level-clip-and-shift"

@@ -82,7 +82,8 @@ def test_first_root_before_a_tangent_root(method: str) -> None:
 def test_first_root_against_exact_reference(sets, method: str, name: str) -> None:
     """No missed and no phantom first root -- for auto, bracket and bernstein on every set, for every method on
     the random and the degree 2-4 / 6-12 ray sets. Closed forms and Sturm miss roots on torus rays and hard
-    cases (README, Targets); there a first-root failure must be one the method's full list already shows."""
+    cases (docs/solvers.md#what-the-current-report-shows); there a first-root failure must be one the
+    method's full list already shows."""
     c, lo, hi, rows, ref = sets[name]
     first, fcounts = first_root_batch(c[rows], lo[rows], hi[rows], method)
     roots, counts = real_roots_batch(c[rows], lo[rows], hi[rows], method)

@@ -278,7 +278,7 @@ def test_docs_example_scene_is_valid() -> None:
 
     import yaml
 
-    text = (ROOT / "README.md").read_text()
+    text = (ROOT / "docs" / "formats.md").read_text()
     block = re.search(r"### The scene format\n\n```yaml\n(.*?)```", text, re.S).group(1)
     sc = parse_scene(yaml.safe_load(block), SCENES / "doc_example.yaml")
     img = render(sc, width=32, height=24, spp=1, threads=2)

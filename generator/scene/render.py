@@ -25,9 +25,9 @@ from implgen.scene.tracer import CScene
 
 RAY_KINDS = ("primary", "shadow", "secondary")  # the first three stats slots (RT_RAYS_*)
 MAX_THREADS = 1024
-DEFAULT_FOLD = (
-    False  # folding constant params into the code: measured (README.md, "Rendering scenes"), within +-4%: off
-)
+# Folding constant params into the generated code measured within a few per cent either way
+# (docs/tracer.md#folding-constant-params): off.
+DEFAULT_FOLD = False
 
 
 @dataclass

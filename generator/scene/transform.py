@@ -1,6 +1,6 @@
 """Affine transforms for scene objects: object -> world as a 3x4 matrix [A | t] (row-major, like the C side).
 
-Two ways to write one in a scene (see README.md, "Rendering scenes"):
+Two ways to write one in a scene (docs/formats.md#the-scene-format):
   {scale: s | [sx, sy, sz], rotate: [rx, ry, rz] | {axis: [x, y, z], angle: deg}, translate: [x, y, z]}
       applied in that order (scale, then rotate, then translate), each optional;
   {position: [x, y, z], axes: [u, v, w]}
