@@ -271,3 +271,25 @@ def test_accepted_names_make_only_their_own_symbols(name):
     for pattern in GENERATED_SYMBOLS:
         symbol = pattern.format(n=name, N=name.upper())
         assert not symbol.lower().startswith(("ig_", "rt_")) or pattern.startswith("IMPLGEN")
+
+
+# ------------------------------------------------------------------------------------------- constants
+
+
+def test_coefficients_beyond_double_range_are_refused_at_validation():
+    parse_spec({"name": "ok", "equation": "(2^150*x)^5 + y"}, "<t>")  # 2^750: fine
+    with pytest.raises(UserError, match="coefficient of the expanded polynomial is beyond 2\\^900"):
+        parse_spec({"name": "big", "equation": "(2^200*x)^5 + y"}, "<t>")  # 2^1000
+    with pytest.raises(UserError, match="constant too large"):
+        parse_spec({"name": "big", "equation": "x + 2^200 * 2^100"}, "<t>")
+
+
+@pytest.mark.parametrize("printer", ["c", "python"])
+def test_printers_refuse_a_constant_that_is_not_a_finite_double(printer):
+    from implgen.codegen.backends import BACKENDS, ConstantRangeError
+
+    doprint = BACKENDS[printer].printer().doprint
+    assert "1.0/3.0" in doprint(sympy.Rational(1, 3)) or "1/3" in doprint(sympy.Rational(1, 3))
+    for value in (sympy.Integer(2) ** 1100, sympy.Rational(1, 2**1100)):
+        with pytest.raises(ConstantRangeError):
+            doprint(value * sympy.Symbol("x"))

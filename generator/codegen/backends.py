@@ -9,7 +9,6 @@ one-line error naming the spec.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from fractions import Fraction
 
 import sympy
 from sympy.codegen.rewriting import create_expand_pow_optimization
@@ -26,51 +25,52 @@ class ConstantRangeError(ValueError):
 
 
 def _finite_double(p: int, q: int = 1) -> float:
-    try:
-        return float(Fraction(p, q))
-    except OverflowError:
+    """p / q as a double, when p and q are each finite doubles (both are printed as literals)."""
+    if max(abs(p).bit_length(), q.bit_length()) > 1023:
         raise ConstantRangeError(
-            f"a constant of the generated code ({'beyond' if abs(p) > q else 'below'} "
-            "double range) comes from the equation's coefficients"
-        ) from None
+            f"a constant of the generated code ({'beyond' if abs(p) > q else 'below'} double range) comes "
+            "from the equation's coefficients"
+        )
+    return p / q
 
 
-class CPrinter(C99CodePrinter):
+class _FiniteConstants:
+    """What every backend's printer shares: rationals are checked to be finite doubles, and infinities are
+    spelled the target's way (INF, set by the subclass)."""
+
+    INF = ""
+
+    def _print_Rational(self, expr: sympy.Rational) -> str:  # noqa: N802 -- SymPy's naming
+        _finite_double(int(expr.p), int(expr.q))
+        return super()._print_Rational(expr)  # type: ignore[misc]
+
+    def _print_Infinity(self, expr: sympy.Expr) -> str:  # noqa: N802
+        return self.INF
+
+    def _print_NegativeInfinity(self, expr: sympy.Expr) -> str:  # noqa: N802
+        return "-" + self.INF
+
+
+class CPrinter(_FiniteConstants, C99CodePrinter):
     """C99 printer: integers that a C `int`/`long` might not hold exactly are written as doubles."""
 
-    def _print_Integer(self, expr: sympy.Integer) -> str:  # noqa: N802 -- SymPy's naming
+    INF = "INFINITY"
+
+    def _print_Integer(self, expr: sympy.Integer) -> str:  # noqa: N802
         value = int(expr)
         if abs(value) < 2**31:
             return str(value)
         return repr(_finite_double(value)) if abs(value) < _EXACT_INT else f"{_finite_double(value):.17g}"
 
-    def _print_Rational(self, expr: sympy.Rational) -> str:  # noqa: N802
-        _finite_double(int(expr.p), int(expr.q))
-        return super()._print_Rational(expr)
 
-    def _print_Infinity(self, expr: sympy.Expr) -> str:  # noqa: N802
-        return "INFINITY"
-
-    def _print_NegativeInfinity(self, expr: sympy.Expr) -> str:  # noqa: N802
-        return "-INFINITY"
-
-
-class PyPrinter(PythonCodePrinter):
+class PyPrinter(_FiniteConstants, PythonCodePrinter):
     """Python printer for NumPy-broadcasting arithmetic (plain operators, floats for huge integers)."""
+
+    INF = "math.inf"
 
     def _print_Integer(self, expr: sympy.Integer) -> str:  # noqa: N802
         value = int(expr)
         return str(value) if abs(value) < _EXACT_INT else f"{_finite_double(value):.17g}"
-
-    def _print_Rational(self, expr: sympy.Rational) -> str:  # noqa: N802
-        _finite_double(int(expr.p), int(expr.q))
-        return super()._print_Rational(expr)
-
-    def _print_Infinity(self, expr: sympy.Expr) -> str:  # noqa: N802
-        return "math.inf"
-
-    def _print_NegativeInfinity(self, expr: sympy.Expr) -> str:  # noqa: N802
-        return "-math.inf"
 
 
 @dataclass(frozen=True)
