@@ -98,7 +98,7 @@ def test_secondary_rays_sanitized(offsets_exes) -> None:
 
 
 def test_secondary_rays_1e5_per_shape(offsets_exes) -> None:
-    """The issue's test: 1e5 hit points per example shape over scales 1e-3 .. 1e3, two rays leave each."""
+    """1e5 hit points per example shape over scales 1e-3 .. 1e3, two secondary rays leave each."""
     _, fast, names = offsets_exes
     out = run(fast, "100000", "12345", timeout=600)
     rows = parse_offsets(out)

@@ -349,5 +349,5 @@ CASE_SETS = [
         lambda k, r, s=None: hard_set(k, r),
     ),
 ]
-#: the set the issue's "degree 6-12 ray polynomials" target is measured on (the example shapes reach 10)
+#: the set the solver report's "degree 6-12 ray polynomials" target is measured on (the example shapes reach 10)
 HIGH_RAYS = "rays deg 6-10"
