@@ -25,12 +25,15 @@ _BaseLoader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml's parser 
 
 
 class _UniqueKeyLoader(_BaseLoader):  # type: ignore[misc,valid-type]
-    """safe_load, but a key given twice is an error rather than silently the last one."""
+    """safe_load, but a key given twice is an error rather than silently the last one. Merge keys
+    (`<<: *defaults`) work as in YAML: the mapping's own keys override the merged ones."""
 
 
 def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False) -> dict:
     seen = set()
     for key_node, _ in node.value:
+        if key_node.tag == "tag:yaml.org,2002:merge":  # `<<: *defaults`: merged keys may be overridden
+            continue
         key = loader.construct_object(key_node, deep=deep)
         if isinstance(key, (str, int, float)) and key in seen:
             raise yaml.constructor.ConstructorError(None, None, f"duplicate key {key!r}", key_node.start_mark)

@@ -21,6 +21,7 @@ from __future__ import annotations
 import ast
 import re
 import string
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from fractions import Fraction
@@ -233,8 +234,12 @@ def parse_expression(
         raise ParseError(f"parentheses nested deeper than {MAX_NESTING}")
     source = text.replace("^", "**").strip()
     try:
-        tree = ast.parse(source, mode="eval")
-    except (SyntaxError, ValueError) as err:
+        with warnings.catch_warnings():
+            # `1and y`, `1if x else y`: the parser's SyntaxWarning becomes the syntax error it is, not a
+            # second line on stderr.
+            warnings.simplefilter("error")
+            tree = ast.parse(source, mode="eval")
+    except (SyntaxError, SyntaxWarning, ValueError) as err:
         raise ParseError(f"syntax error in {text.strip()[:60]!r}") from err
     except (RecursionError, MemoryError) as err:
         raise ParseError("expression is nested too deeply") from err

@@ -24,6 +24,7 @@ MAX_CSG_DEPTH = abi.value("RT_MAX_CSG_DEPTH")  # depth of the binary tree the tr
 MAX_CSG_NESTING = 32  # CSG operations nested inside each other, as written in the scene
 MAX_CSG_CHILDREN = 1024  # objects in one CSG list (a list becomes a balanced binary tree)
 MAX_SHAPES = 256  # distinct shapes (spec files and inline equations) in one scene
+MAX_OBJECTS = 10_000  # shapes placed in one scene, CSG operands included (each is one BVH leaf)
 MAX_DEPTH = abi.value("RT_MAX_DEPTH")
 MAX_SPP = abi.value("RT_MAX_SPP")
 MAX_SIZE = 16384  # image width and height
@@ -71,7 +72,9 @@ class _Ctx:
         self.path = path
         self.source = str(path)
         self.spec_cache: dict[Path, Spec] = {}
+        self.resolved: dict[str, Path] = {}  # `shape:` text -> spec file, looked up once per scene
         self.inline_count = 0
+        self.leaves = 0
 
     def fail(self, key: str, msg: str) -> UserError:
         return UserError(self.source, f"{key}: {msg}")
@@ -151,17 +154,28 @@ def _material_ref(ctx: _Ctx, key: str, raw: Any, named: dict[str, Material]) -> 
 def _resolve_shape_path(ctx: _Ctx, key: str, value: Any) -> Path:
     if not isinstance(value, str) or not value.strip() or "\0" in value:
         raise ctx.fail(key, "expected the path of a spec file")
-    p = Path(value)
+    if value not in ctx.resolved:
+        ctx.resolved[value] = _find_spec_file(ctx, key, Path(value))
+    return ctx.resolved[value]
+
+
+def _find_spec_file(ctx: _Ctx, key: str, p: Path) -> Path:
     candidates = [p] if p.is_absolute() else [ctx.path.parent / p, Path.cwd() / p]
-    for c in candidates:
-        if c.exists():
-            return c.resolve()  # whatever it is: read_yaml says what is wrong with it
+    try:
+        for c in candidates:
+            if c.exists():
+                return c.resolve()  # whatever it is: read_yaml says what is wrong with it
+    except (OSError, RuntimeError) as err:  # a name too long, a loop of links
+        raise ctx.fail(key, f"cannot use this path ({getattr(err, 'strerror', None) or err})") from None
     tried = " or ".join(str(c) for c in candidates)
     raise ctx.fail(key, f"spec file not found (tried {tried})")
 
 
 def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
     _mapping(ctx, key, raw, LEAF_KEYS)
+    ctx.leaves += 1
+    if ctx.leaves > MAX_OBJECTS:
+        raise ctx.fail(key, f"more than {MAX_OBJECTS} objects in one scene (CSG operands count)")
     if ("shape" in raw) == ("equation" in raw):
         raise ctx.fail(
             key,
