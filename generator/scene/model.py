@@ -27,6 +27,7 @@ class Material:
     transparency: float = 0.0
     ior: float = 1.5
     absorption: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    inside: tuple[float, float, float] | None = None  # colour of a surface's back (f < 0) side; None: color
 
     def packed(self) -> list[float]:
         """RT_MATERIAL_DOUBLES values in the order of rt_material's fields (read from tracer.h)."""
