@@ -115,8 +115,9 @@ class Document:
         return doc
 
     def set_spec(self, spec: Spec) -> None:
-        """A new shape: param values kept where the name survives, else the new default."""
-        self.values = {k: self.values.get(k, v) if k in self.spec.params else v for k, v in spec.params.items()}
+        """A new shape: a param keeps its slider value while its name and default stay, else takes the default."""
+        old = self.spec.params
+        self.values = {k: self.values.get(k, v) if old.get(k) == v else v for k, v in spec.params.items()}
         self.spec = spec
 
     def lights(self) -> list[Light]:

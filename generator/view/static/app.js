@@ -24,6 +24,7 @@
   let frames = 0;
   let queued = null; // {refine} of a render waiting for the next animation frame
   let restTimer = 0;
+  let typing = 0; // the pause after typing that applies the equation
   const sentAt = new Map();
 
   // ---------------------------------------------------------------- colours
@@ -83,6 +84,7 @@
   }
 
   function applyShape() {
+    clearTimeout(typing);
     send({ type: "shape", equation: $("equation").value, params: parseParamsText($("params-text").value) });
   }
 
@@ -266,7 +268,6 @@
   }, { passive: false });
 
   // ---------------------------------------------------------------- controls
-  let typing = 0;
   $("equation").addEventListener("keydown", (e) => {
     if (e.key === "Enter" && !e.shiftKey) { e.preventDefault(); applyShape(); }
   });
