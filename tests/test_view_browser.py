@@ -70,7 +70,8 @@ def wait(driver, what, message: str):
 
 
 def frame_state(driver) -> tuple[int, str]:
-    seq, kind = driver.execute_script("const c = document.getElementById('view'); return [c.dataset.seq, c.dataset.kind];")
+    script = "const c = document.getElementById('view'); return [c.dataset.seq, c.dataset.kind];"
+    seq, kind = driver.execute_script(script)
     return (int(seq) if seq is not None else -1, kind or "")
 
 
