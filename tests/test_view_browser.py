@@ -182,7 +182,7 @@ def test_the_page_in_a_real_browser(server, driver) -> None:
         slider = driver.find_element("css selector", "input[type=range][data-name=c]")  # rebuilt with the shape
         ActionChains(driver).click_and_hold(slider).release().perform()  # the middle of the range: c = 11.8
         shown = wait_full_after(driver, shown)
-        ActionChains(driver).scroll_from_origin(ScrollOrigin.from_element(canvas), 0, 250).perform()
+        ActionChains(driver).scroll_from_origin(ScrollOrigin.from_element(canvas), 0, 600).perform()
         wait_full_after(driver, shown)
         time.sleep(1.0)
         driver.save_screenshot(shot)
