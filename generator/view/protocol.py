@@ -3,6 +3,7 @@
 A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
 
     {"type": "shape", "equation": "...", "params": {"a": 1.0}}        a new equation and its param defaults
+                                                                      (optional "bounds" as in a spec)
     {"type": "render", "seq": 7, "refine": true, "width": 640, "height": 480,
      "values": {"a": 1.2}, "orbit": {...}, "options": {...}}          the view to show (the newest wins)
     {"type": "save_png", "width": 1920, "height": 1080, "spp": 16}    the current view through render()
@@ -75,6 +76,8 @@ def parse_shape(data: dict, current: Spec) -> Spec:
     mapping: dict[str, Any] = {"name": current.name, "equation": data.get("equation")}
     if data.get("params"):
         mapping["params"] = _mapping("params", data["params"])
+    if data.get("bounds") is not None:  # given: checked like a spec file's
+        return parse_spec({**mapping, "bounds": data["bounds"]}, "equation")
     bounds = _bounds_text(current)
     if bounds is not None:
         try:
