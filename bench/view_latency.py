@@ -138,6 +138,7 @@ def main() -> int:
     args = ap.parse_args()
     specs = [s for s in (load_spec(p) for p in sorted(SHAPES.glob("*.yaml"))) if s.degree <= MAX_DEGREE]
     nonce = time.time_ns() % 10**9
+    load_before = os.getloadavg()[0]
     results: dict[str, dict[str, list[float]]] = {s.name: {} for s in specs}
 
     def add(name: str, key: str, value: float) -> None:
@@ -179,6 +180,7 @@ def main() -> int:
             server.terminate()
             server.wait(30)
 
+    load_after = os.getloadavg()[0]
     med = {n: {k: statistics.median(v) for k, v in d.items()} for n, d in results.items()}
     degree = {s.name: s.degree for s in specs}
     lines = [
@@ -187,7 +189,8 @@ def main() -> int:
         f"Written by `bench/view_latency.py --rounds {args.rounds} --orbit-frames {args.orbit_frames}` on "
         f"{machine()}. The server (`implgen view`, its own process, an empty build cache) and this client ran on "
         "the same machine; everything goes through the WebSocket as the page's messages do. Medians over the "
-        "rounds, shapes interleaved within each round.",
+        "rounds, shapes interleaved within each round. Load average (1 min) before the run "
+        f"{load_before:.2f}, after {load_after:.2f}: above about 1 the machine was shared and the times are longer.",
         "",
         f"Cold start (the runtime compiled into cached objects, once per cache): first picture after {cold:.2f} s.",
         "",
