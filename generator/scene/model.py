@@ -34,6 +34,8 @@ class Material:
         values: list[float] = []
         for name, count in abi.material_fields():
             v = getattr(self, name)
+            if name == "inside" and v is None:
+                v = (-1.0, -1.0, -1.0)  # no inside colour: both sides show color (tracer.h)
             values += [float(x) for x in v] if count > 1 else [float(v)]
         return values + [0.0] * (abi.value("RT_MATERIAL_DOUBLES") - len(values))
 

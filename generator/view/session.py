@@ -21,6 +21,7 @@ import struct
 import tempfile
 import time
 from collections.abc import Awaitable, Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -123,13 +124,10 @@ class Session:
 
     async def _shape(self, data: dict) -> None:
         spec = protocol.parse_shape(data, self.doc.spec)
-        old = self.doc.spec
-        self.doc.set_spec(spec)
-        try:
-            await asyncio.to_thread(self._library, self.doc.scene())  # generate + compile off the event loop
-        except BaseException:
-            self.doc.set_spec(old)
-            raise
+        trial = replace(self.doc)  # the page keeps showing the current shape until the new one is built
+        trial.set_spec(spec)
+        await asyncio.to_thread(self._library, trial.scene())  # generate + compile off the event loop
+        self.doc.spec, self.doc.values = trial.spec, trial.values
         await self.send(
             {
                 "type": "shape",
