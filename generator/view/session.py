@@ -65,6 +65,7 @@ class Session:
         self._running = None  # (lib, rt_render*) of the render in progress
         self._last_start = 0.0
         self._task: asyncio.Task | None = None
+        self._saving: asyncio.Task | None = None
         self.frames = 0  # frames sent (for tests)
 
     # ------------------------------------------------------------------ messages
@@ -108,7 +109,11 @@ class Session:
             elif kind == "render":
                 self.request(protocol.parse_render(data, self.doc.spec))
             elif kind == "save_png":
-                await self._save_png(*protocol.parse_save(data))
+                size = protocol.parse_save(data)
+                if self._saving is not None and not self._saving.done():
+                    raise UserError("save_png", "a picture is already being saved")
+                # its own task: the page stays interactive while a large picture renders
+                self._saving = asyncio.get_running_loop().create_task(self._save_png(*size))
             elif kind == "save_yaml":
                 await self.send({"type": "yaml", "mode": self._mode(), "text": self.yaml_text()})
             elif kind == "show_c":
@@ -254,11 +259,17 @@ class Session:
                 write_png(img, path)
                 return path.read_bytes()
 
-        data = await asyncio.to_thread(work)
+        try:
+            data = await asyncio.to_thread(work)
+        except UserError as err:
+            await self.send({"type": "error", "field": "message", "message": str(err)})
+            return
         await self.send(HEADER.pack(0, KIND_SAVE, width, height) + data)
 
     async def close(self) -> None:
         self._pending = None
+        if self._saving is not None and not self._saving.done():
+            await asyncio.wait([self._saving])  # render() cannot be cancelled from here; it ends on its own
         if self._running is not None:
             lib, ctx = self._running
             lib.rt_render_cancel(ctx)
