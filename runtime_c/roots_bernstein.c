@@ -111,9 +111,7 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     c.out = out;
     c.cnt = 0;
     c.fallback_from = NAN;
-    double x = fabs(a) + h, M = 0.0;
-    for (int k = n; k >= 0; --k)
-        M = M * x + fabs(p[k]);
+    double M = ig_horner_abs(p, n, fabs(a) + h);
     c.tol = 24.0 * n * IG_U * M;
     if (!isfinite(c.tol))
         return ig_bracket_interval(p, n, a, b, out);

@@ -11,6 +11,7 @@
  * implemented in NumPy by implgen.raycast for the generated Python modules.
  */
 #include "shape.h"
+#include "numerics.h"
 
 #include <math.h>
 
@@ -44,7 +45,9 @@ void ig_shape_prepare(const ig_shape *shape, const double *params, ig_shape_prep
     }
 }
 
-/* Slab clip of [*t0, *t1] against the grown box; an infinite bound imposes nothing on its side. 0 when empty. */
+/* Slab clip of [*t0, *t1] against the grown box; an infinite bound imposes nothing on its side. 0 when empty.
+ * Unlike the tracer's rt_clip_box it neither tests the box for emptiness nor stops early: prepare() built the
+ * box, and only its clipping axes are visited. */
 static int clip_box(const ig_shape_prep *prep, const double o[3], const double d[3], double *t0, double *t1)
 {
     for (int k = 0; k < prep->nclip; ++k) {
@@ -55,13 +58,8 @@ static int clip_box(const ig_shape_prep *prep, const double o[3], const double d
                 return 0;
             continue;
         }
-        double inv = 1.0 / d[i];
-        double ta = (lo - o[i]) * inv, tb = (hi - o[i]) * inv;
-        if (ta > tb) {
-            double t = ta;
-            ta = tb;
-            tb = t;
-        }
+        double ta, tb;
+        ig_slab(lo, hi, o[i], 1.0 / d[i], &ta, &tb);
         if (ta > *t0)
             *t0 = ta;
         if (tb < *t1)

@@ -2,6 +2,7 @@
 #ifndef IMPLGEN_TRACER_INTERNAL_H
 #define IMPLGEN_TRACER_INTERNAL_H
 
+#include "numerics.h"
 #include "tracer.h"
 
 typedef struct rt_node {
@@ -100,11 +101,12 @@ enum { RT_CLOSEST = 0, RT_ANY_OPAQUE = 1 };
 int rt_spawn_skip(const rt_scene *s, const rt_hit *h);
 
 /* tracer_scene.c */
+void rt_xform_point(const double m[12], const double p[3], double out[3]);
+void rt_xform_vector(const double m[12], const double v[3], double out[3]);
+/* tracer_hit.c */
 void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far);
 int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
                      int skip, rt_pending *out);
-void rt_xform_point(const double m[12], const double p[3], double out[3]);
-void rt_xform_vector(const double m[12], const double v[3], double out[3]);
 int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0,
                 int *f1);
 /* Fills hit (normal, object-space point, ...) for the pending hit of the ray o + t d. With lazy == NULL the
@@ -126,5 +128,10 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
 
 /* small vector helpers */
 static inline double rt_dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static inline double rt_maxabs3(const double v[3])
+{
+    double a = fabs(v[0]), b = fabs(v[1]), c = fabs(v[2]);
+    return a > b ? (a > c ? a : c) : (b > c ? b : c);
+}
 
 #endif
