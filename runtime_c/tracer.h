@@ -90,7 +90,7 @@ double rt_scene_far(const rt_scene *s);
 /* World box of a node: returns 1 and fills box when bounded, 0 when unbounded. */
 int rt_scene_node_box(const rt_scene *s, int node, double box[6]);
 
-/* ---- ray queries (tracer_scene.c, tracer_csg.c) ---- */
+/* ---- ray queries (tracer_hit.c, tracer_csg.c) ---- */
 /* Closest hit with tmin < t < tmax (tmax may be INFINITY). Returns 1 and fills *hit, or 0. */
 int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax,
                        rt_hit *hit);
