@@ -42,8 +42,8 @@ static double clock_overhead(void)
 /* One timed pass (a clock read either side of every solve) and one untimed pass (throughput; the checksum
  * keeps the work from being optimised away). first != 0: ig_first_root's path (at most one root each, so
  * `roots` holds `count` entries); else all roots (`roots` holds count * n, NaN-padded). */
-static double bench_batch(const double *c, int n, long count, const double *lo, const double *hi, int method,
-                          int first, double *roots, int *counts, double *ns)
+static double bench_batch(const double *c, int n, long count, const double *lo, const double *hi, int method, int first,
+                          double *roots, int *counts, double *ns)
 {
     double r[IG_MAX_DEGREE];
     double over = clock_overhead();

@@ -39,9 +39,9 @@
 typedef struct {
     const double *p; /* power-form coefficients, exact degree n */
     int n;
-    double a, h;    /* the interval [a, a + h]; t = a + s h */
-    double tol;     /* |b_i| <= tol: the sign of b_i is not certain */
-    int first;      /* stop at the leftmost root */
+    double a, h; /* the interval [a, a + h]; t = a + s h */
+    double tol;  /* |b_i| <= tol: the sign of b_i is not certain */
+    int first;   /* stop at the leftmost root */
     double *out;
     int cnt;
     double fallback_from; /* NaN, or the left end of the first piece that was not certain: bracketing decides
@@ -51,10 +51,10 @@ typedef struct {
 } bz_ctx;
 
 /* 1/k, k = 0 .. IG_MAX_DEGREE (entry 0 unused): turns the binomial scaling into products. */
-static const double bz_inv[IG_MAX_DEGREE + 1] = {
-    0.0,       1.0,        1.0 / 2,  1.0 / 3,  1.0 / 4,  1.0 / 5,  1.0 / 6,  1.0 / 7,  1.0 / 8,
-    1.0 / 9,   1.0 / 10,   1.0 / 11, 1.0 / 12, 1.0 / 13, 1.0 / 14, 1.0 / 15, 1.0 / 16, 1.0 / 17,
-    1.0 / 18,  1.0 / 19,   1.0 / 20, 1.0 / 21, 1.0 / 22, 1.0 / 23, 1.0 / 24};
+static const double bz_inv[IG_MAX_DEGREE + 1] = {0.0,      1.0,      1.0 / 2,  1.0 / 3,  1.0 / 4,  1.0 / 5,  1.0 / 6,
+                                                 1.0 / 7,  1.0 / 8,  1.0 / 9,  1.0 / 10, 1.0 / 11, 1.0 / 12, 1.0 / 13,
+                                                 1.0 / 14, 1.0 / 15, 1.0 / 16, 1.0 / 17, 1.0 / 18, 1.0 / 19, 1.0 / 20,
+                                                 1.0 / 21, 1.0 / 22, 1.0 / 23, 1.0 / 24};
 
 /* Certain sign of p at t given the Bernstein value bv there (b_0 or b_n of a piece): the plain value when it
  * is clear of the rounding band, else the compensated evaluation (0: p is zero within rounding). */
@@ -118,17 +118,50 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     double bz[IG_MAX_DEGREE + 1], vl, vr;
     bz_piece_fn piece;
     switch (n) {
-    case 3: to_bernstein_3(p, n, a, h, bz); piece = piece_3; break;
-    case 4: to_bernstein_4(p, n, a, h, bz); piece = piece_4; break;
-    case 5: to_bernstein_5(p, n, a, h, bz); piece = piece_5; break;
-    case 6: to_bernstein_6(p, n, a, h, bz); piece = piece_6; break;
-    case 7: to_bernstein_7(p, n, a, h, bz); piece = piece_7; break;
-    case 8: to_bernstein_8(p, n, a, h, bz); piece = piece_8; break;
-    case 9: to_bernstein_9(p, n, a, h, bz); piece = piece_9; break;
-    case 10: to_bernstein_10(p, n, a, h, bz); piece = piece_10; break;
-    case 11: to_bernstein_11(p, n, a, h, bz); piece = piece_11; break;
-    case 12: to_bernstein_12(p, n, a, h, bz); piece = piece_12; break;
-    default: to_bernstein_any(p, n, a, h, bz); piece = piece_any; break;
+    case 3:
+        to_bernstein_3(p, n, a, h, bz);
+        piece = piece_3;
+        break;
+    case 4:
+        to_bernstein_4(p, n, a, h, bz);
+        piece = piece_4;
+        break;
+    case 5:
+        to_bernstein_5(p, n, a, h, bz);
+        piece = piece_5;
+        break;
+    case 6:
+        to_bernstein_6(p, n, a, h, bz);
+        piece = piece_6;
+        break;
+    case 7:
+        to_bernstein_7(p, n, a, h, bz);
+        piece = piece_7;
+        break;
+    case 8:
+        to_bernstein_8(p, n, a, h, bz);
+        piece = piece_8;
+        break;
+    case 9:
+        to_bernstein_9(p, n, a, h, bz);
+        piece = piece_9;
+        break;
+    case 10:
+        to_bernstein_10(p, n, a, h, bz);
+        piece = piece_10;
+        break;
+    case 11:
+        to_bernstein_11(p, n, a, h, bz);
+        piece = piece_11;
+        break;
+    case 12:
+        to_bernstein_12(p, n, a, h, bz);
+        piece = piece_12;
+        break;
+    default:
+        to_bernstein_any(p, n, a, h, bz);
+        piece = piece_any;
+        break;
     }
     int sl = end_sign(&c, bz[0], a, &vl), sr = end_sign(&c, bz[n], b, &vr);
     if (sl == 0 || sr == 0) /* a root at an end of the interval (within rounding) */

@@ -61,8 +61,8 @@ static double polish_multiple(const double (*chain)[IG_MAX_DEGREE + 1], int n, d
  * there) and report roots at a and b. Otherwise only roots strictly inside (a, b) matter, as cut points for
  * the next level: a plain sign and a looser tolerance are enough (missing an even-multiplicity root of an
  * intermediate derivative leaves the next polynomial monotonic across it). out[] needs nc + 2 entries. */
-static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n, double a, double b, const double *crit,
-                          int nc, int final, double *out)
+static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n, double a, double b,
+                          const double *crit, int nc, int final, double *out)
 {
     const double *q = chain[j], *ddq = chain[j + 2];
     const int m = n - j;
@@ -165,7 +165,7 @@ int ig_bracket_interval(const double *p, int n, double a, double b, double *out)
                 buf[cur][nc++] = q[i];
     }
     for (int j = n - 3; j >= 0; --j) {
-        nc = monotone_level((const double (*)[IG_MAX_DEGREE + 1])chain, j, n, a, b, buf[cur], nc, j == 0, buf[1 - cur]);
+        nc = monotone_level((const double(*)[IG_MAX_DEGREE + 1]) chain, j, n, a, b, buf[cur], nc, j == 0, buf[1 - cur]);
         cur = 1 - cur;
     }
     memcpy(out, buf[cur], (size_t)nc * sizeof(double));

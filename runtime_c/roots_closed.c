@@ -129,16 +129,13 @@ static int finish(double *y, int k, int e, double lo, double hi, double *r)
 
 /* ------------------------------------------------------------------------------------------- plain */
 
-static int is_zero_classic(double x)
-{
-    return x > -1e-9 && x < 1e-9;
-}
+static int is_zero_classic(double x) { return x > -1e-9 && x < 1e-9; }
 
 /* Classic cubic on the monic x^3 + A x^2 + B x + C (Cardano, trigonometric for three real roots). */
 static int cubic_classic(double A, double B, double C, double *x)
 {
     double sub = A / 3.0;
-    double p = (B - A * sub) / 3.0;                          /* depressed y^3 + 3p y + 2q */
+    double p = (B - A * sub) / 3.0; /* depressed y^3 + 3p y + 2q */
     double q = 0.5 * (2.0 / 27.0 * A * A * A - A * B / 3.0 + C);
     double D = q * q + p * p * p;
     int k;

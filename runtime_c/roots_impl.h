@@ -35,8 +35,8 @@ double ig_refine(const double *c, int n, double l, double r, double vl, double v
 
 /* ig_refine on k brackets of the same polynomial at once (four evaluation chains in flight): roots[i] is
  * bitwise what ig_refine(c, n, l[i], r[i], vl[i], vr[i], tol, x0[i]) returns. */
-void ig_refine_many(const double *c, int n, int k, const double *l, const double *r, const double *vl,
-                    const double *vr, double tol, const double *x0, double *roots);
+void ig_refine_many(const double *c, int n, int k, const double *l, const double *r, const double *vl, const double *vr,
+                    double tol, const double *x0, double *roots);
 
 /* Midpoint of [l, r] in the ordering of doubles (halves the number of doubles between them). */
 double ig_ordered_mid(double l, double r);

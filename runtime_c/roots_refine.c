@@ -81,7 +81,8 @@ static double refine_safe(const double *c, int n, double l, double r, double vl,
         } else {
             /* Newton's error after this step is about K step^2 with K = |step| / dx^2 estimated from the
              * last two steps: stop when that is below the tolerance (saves the confirming evaluation) */
-            if (newton_before && as <= 1e-3 * fabs(dx) && as <= 1e-3 * fabs(xn) && (as / dx) * (as / dx) * as <= tol * fabs(xn))
+            if (newton_before && as <= 1e-3 * fabs(dx) && as <= 1e-3 * fabs(xn) &&
+                (as / dx) * (as / dx) * as <= tol * fabs(xn))
                 return xn;
             /* steps stopped shrinking while already tiny: they are rounding noise of p(x), which is as
              * close as this root can be resolved (or a multiple root, converging linearly) */
@@ -230,8 +231,8 @@ double ig_refine(const double *c, int n, double l, double r, double vl, double v
     return refine_safe(c, n, s.l, s.r, s.vl, s.vr, tol, s.x);
 }
 
-void ig_refine_many(const double *c, int n, int k, const double *l, const double *r, const double *vl,
-                    const double *vr, double tol, const double *x0, double *roots)
+void ig_refine_many(const double *c, int n, int k, const double *l, const double *r, const double *vl, const double *vr,
+                    double tol, const double *x0, double *roots)
 {
     if (k == 1) {
         roots[0] = ig_refine(c, n, l[0], r[0], vl[0], vr[0], tol, x0[0]);

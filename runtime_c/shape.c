@@ -18,7 +18,8 @@
 void ig_shape_prepare(const ig_shape *shape, const double *params, ig_shape_prep *prep)
 {
     double box[6] = {-INFINITY, -INFINITY, -INFINITY, INFINITY, INFINITY, INFINITY};
-    prep->degree = (shape && shape->coeffs && shape->degree >= 0 && shape->degree <= IG_MAX_DEGREE) ? shape->degree : -1;
+    prep->degree =
+        (shape && shape->coeffs && shape->degree >= 0 && shape->degree <= IG_MAX_DEGREE) ? shape->degree : -1;
     prep->bounded = (shape && shape->bounds) ? shape->bounds(params, box) : 0;
     prep->nclip = prep->nfinite = 0;
     for (int i = 0; i < 3; ++i) {
@@ -129,8 +130,8 @@ int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_p
 }
 
 /* Clip, shift, coefficients, solve (all roots, or only the first), shift back. */
-static int shape_solve(const ig_shape *shape, const double *params, const double o[3], const double d[3],
-                       double tmin, double tmax, ig_root_method method, int first, double *roots)
+static int shape_solve(const ig_shape *shape, const double *params, const double o[3], const double d[3], double tmin,
+                       double tmax, ig_root_method method, int first, double *roots)
 {
     ig_shape_prep prep;
     if (!shape || !shape->coeffs || !roots)
@@ -139,14 +140,14 @@ static int shape_solve(const ig_shape *shape, const double *params, const double
     return ig_shape_solve(shape, params, &prep, o, d, tmin, tmax, method, first, roots);
 }
 
-int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3], const double d[3],
-                   double tmin, double tmax, ig_root_method method, double *roots)
+int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3], const double d[3], double tmin,
+                   double tmax, ig_root_method method, double *roots)
 {
     return shape_solve(shape, params, o, d, tmin, tmax, method, 0, roots);
 }
 
-int ig_shape_first_root(const ig_shape *shape, const double *params, const double o[3], const double d[3],
-                        double tmin, double tmax, ig_root_method method, double *t)
+int ig_shape_first_root(const ig_shape *shape, const double *params, const double o[3], const double d[3], double tmin,
+                        double tmax, ig_root_method method, double *t)
 {
     return shape_solve(shape, params, o, d, tmin, tmax, method, 1, t);
 }

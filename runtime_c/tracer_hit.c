@@ -16,9 +16,11 @@ void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far)
     memcpy(r->o, o, sizeof r->o);
     memcpy(r->d, d, sizeof r->d);
     r->len = sqrt(rt_dot(d, d));
-    for (a = 0; a < 3; ++a) r->inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
+    for (a = 0; a < 3; ++a)
+        r->inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
     if (r->len > 0.0) {
-        for (a = 0; a < 3; ++a) r->u[a] = d[a] / r->len;
+        for (a = 0; a < 3; ++a)
+            r->u[a] = d[a] / r->len;
         r->far_t = far / r->len;
     } else {
         r->u[0] = r->u[1] = r->u[2] = 0.0;
@@ -31,42 +33,47 @@ void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far)
  * outside the box on it, gives 0. f0/f1 (may be NULL) receive the outward face code +-(axis + 1) of the face
  * that moved the bound, or keep their value when the bound did not move. Returns 1 when the clipped interval
  * is non-empty. */
-static inline int clip_slabs(const double box[6], const double o[3], const double d[3], const double inv[3],
-                             double *t0, double *t1, int *f0, int *f1)
+static inline int clip_slabs(const double box[6], const double o[3], const double d[3], const double inv[3], double *t0,
+                             double *t1, int *f0, int *f1)
 {
     double lo = *t0, hi = *t1;
     int a;
     for (a = 0; a < 3; ++a) {
         double bmin = box[a], bmax = box[a + 3], ta, tb;
         int fa;
-        if (!(bmin <= bmax)) return 0; /* empty or NaN box */
+        if (!(bmin <= bmax))
+            return 0; /* empty or NaN box */
         if (d[a] == 0.0) {
-            if (!(o[a] >= bmin && o[a] <= bmax)) return 0;
+            if (!(o[a] >= bmin && o[a] <= bmax))
+                return 0;
             continue;
         }
         /* outward normal of the face the ray enters through: the min face, or the max one when d < 0 */
         fa = ig_slab(bmin, bmax, o[a], inv[a], &ta, &tb) ? a + 1 : -(a + 1);
         if (ta > lo) {
             lo = ta;
-            if (f0) *f0 = fa;
+            if (f0)
+                *f0 = fa;
         }
         if (tb < hi) {
             hi = tb;
-            if (f1) *f1 = -fa;
+            if (f1)
+                *f1 = -fa;
         }
-        if (!(lo <= hi)) return 0;
+        if (!(lo <= hi))
+            return 0;
     }
     *t0 = lo;
     *t1 = hi;
     return 1;
 }
 
-int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0,
-                int *f1)
+int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0, int *f1)
 {
     double inv[3];
     int a;
-    for (a = 0; a < 3; ++a) inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
+    for (a = 0; a < 3; ++a)
+        inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
     return clip_slabs(box, o, d, inv, t0, t1, f0, f1);
 }
 
@@ -109,8 +116,10 @@ static double solver_noise(const rt_node *n, const double oo[3], const double od
         den = rt_dot(od, od);
     }
     ts = den > 0.0 ? num / den : 0.0;
-    if (!isfinite(ts)) ts = 0.0;
-    for (a = 0; a < 3; ++a) os[a] = oo[a] + ts * od[a];
+    if (!isfinite(ts))
+        ts = 0.0;
+    for (a = 0; a < 3; ++a)
+        os[a] = oo[a] + ts * od[a];
     n->shape->coeffs(os, od, n->params, c);
     tau = t - ts;
     for (k = 0; k <= deg; ++k) {
@@ -124,14 +133,18 @@ static double solver_noise(const rt_node *n, const double oo[3], const double od
      * meets near po. */
     {
         double seg[3], c2[IG_MAX_DEGREE + 1], sum2 = 0.0;
-        for (a = 0; a < 3; ++a) seg[a] = po[a] - n->prep.centre[a];
+        for (a = 0; a < 3; ++a)
+            seg[a] = po[a] - n->prep.centre[a];
         n->shape->coeffs(n->prep.centre, seg, n->params, c2);
-        for (k = 0; k <= deg; ++k) sum2 += fabs(c2[k]);
-        if (sum2 > sum) sum = sum2;
+        for (k = 0; k <= deg; ++k)
+            sum2 += fabs(c2[k]);
+        if (sum2 > sum)
+            sum = sum2;
     }
     sum = RT_ERR_OBJECT * DBL_EPSILON * (double)(deg + 1) * sum;
     horner = RT_ERR_OBJECT * fabs(horner - fp);
-    if (!isfinite(sum) || !isfinite(horner)) return 0.0;
+    if (!isfinite(sum) || !isfinite(horner))
+        return 0.0;
     return sum > horner ? sum : horner;
 }
 
@@ -146,8 +159,10 @@ static double distance_bound(const rt_node *n, const double po[3], const double 
     n->shape->coeffs(po, u, n->params, c);
     for (k = 1; k <= deg; ++k) {
         double q;
-        if (k > 1 && isfinite(best)) best_pow *= best; /* best^k */
-        if (!(c[k] != 0.0) || !isfinite(c[k])) continue;
+        if (k > 1 && isfinite(best))
+            best_pow *= best; /* best^k */
+        if (!(c[k] != 0.0) || !isfinite(c[k]))
+            continue;
         q = level / fabs(c[k]);
         if (k == 1) {
             best = q;
@@ -181,13 +196,16 @@ void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], c
         double f = n->shape->value(hit->po, n->params), gl;
         n->shape->gradient(hit->po, n->params, g);
         gl = sqrt(rt_dot(g, g));
-        if (!(gl > 0.0) || !isfinite(gl) || !isfinite(f)) singular = 1;
+        if (!(gl > 0.0) || !isfinite(gl) || !isfinite(f))
+            singular = 1;
         /* the direction rt_hit_error measures the distance to f = 0 along */
         if (!singular) {
-            for (a = 0; a < 3; ++a) lz->u[a] = g[a] / gl;
+            for (a = 0; a < 3; ++a)
+                lz->u[a] = g[a] / gl;
         } else {
             double l = sqrt(rt_dot(lz->od, lz->od));
-            for (a = 0; a < 3; ++a) lz->u[a] = lz->od[a] / l;
+            for (a = 0; a < 3; ++a)
+                lz->u[a] = lz->od[a] / l;
         }
         lz->f = f;
     } else {
@@ -196,18 +214,23 @@ void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], c
     }
     /* World normal by the inverse transpose: n_w = Minv^T g. */
     if (!singular) {
-        for (a = 0; a < 3; ++a) nw[a] = n->minv[a] * g[0] + n->minv[4 + a] * g[1] + n->minv[8 + a] * g[2];
+        for (a = 0; a < 3; ++a)
+            nw[a] = n->minv[a] * g[0] + n->minv[4 + a] * g[1] + n->minv[8 + a] * g[2];
         len = sqrt(rt_dot(nw, nw));
-        if (!(len > 0.0) || !isfinite(len)) singular = 1;
+        if (!(len > 0.0) || !isfinite(len))
+            singular = 1;
         else
-            for (a = 0; a < 3; ++a) nw[a] /= len;
+            for (a = 0; a < 3; ++a)
+                nw[a] /= len;
     }
     if (singular) {
         /* grad f = 0 (a cusp, an apex): no normal exists; face the ray so shading stays finite. */
         len = sqrt(rt_dot(d, d));
-        for (a = 0; a < 3; ++a) nw[a] = -d[a] / len;
+        for (a = 0; a < 3; ++a)
+            nw[a] = -d[a] / len;
         g[0] = g[1] = g[2] = 0.0;
-        if (!entering_known) entering = 1;
+        if (!entering_known)
+            entering = 1;
     } else if (!entering_known) {
         entering = rt_dot(nw, d) < 0.0;
     } else if ((rt_dot(nw, d) < 0.0) != (entering != 0)) {
@@ -219,7 +242,8 @@ void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], c
     }
     memcpy(hit->n, nw, sizeof nw);
     len = sqrt(rt_dot(g, g));
-    for (a = 0; a < 3; ++a) hit->no[a] = len > 0.0 ? g[a] / len : nw[a];
+    for (a = 0; a < 3; ++a)
+        hit->no[a] = len > 0.0 ? g[a] / len : nw[a];
     hit->err = 0.0;
     hit->t = t;
     hit->object = pd->object;
@@ -229,7 +253,8 @@ void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], c
     hit->entering = entering != 0;
     hit->singular = singular;
     lz->pending = 1;
-    if (!lazy) rt_hit_error(s, hit, lz);
+    if (!lazy)
+        rt_hit_error(s, hit, lz);
 }
 
 void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lz)
@@ -237,7 +262,8 @@ void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lz)
     const rt_node *n = &s->nodes[hit->leaf];
     double dist = 0.0, mag_o, mag_w, td[3], tod[3], tr[3], t = hit->t;
     int a;
-    if (!lz->pending) return;
+    if (!lz->pending)
+        return;
     lz->pending = 0;
     if (hit->face == 0) {
         double f = lz->f, level;
@@ -262,7 +288,6 @@ void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lz)
                RT_ERR_WORLD * DBL_EPSILON * mag_w;
 }
 
-
 int rt_spawn_skip(const rt_scene *s, const rt_hit *h) { return s->flat[h->object] ? h->object : -1; }
 
 int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
@@ -274,21 +299,23 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
     double entry[128];
     rt_ray ray;
     rt_pending h;
-    if (!s->committed) return 0;
-    if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]) || !isfinite(o[0]) || !isfinite(o[1]) ||
-        !isfinite(o[2]))
+    if (!s->committed)
+        return 0;
+    if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]) || !isfinite(o[0]) || !isfinite(o[1]) || !isfinite(o[2]))
         return 0;
     rt_ray_init(&ray, o, d, s->far);
     /* A hit is kept when it is closer than the best so far (rt_object_hit only reports t < best). In
      * RT_ANY_OPAQUE mode a hit on an opaque material ends the search. */
-#define RT_TAKE(obj)                                                                                             \
-    if ((obj) != skip && rt_object_hit(s, (obj), &ray, tmin, best, &h)) {                                       \
-        *out = h;                                                                                                \
-        best = h.t;                                                                                              \
-        found = 1;                                                                                               \
-        if (mode == RT_ANY_OPAQUE && s->materials[s->nodes[h.leaf].material].transparency <= 0.0) return 1;    \
+#define RT_TAKE(obj)                                                                                                   \
+    if ((obj) != skip && rt_object_hit(s, (obj), &ray, tmin, best, &h)) {                                              \
+        *out = h;                                                                                                      \
+        best = h.t;                                                                                                    \
+        found = 1;                                                                                                     \
+        if (mode == RT_ANY_OPAQUE && s->materials[s->nodes[h.leaf].material].transparency <= 0.0)                      \
+            return 1;                                                                                                  \
     }
-    for (i = 0; i < s->nunbounded; ++i) RT_TAKE(s->unbounded[i])
+    for (i = 0; i < s->nunbounded; ++i)
+        RT_TAKE(s->unbounded[i])
     /* Each stack entry carries the t where the ray enters its box, so a node is clipped once and skipped
      * when a closer hit has been found since it was pushed. */
     if (s->nbvh > 0) {
@@ -301,10 +328,12 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
     while (sp > 0) {
         const rt_bvh_node *b;
         --sp;
-        if (entry[sp] > best) continue;
+        if (entry[sp] > best)
+            continue;
         b = &s->bvh[stack[sp]];
         if (b->left < 0) {
-            for (i = b->first; i < b->first + b->count; ++i) RT_TAKE(s->order[i])
+            for (i = b->first; i < b->first + b->count; ++i)
+                RT_TAKE(s->order[i])
         } else if (sp + 2 <= (int)(sizeof stack / sizeof stack[0])) {
             /* visit the nearer child first: push it last */
             const rt_bvh_node *l = &s->bvh[b->left], *r = &s->bvh[b->right];
@@ -332,11 +361,11 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
     return found;
 }
 
-int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax,
-                       rt_hit *hit)
+int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, rt_hit *hit)
 {
     rt_pending h;
-    if (!rt_scene_closest(s, o, d, tmin, tmax, RT_CLOSEST, -1, &h)) return 0;
+    if (!rt_scene_closest(s, o, d, tmin, tmax, RT_CLOSEST, -1, &h))
+        return 0;
     rt_finish_hit(s, &h, o, d, hit, NULL);
     return 1;
 }

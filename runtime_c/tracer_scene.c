@@ -19,7 +19,8 @@ void rt_xform_point(const double m[12], const double p[3], double out[3])
 {
     double r[3];
     int i;
-    for (i = 0; i < 3; ++i) r[i] = m[4 * i] * p[0] + m[4 * i + 1] * p[1] + m[4 * i + 2] * p[2] + m[4 * i + 3];
+    for (i = 0; i < 3; ++i)
+        r[i] = m[4 * i] * p[0] + m[4 * i + 1] * p[1] + m[4 * i + 2] * p[2] + m[4 * i + 3];
     memcpy(out, r, sizeof r);
 }
 
@@ -27,7 +28,8 @@ void rt_xform_vector(const double m[12], const double v[3], double out[3])
 {
     double r[3];
     int i;
-    for (i = 0; i < 3; ++i) r[i] = m[4 * i] * v[0] + m[4 * i + 1] * v[1] + m[4 * i + 2] * v[2];
+    for (i = 0; i < 3; ++i)
+        r[i] = m[4 * i] * v[0] + m[4 * i + 1] * v[1] + m[4 * i + 2] * v[2];
     memcpy(out, r, sizeof r);
 }
 
@@ -46,11 +48,14 @@ static int grow(void **arr, int *cap, int need, size_t elem)
 {
     void *p;
     int ncap;
-    if (need <= *cap) return 1;
+    if (need <= *cap)
+        return 1;
     ncap = *cap ? *cap * 2 : 16;
-    while (ncap < need) ncap *= 2;
+    while (ncap < need)
+        ncap *= 2;
     p = realloc(*arr, (size_t)ncap * elem);
-    if (!p) return 0;
+    if (!p)
+        return 0;
     *arr = p;
     *cap = ncap;
     return 1;
@@ -73,15 +78,27 @@ static int invert_affine(const double m[12], double inv[12])
     double scale = 0.0, t[3];
     int i;
     for (i = 0; i < 12; ++i)
-        if (i % 4 != 3 && fabs(m[i]) > scale) scale = fabs(m[i]);
-    if (!(scale > 0.0) || !isfinite(det) || fabs(det) <= 1e-12 * scale * scale * scale) return 0;
-    inv[0] = c00 / det; inv[1] = c01 / det; inv[2] = c02 / det;
-    inv[4] = c10 / det; inv[5] = c11 / det; inv[6] = c12 / det;
-    inv[8] = c20 / det; inv[9] = c21 / det; inv[10] = c22 / det;
+        if (i % 4 != 3 && fabs(m[i]) > scale)
+            scale = fabs(m[i]);
+    if (!(scale > 0.0) || !isfinite(det) || fabs(det) <= 1e-12 * scale * scale * scale)
+        return 0;
+    inv[0] = c00 / det;
+    inv[1] = c01 / det;
+    inv[2] = c02 / det;
+    inv[4] = c10 / det;
+    inv[5] = c11 / det;
+    inv[6] = c12 / det;
+    inv[8] = c20 / det;
+    inv[9] = c21 / det;
+    inv[10] = c22 / det;
     inv[3] = inv[7] = inv[11] = 0.0;
-    t[0] = m[3]; t[1] = m[7]; t[2] = m[11];
+    t[0] = m[3];
+    t[1] = m[7];
+    t[2] = m[11];
     rt_xform_vector(inv, t, t);
-    inv[3] = -t[0]; inv[7] = -t[1]; inv[11] = -t[2];
+    inv[3] = -t[0];
+    inv[7] = -t[1];
+    inv[11] = -t[2];
     return 1;
 }
 
@@ -90,7 +107,8 @@ static int invert_affine(const double m[12], double inv[12])
 rt_scene *rt_scene_new(void)
 {
     rt_scene *s = calloc(1, sizeof *s);
-    if (!s) return NULL;
+    if (!s)
+        return NULL;
     s->eye[2] = 5.0;
     s->up[1] = 1.0;
     s->vfov = 40.0;
@@ -100,8 +118,10 @@ rt_scene *rt_scene_new(void)
 void rt_scene_free(rt_scene *s)
 {
     int i;
-    if (!s) return;
-    for (i = 0; i < s->nnodes; ++i) free(s->nodes[i].params);
+    if (!s)
+        return;
+    for (i = 0; i < s->nnodes; ++i)
+        free(s->nodes[i].params);
     free(s->nodes);
     free(s->objects);
     free(s->materials);
@@ -119,9 +139,11 @@ int rt_scene_add_material(rt_scene *s, const double *v)
 {
     rt_material *m;
     int i;
-    if (s->committed) return fail(s, "scene already committed");
+    if (s->committed)
+        return fail(s, "scene already committed");
     for (i = 0; i < RT_MATERIAL_DOUBLES; ++i)
-        if (!isfinite(v[i])) return fail(s, "material value is not finite");
+        if (!isfinite(v[i]))
+            return fail(s, "material value is not finite");
     if (!grow((void **)&s->materials, &s->cap_materials, s->nmaterials + 1, sizeof *s->materials))
         return fail(s, "out of memory");
     m = &s->materials[s->nmaterials];
@@ -137,33 +159,43 @@ int rt_scene_add_material(rt_scene *s, const double *v)
     m->ior = v[13];
     memcpy(m->absorption, v + 14, 3 * sizeof(double));
     /* v[17], v[18] reserved (zero) */
-    if (m->ior <= 0.0) return fail(s, "index of refraction must be positive");
-    if (m->checker_scale < 0.0) return fail(s, "checker scale must be positive");
+    if (m->ior <= 0.0)
+        return fail(s, "index of refraction must be positive");
+    if (m->checker_scale < 0.0)
+        return fail(s, "checker scale must be positive");
     return s->nmaterials++;
 }
 
 static int new_node(rt_scene *s)
 {
-    if (s->committed) return fail(s, "scene already committed");
-    if (!grow((void **)&s->nodes, &s->cap_nodes, s->nnodes + 1, sizeof *s->nodes)) return fail(s, "out of memory");
+    if (s->committed)
+        return fail(s, "scene already committed");
+    if (!grow((void **)&s->nodes, &s->cap_nodes, s->nnodes + 1, sizeof *s->nodes))
+        return fail(s, "out of memory");
     memset(&s->nodes[s->nnodes], 0, sizeof s->nodes[0]);
     return s->nnodes++;
 }
 
-int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, int nparams,
-                      const double *m, int material)
+int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, int nparams, const double *m,
+                      int material)
 {
     rt_node *n;
     int i, k;
-    if (!shape) return fail(s, "no shape");
-    if (nparams != shape->nparams) return fail(s, "wrong number of shape parameters");
-    if (material < 0 || material >= s->nmaterials) return fail(s, "leaf without a valid material");
+    if (!shape)
+        return fail(s, "no shape");
+    if (nparams != shape->nparams)
+        return fail(s, "wrong number of shape parameters");
+    if (material < 0 || material >= s->nmaterials)
+        return fail(s, "leaf without a valid material");
     for (i = 0; i < 12; ++i)
-        if (!isfinite(m[i])) return fail(s, "transform is not finite");
+        if (!isfinite(m[i]))
+            return fail(s, "transform is not finite");
     for (i = 0; i < nparams; ++i)
-        if (!isfinite(params[i])) return fail(s, "shape parameter is not finite");
+        if (!isfinite(params[i]))
+            return fail(s, "shape parameter is not finite");
     k = new_node(s);
-    if (k < 0) return k;
+    if (k < 0)
+        return k;
     n = &s->nodes[k];
     n->kind = RT_LEAF;
     n->left = n->right = -1;
@@ -174,7 +206,8 @@ int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, 
         s->nnodes--;
         return fail(s, "out of memory");
     }
-    if (nparams > 0) memcpy(n->params, params, (size_t)nparams * sizeof(double));
+    if (nparams > 0)
+        memcpy(n->params, params, (size_t)nparams * sizeof(double));
     memcpy(n->m, m, sizeof n->m);
     if (!invert_affine(n->m, n->minv)) {
         free(n->params);
@@ -183,11 +216,13 @@ int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, 
     }
     n->mnorm = 0.0;
     for (i = 0; i < 12; ++i)
-        if (i % 4 != 3) n->mnorm += m[i] * m[i];
+        if (i % 4 != 3)
+            n->mnorm += m[i] * m[i];
     n->mnorm = sqrt(n->mnorm);
     n->identity = 1;
     for (i = 0; i < 12; ++i)
-        if (m[i] != ((i == 0 || i == 5 || i == 10) ? 1.0 : 0.0)) n->identity = 0;
+        if (m[i] != ((i == 0 || i == 5 || i == 10) ? 1.0 : 0.0))
+            n->identity = 0;
     for (i = 0; i < 3; ++i) { /* what shape.c starts from too: an axis bounds() leaves alone is open */
         n->obox[i] = -INFINITY;
         n->obox[i + 3] = INFINITY;
@@ -206,15 +241,19 @@ int rt_scene_add_csg(rt_scene *s, int op, int left, int right, int material)
 {
     rt_node *n;
     int k, dl, dr;
-    if (op != RT_UNION && op != RT_INTERSECTION && op != RT_DIFFERENCE) return fail(s, "unknown CSG operation");
+    if (op != RT_UNION && op != RT_INTERSECTION && op != RT_DIFFERENCE)
+        return fail(s, "unknown CSG operation");
     if (left < 0 || left >= s->nnodes || right < 0 || right >= s->nnodes || left == right)
         return fail(s, "CSG child index out of range");
-    if (material >= s->nmaterials) return fail(s, "material index out of range");
+    if (material >= s->nmaterials)
+        return fail(s, "material index out of range");
     dl = s->nodes[left].depth;
     dr = s->nodes[right].depth;
-    if ((dl > dr ? dl : dr) + 1 > RT_MAX_CSG_DEPTH) return fail(s, "CSG nesting too deep");
+    if ((dl > dr ? dl : dr) + 1 > RT_MAX_CSG_DEPTH)
+        return fail(s, "CSG nesting too deep");
     k = new_node(s);
-    if (k < 0) return k;
+    if (k < 0)
+        return k;
     n = &s->nodes[k];
     n->kind = op;
     n->left = left;
@@ -227,8 +266,10 @@ int rt_scene_add_csg(rt_scene *s, int op, int left, int right, int material)
 
 int rt_scene_add_object(rt_scene *s, int node)
 {
-    if (s->committed) return fail(s, "scene already committed");
-    if (node < 0 || node >= s->nnodes) return fail(s, "object node out of range");
+    if (s->committed)
+        return fail(s, "scene already committed");
+    if (node < 0 || node >= s->nnodes)
+        return fail(s, "object node out of range");
     if (!grow((void **)&s->objects, &s->cap_objects, s->nobjects + 1, sizeof *s->objects))
         return fail(s, "out of memory");
     s->objects[s->nobjects] = node;
@@ -238,9 +279,11 @@ int rt_scene_add_object(rt_scene *s, int node)
 int rt_scene_add_light(rt_scene *s, const double position[3], const double color[3])
 {
     int i;
-    if (s->committed) return fail(s, "scene already committed");
+    if (s->committed)
+        return fail(s, "scene already committed");
     for (i = 0; i < 3; ++i)
-        if (!isfinite(position[i]) || !isfinite(color[i])) return fail(s, "light is not finite");
+        if (!isfinite(position[i]) || !isfinite(color[i]))
+            return fail(s, "light is not finite");
     if (!grow((void **)&s->lights, &s->cap_lights, 6 * (s->nlights + 1), sizeof *s->lights))
         return fail(s, "out of memory");
     memcpy(s->lights + 6 * s->nlights, position, 3 * sizeof(double));
@@ -248,8 +291,7 @@ int rt_scene_add_light(rt_scene *s, const double position[3], const double color
     return s->nlights++;
 }
 
-void rt_scene_set_camera(rt_scene *s, const double eye[3], const double look_at[3], const double up[3],
-                         double vfov)
+void rt_scene_set_camera(rt_scene *s, const double eye[3], const double look_at[3], const double up[3], double vfov)
 {
     memcpy(s->eye, eye, sizeof s->eye);
     memcpy(s->look_at, look_at, sizeof s->look_at);
@@ -266,9 +308,12 @@ static void pad_box(double b[6])
     double ext = 0.0, mag = 0.0, pad;
     int a;
     for (a = 0; a < 3; ++a) {
-        if (b[a + 3] - b[a] > ext) ext = b[a + 3] - b[a];
-        if (fabs(b[a]) > mag) mag = fabs(b[a]);
-        if (fabs(b[a + 3]) > mag) mag = fabs(b[a + 3]);
+        if (b[a + 3] - b[a] > ext)
+            ext = b[a + 3] - b[a];
+        if (fabs(b[a]) > mag)
+            mag = fabs(b[a]);
+        if (fabs(b[a + 3]) > mag)
+            mag = fabs(b[a + 3]);
     }
     /* Rounding in the corner transform is ~1e-16 relative; 1e-9 keeps the box conservative with room. */
     pad = 1e-9 * (ext + mag) + DBL_MIN;
@@ -284,9 +329,11 @@ static void node_box(rt_scene *s, int k)
     int a, i;
     if (n->kind == RT_LEAF) {
         n->wbounded = 0;
-        if (!n->obounded) return;
+        if (!n->obounded)
+            return;
         for (a = 0; a < 6; ++a)
-            if (!isfinite(n->obox[a])) return;
+            if (!isfinite(n->obox[a]))
+                return;
         for (a = 0; a < 3; ++a) {
             n->wbox[a] = INFINITY;
             n->wbox[a + 3] = -INFINITY;
@@ -298,8 +345,10 @@ static void node_box(rt_scene *s, int k)
             c[2] = n->obox[(i & 4) ? 5 : 2];
             rt_xform_point(n->m, c, w);
             for (a = 0; a < 3; ++a) {
-                if (w[a] < n->wbox[a]) n->wbox[a] = w[a];
-                if (w[a] > n->wbox[a + 3]) n->wbox[a + 3] = w[a];
+                if (w[a] < n->wbox[a])
+                    n->wbox[a] = w[a];
+                if (w[a] > n->wbox[a + 3])
+                    n->wbox[a + 3] = w[a];
             }
         }
         pad_box(n->wbox);
@@ -327,7 +376,8 @@ static void node_box(rt_scene *s, int k)
             }
         } else { /* difference: never larger than its left operand */
             n->wbounded = l->wbounded;
-            if (n->wbounded) memcpy(n->wbox, l->wbox, sizeof n->wbox);
+            if (n->wbounded)
+                memcpy(n->wbox, l->wbox, sizeof n->wbox);
         }
     }
 }
@@ -354,7 +404,8 @@ static int build_bvh(rt_scene *s, int first, int count)
     b->first = first;
     b->count = count;
     b->left = b->right = -1;
-    if (count <= 2) return k;
+    if (count <= 2)
+        return k;
     for (a = 0; a < 3; ++a)
         if (cmax[a] - cmin[a] > best) {
             best = cmax[a] - cmin[a];
@@ -367,7 +418,8 @@ static int build_bvh(rt_scene *s, int first, int count)
         double cv = wv[axis] + wv[axis + 3];
         while (j >= first) {
             const double *wj = s->nodes[s->objects[s->order[j]]].wbox;
-            if (wj[axis] + wj[axis + 3] <= cv) break;
+            if (wj[axis] + wj[axis + 3] <= cv)
+                break;
             s->order[j + 1] = s->order[j];
             --j;
         }
@@ -388,9 +440,12 @@ int rt_scene_commit(rt_scene *s)
 {
     int i, a, nb = 0;
     double size = 0.0;
-    if (s->committed) return 0;
-    if (s->nmaterials == 0 && s->nobjects > 0) return fail(s, "no materials");
-    for (i = 0; i < s->nnodes; ++i) node_box(s, i); /* children always precede parents */
+    if (s->committed)
+        return 0;
+    if (s->nmaterials == 0 && s->nobjects > 0)
+        return fail(s, "no materials");
+    for (i = 0; i < s->nnodes; ++i)
+        node_box(s, i); /* children always precede parents */
     free(s->unbounded);
     free(s->flat);
     free(s->order);
@@ -399,7 +454,8 @@ int rt_scene_commit(rt_scene *s)
     s->flat = malloc((size_t)(s->nobjects + 1));
     s->order = malloc((size_t)(s->nobjects + 1) * sizeof(int));
     s->bvh = malloc((size_t)(2 * s->nobjects + 1) * sizeof *s->bvh);
-    if (!s->unbounded || !s->flat || !s->order || !s->bvh) return fail(s, "out of memory");
+    if (!s->unbounded || !s->flat || !s->order || !s->bvh)
+        return fail(s, "out of memory");
     s->nunbounded = 0;
     s->nbvh = 0;
     for (i = 0; i < s->nobjects; ++i) {
@@ -407,16 +463,20 @@ int rt_scene_commit(rt_scene *s)
         s->flat[i] = n->kind == RT_LEAF && n->shape->degree == 1;
         if (n->wbounded) {
             s->order[nb++] = i;
-            for (a = 0; a < 6; ++a) size = fmax(size, fabs(n->wbox[a]));
+            for (a = 0; a < 6; ++a)
+                size = fmax(size, fabs(n->wbox[a]));
         } else {
             s->unbounded[s->nunbounded++] = i;
         }
     }
-    if (nb > 0) build_bvh(s, 0, nb);
+    if (nb > 0)
+        build_bvh(s, 0, nb);
     size = fmax(size, rt_maxabs3(s->eye));
     size = fmax(size, rt_maxabs3(s->look_at));
-    for (i = 0; i < s->nlights; ++i) size = fmax(size, rt_maxabs3(s->lights + 6 * i));
-    if (!(size > 0.0) || !isfinite(size)) size = 1.0;
+    for (i = 0; i < s->nlights; ++i)
+        size = fmax(size, rt_maxabs3(s->lights + 6 * i));
+    if (!(size > 0.0) || !isfinite(size))
+        size = 1.0;
     s->far = 1e5 * size;
     s->committed = 1;
     return 0;
@@ -425,11 +485,16 @@ int rt_scene_commit(rt_scene *s)
 int rt_scene_count(const rt_scene *s, int what)
 {
     switch (what) {
-    case 0: return s->nnodes;
-    case 1: return s->nobjects;
-    case 2: return s->nunbounded;
-    case 3: return s->nbvh;
-    default: return -1;
+    case 0:
+        return s->nnodes;
+    case 1:
+        return s->nobjects;
+    case 2:
+        return s->nunbounded;
+    case 3:
+        return s->nbvh;
+    default:
+        return -1;
     }
 }
 
@@ -437,7 +502,8 @@ double rt_scene_far(const rt_scene *s) { return s->far; }
 
 int rt_scene_node_box(const rt_scene *s, int node, double box[6])
 {
-    if (node < 0 || node >= s->nnodes || !s->nodes[node].wbounded) return 0;
+    if (node < 0 || node >= s->nnodes || !s->nodes[node].wbounded)
+        return 0;
     memcpy(box, s->nodes[node].wbox, 6 * sizeof(double));
     return 1;
 }

@@ -14,8 +14,8 @@
 static int failures = 0;
 
 /* Refine k brackets of c both ways; each root must be bitwise the same and within rtol of want[i]. */
-static void check(const char *name, const double *c, int n, int k, const double *l, const double *r,
-                  const double *x0, const double *want, double rtol)
+static void check(const char *name, const double *c, int n, int k, const double *l, const double *r, const double *x0,
+                  const double *want, double rtol)
 {
     double vl[IG_MAX_DEGREE + 1] = {0.0}, vr[IG_MAX_DEGREE + 1] = {0.0}, many[IG_MAX_DEGREE + 1];
     for (int i = 0; i < k; ++i) {
@@ -29,8 +29,9 @@ static void check(const char *name, const double *c, int n, int k, const double 
                  fabs(one - want[i]) <= rtol * fmax(fabs(want[i]), 1e-300);
         if (!ok) {
             ++failures;
-            fprintf(stderr, "FAIL %s, bracket %d of %d [%.17g, %.17g]: one at a time %.17g, batched %.17g, want %.17g\n",
-                    name, i, k, l[i], r[i], one, many[i], want[i]);
+            fprintf(stderr,
+                    "FAIL %s, bracket %d of %d [%.17g, %.17g]: one at a time %.17g, batched %.17g, want %.17g\n", name,
+                    i, k, l[i], r[i], one, many[i], want[i]);
         }
     }
 }

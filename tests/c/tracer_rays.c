@@ -20,14 +20,14 @@
 
 static int failures = 0;
 
-#define CHECK(cond, ...)                                                                                     \
-    do {                                                                                                     \
-        if (!(cond)) {                                                                                       \
-            ++failures;                                                                                      \
-            printf("FAIL %s:%d: ", __FILE__, __LINE__);                                                      \
-            printf(__VA_ARGS__);                                                                             \
-            printf("\n");                                                                                    \
-        }                                                                                                    \
+#define CHECK(cond, ...)                                                                                               \
+    do {                                                                                                               \
+        if (!(cond)) {                                                                                                 \
+            ++failures;                                                                                                \
+            printf("FAIL %s:%d: ", __FILE__, __LINE__);                                                                \
+            printf(__VA_ARGS__);                                                                                       \
+            printf("\n");                                                                                              \
+        }                                                                                                              \
     } while (0)
 
 static const double IDENTITY[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
@@ -110,7 +110,8 @@ static void test_sphere_distances(void)
                 long double q = -0.5L * (b + (b >= 0 ? sqrtl(disc) : -sqrtl(disc)));
                 long double t1 = q / a, t2 = c / q, lo = t1 < t2 ? t1 : t2, hi = t1 < t2 ? t2 : t1;
                 double t = lo > 0 ? (double)lo : (hi > 0 ? (double)hi : INFINITY);
-                if (t < best) best = t;
+                if (t < best)
+                    best = t;
             }
         }
         got = rt_scene_intersect(s, o, d, 0, INFINITY, &h);
@@ -118,7 +119,8 @@ static void test_sphere_distances(void)
             ++nmiss;
         } else if (got) {
             double e = fabs(h.t - best) / fmax(1.0, best);
-            if (e > worst) worst = e;
+            if (e > worst)
+                worst = e;
         }
     }
     CHECK(nmiss == 0, "%d random rays disagree on hit/miss", nmiss);
@@ -139,23 +141,26 @@ static void test_optics(void)
         double d[3] = {sin(th) * cos(ph), -cos(th), sin(th) * sin(ph)}, t[3], crit;
         int ok = rt_refract(d, n, eta, t);
         crit = eta > 1.0 ? asin(1.0 / eta) : M_PI;
-        if ((th > crit + 1e-12 && ok) || (th < crit - 1e-12 && !ok)) ++tir_wrong;
+        if ((th > crit + 1e-12 && ok) || (th < crit - 1e-12 && !ok))
+            ++tir_wrong;
         if (ok) {
             double st = sqrt(t[0] * t[0] + t[2] * t[2]);
             double e = fabs(eta * sin(th) - st);
             /* coplanar: t lies in the plane of d and n */
             double cx[3] = {d[1] * n[2] - d[2] * n[1], d[2] * n[0] - d[0] * n[2], d[0] * n[1] - d[1] * n[0]};
             double pe = fabs(rt_dot(cx, t));
-            if (e > worst_snell) worst_snell = e;
-            if (pe > worst_plane) worst_plane = pe;
+            if (e > worst_snell)
+                worst_snell = e;
+            if (pe > worst_plane)
+                worst_plane = pe;
             CHECK(t[1] < 0.0 || th > 1.5707, "refracted ray must go through the surface");
         }
     }
     CHECK(worst_snell < 1e-14, "Snell residual %.3g", worst_snell);
     CHECK(worst_plane < 1e-14, "coplanarity residual %.3g", worst_plane);
     CHECK(tir_wrong == 0, "%d rays on the wrong side of the critical angle", tir_wrong);
-    printf("snell: 40000 rays, worst |eta sin(i) - sin(t)| %.3g, coplanarity %.3g, TIR misclassified %d\n",
-           worst_snell, worst_plane, tir_wrong);
+    printf("snell: 40000 rays, worst |eta sin(i) - sin(t)| %.3g, coplanarity %.3g, TIR misclassified %d\n", worst_snell,
+           worst_plane, tir_wrong);
     {
         double d[3] = {sin(0.9), -cos(0.9), 0}, t[3];
         /* 0.9 rad > asin(1/1.5) = 0.7297: total internal reflection going from glass to air */
@@ -208,8 +213,12 @@ static void cyl_gradient(const double q[3], const double *p, double g[3])
 static int cyl_bounds(const double *p, double box[6])
 {
     (void)p;
-    box[0] = -1.0; box[1] = -1.0; box[2] = -1.0;
-    box[3] = 1.0; box[4] = 1.0; box[5] = 1.0;
+    box[0] = -1.0;
+    box[1] = -1.0;
+    box[2] = -1.0;
+    box[3] = 1.0;
+    box[4] = 1.0;
+    box[5] = 1.0;
     return 1;
 }
 static const ig_shape capped_cylinder = {"capped_cylinder", 2, 0, cyl_coeffs, cyl_value, cyl_gradient, cyl_bounds};
@@ -252,7 +261,11 @@ static void test_csg(void)
                   !hc.entering && fabs(hc.n[1] - 1.0) < 1e-12,
               "capped cylinder top face from inside: t %g face %d", hc.t, hc.face);
         /* the side is the surface f = 0, even where it touches the box face x = -1 */
-        o[0] = -5.0; o[1] = 0.5; o[2] = 20.0; d[0] = 1.0; d[1] = 0.0;
+        o[0] = -5.0;
+        o[1] = 0.5;
+        o[2] = 20.0;
+        d[0] = 1.0;
+        d[1] = 0.0;
         CHECK(rt_scene_intersect(s, o, d, 0, INFINITY, &hc) == 1 && fabs(hc.t - 4.0) < 1e-12 && hc.face == 0 &&
                   fabs(hc.n[0] + 1.0) < 1e-12,
               "capped cylinder side: t %g face %d", hc.t, hc.face);
@@ -282,8 +295,7 @@ static void test_csg(void)
         double o[3] = {5, 0, 0}, d[3] = {-1, 0, 0};
         CHECK(rt_scene_intersect(s, o, d, 0, INFINITY, &h) == 1, "A - B from +x misses");
         CHECK(fabs(h.t - 5.0) < 1e-12 && h.leaf == B && h.entering && fabs(h.n[0] - 1.0) < 1e-12,
-              "A - B from +x: t %g leaf %d entering %d n (%g %g %g)", h.t, h.leaf, h.entering, h.n[0], h.n[1],
-              h.n[2]);
+              "A - B from +x: t %g leaf %d entering %d n (%g %g %g)", h.t, h.leaf, h.entering, h.n[0], h.n[1], h.n[2]);
     }
     {
         /* tangent: y = 1 grazes both spheres (double roots), so there is no inside anywhere */
@@ -309,8 +321,7 @@ static void test_csg(void)
 /* ---------------------------------------------------------------- transforms */
 static void rot_axis(const double axis[3], double ang, double R[9])
 {
-    double c = cos(ang), sn = sin(ang), l = sqrt(rt_dot(axis, axis)), x = axis[0] / l, y = axis[1] / l,
-           z = axis[2] / l;
+    double c = cos(ang), sn = sin(ang), l = sqrt(rt_dot(axis, axis)), x = axis[0] / l, y = axis[1] / l, z = axis[2] / l;
     R[0] = c + x * x * (1 - c);
     R[1] = x * y * (1 - c) - z * sn;
     R[2] = x * z * (1 - c) + y * sn;
@@ -333,7 +344,8 @@ static void test_transformed_torus(void)
     rt_hit h;
     rot_axis(axis, 0.8, R);
     for (i = 0; i < 3; ++i) {
-        for (j = 0; j < 3; ++j) M[4 * i + j] = R[3 * i + j] * S[j];
+        for (j = 0; j < 3; ++j)
+            M[4 * i + j] = R[3 * i + j] * S[j];
         M[4 * i + 3] = T[i];
     }
     mat = add_matte(s);
@@ -347,7 +359,8 @@ static void test_transformed_torus(void)
             o[k] = T[k] + 8.0 * urand(&seed) - 4.0;
             d[k] = T[k] + 1.2 * (2.0 * urand(&seed) - 1.0) - o[k];
         }
-        for (k = 0; k < 3; ++k) po[k] = o[k] - T[k];
+        for (k = 0; k < 3; ++k)
+            po[k] = o[k] - T[k];
         for (k = 0; k < 3; ++k) {
             oo[k] = (R[k] * po[0] + R[3 + k] * po[1] + R[6 + k] * po[2]) / S[k];
             od[k] = (R[k] * d[0] + R[3 + k] * d[1] + R[6 + k] * d[2]) / S[k];
@@ -365,13 +378,16 @@ static void test_transformed_torus(void)
             ++disagree;
             continue;
         }
-        if (!got) continue;
+        if (!got)
+            continue;
         ++hits;
-        if (fabs(h.t - first) / fmax(1.0, first) > worst) worst = fabs(h.t - first) / fmax(1.0, first);
+        if (fabs(h.t - first) / fmax(1.0, first) > worst)
+            worst = fabs(h.t - first) / fmax(1.0, first);
         /* the world normal must be perpendicular to M x (object tangent vectors) */
         {
             double g[3], t1[3], t2[3], w1[3], w2[3], p[3];
-            for (k = 0; k < 3; ++k) p[k] = oo[k] + h.t * od[k];
+            for (k = 0; k < 3; ++k)
+                p[k] = oo[k] + h.t * od[k];
             torus_z_gradient(p, tp, g);
             /* two tangents: g x e, g x (g x e) */
             {
@@ -388,8 +404,10 @@ static void test_transformed_torus(void)
             {
                 double e1 = fabs(rt_dot(w1, h.n)) / sqrt(rt_dot(w1, w1));
                 double e2 = fabs(rt_dot(w2, h.n)) / sqrt(rt_dot(w2, w2));
-                if (e1 > worst_n) worst_n = e1;
-                if (e2 > worst_n) worst_n = e2;
+                if (e1 > worst_n)
+                    worst_n = e1;
+                if (e2 > worst_n)
+                    worst_n = e2;
             }
         }
     }
@@ -431,8 +449,8 @@ static void test_piriform_basis(void)
         CHECK(fabs(h.t - 3.0) < 1e-4, "cusp at t = %.17g, want 3", h.t);
         CHECK(isfinite(h.n[0]) && isfinite(h.n[1]) && isfinite(h.n[2]) && fabs(rt_dot(h.n, h.n) - 1) < 1e-12,
               "cusp normal not finite/unit");
-        printf("piriform cusp: t = %.12g (want 3), singular %d, normal (%g %g %g)\n", h.t, h.singular, h.n[0],
-               h.n[1], h.n[2]);
+        printf("piriform cusp: t = %.12g (want 3), singular %d, normal (%g %g %g)\n", h.t, h.singular, h.n[0], h.n[1],
+               h.n[2]);
         CHECK(rt_scene_intersect(s, o, d, 3.5, INFINITY, &h) == 1 && fabs(h.t - 4.0) < 1e-12,
               "tip at t = %.17g, want 4", h.t);
     }
@@ -446,9 +464,11 @@ static void test_piriform_basis(void)
         CHECK(rt_scene_intersect(s, o, d, 0, INFINITY, &h) == 1 && fabs(h.t - 1.75) < 1e-12, "t = %.17g want 1.75",
               h.t);
         /* object gradient (-0.25, -0.5, 0) maps to g_x u/|u|^2 + g_y v/|v|^2 + g_z w/|w|^2 */
-        for (k = 0; k < 3; ++k) want[k] = g[0] * u[k] / 9.0 + g[1] * v[k] / 4.0 + g[2] * w[k] / 2.25;
+        for (k = 0; k < 3; ++k)
+            want[k] = g[0] * u[k] / 9.0 + g[1] * v[k] / 4.0 + g[2] * w[k] / 2.25;
         l = sqrt(rt_dot(want, want));
-        for (k = 0; k < 3; ++k) CHECK(fabs(h.n[k] - want[k] / l) < 1e-12, "piriform normal[%d]", k);
+        for (k = 0; k < 3; ++k)
+            CHECK(fabs(h.n[k] - want[k] / l) < 1e-12, "piriform normal[%d]", k);
         CHECK(rt_scene_intersect(s, o, d, 1.8, INFINITY, &h) == 1 && fabs(h.t - 2.25) < 1e-12, "second root");
     }
     rt_scene_free(s);
@@ -495,15 +515,14 @@ static void test_unbounded_and_shading(void)
     rt_scene_free(s);
 }
 
-
 /* ---------------------------------------------------------------- glass: Beer-Lambert, CSG boundaries, shadows */
 static void glass_material(double m[RT_MATERIAL_DOUBLES], double ior, double tr, double s0, double s1, double s2)
 {
     memset(m, 0, RT_MATERIAL_DOUBLES * sizeof(double));
     m[0] = m[1] = m[2] = 1.0;
-    m[12] = tr;  /* transparency */
+    m[12] = tr; /* transparency */
     m[13] = ior;
-    m[14] = s0;  /* absorption */
+    m[14] = s0; /* absorption */
     m[15] = s1;
     m[16] = s2;
 }
@@ -549,14 +568,18 @@ static void test_glass(void)
             /* start at (0, -sin a, 0)... a chord from a point at distance sin(a) from the centre, heading along
              * x, meets the sphere with incidence angle a */
             o[1] = -sin(60.0 * M_PI / 180.0);
-            d60[0] = 1; d60[1] = 0; d60[2] = 0;
+            d60[0] = 1;
+            d60[1] = 0;
+            d60[2] = 0;
             rt_trace_ray(s2, o, d60, 12, c60, NULL);
             o[1] = -sin(30.0 * M_PI / 180.0);
-            d30[0] = 1; d30[1] = 0; d30[2] = 0;
+            d30[0] = 1;
+            d30[1] = 0;
+            d30[2] = 0;
             rt_trace_ray(s2, o, d30, 12, c30, NULL);
             Ft = rt_fresnel(cos(30.0 * M_PI / 180.0), 1.5);
-            CHECK(c60[0] == 0.0 && c60[1] == 0.0 && c60[2] == 0.0, "TIR must trap the ray: (%g %g %g)", c60[0],
-                  c60[1], c60[2]);
+            CHECK(c60[0] == 0.0 && c60[1] == 0.0 && c60[2] == 0.0, "TIR must trap the ray: (%g %g %g)", c60[0], c60[1],
+                  c60[2]);
             for (a = 0; a < 3; ++a)
                 CHECK(c30[a] >= (1 - Ft) * bg[a] - 1e-12 && c30[a] <= bg[a] + 1e-12, "30 deg: %g (F %g)", c30[a], Ft);
             printf("inside the ball: 60 deg -> (%g %g %g) (trapped), 30 deg -> %.6f >= (1 - F) bg = %.6f\n", c60[0],
@@ -586,7 +609,8 @@ static void test_glass(void)
             rt_trace_ray(s, o, d, 8, rgb, NULL);
             for (a = 0; a < 3; ++a) {
                 double e = fabs(rgb[a] - exp(-sigma[a] * L) * bg[a]);
-                if (e > worst) worst = e;
+                if (e > worst)
+                    worst = e;
             }
         }
         /* each boundary moves the path by its error bound (~1e-12 here) */
@@ -615,14 +639,12 @@ static void test_glass(void)
             rt_trace_ray(s, o, d, 4, rgb, NULL);
             for (a = 0; a < 3; ++a) {
                 double want = 0.1 + 0.8 * exp(-2 * sigma[a]) * 0.9;
-                CHECK(fabs(rgb[a] - want) < 1e-9, "shadow through glass channel %d: %.17g want %.17g", a, rgb[a],
-                      want);
+                CHECK(fabs(rgb[a] - want) < 1e-9, "shadow through glass channel %d: %.17g want %.17g", a, rgb[a], want);
             }
         }
         rt_scene_free(s);
     }
 }
-
 
 /* ---------------------------------------------------------------- the tracer's own shortcuts */
 
@@ -703,10 +725,12 @@ static void test_shortcuts(void)
             same += memcmp(&eager, &lazy_hit, sizeof eager) == 0;
             /* a ray leaving the plane never meets the plane again (why rays spawned there skip it) */
             if (eager.object == plane) {
-                for (i = 0; i < 3; ++i) L[i] = 2 * urand(&seed) - 1;
+                for (i = 0; i < 3; ++i)
+                    L[i] = 2 * urand(&seed) - 1;
                 rt_spawn_origin(&eager, L, q);
                 ++spawned;
-                if (rt_scene_closest(s, q, L, 0, INFINITY, RT_CLOSEST, -1, &ph) && ph.object == plane) ++self;
+                if (rt_scene_closest(s, q, L, 0, INFINITY, RT_CLOSEST, -1, &ph) && ph.object == plane)
+                    ++self;
                 CHECK(rt_spawn_skip(s, &eager) == plane, "a plane hit must skip the plane");
             } else {
                 CHECK(rt_spawn_skip(s, &eager) == -1, "only planes are skipped");
@@ -742,11 +766,11 @@ static void test_shortcuts(void)
     }
     CHECK(hits > 5000 && same == hits, "lazy error bound: %d of %d hits identical", same, hits);
     CHECK(self == 0 && spawned > 1000, "rays leaving the plane met it again %d times of %d", self, spawned);
-    CHECK(any_ok == any_n && any_n > 1000 && any_behind > 10, "RT_ANY_OPAQUE right on %d of %d segments (%d behind glass)",
-          any_ok, any_n, any_behind);
+    CHECK(any_ok == any_n && any_n > 1000 && any_behind > 10,
+          "RT_ANY_OPAQUE right on %d of %d segments (%d behind glass)", any_ok, any_n, any_behind);
     printf("shortcuts: %d hits, lazy error bound identical on %d; %d rays off the plane, %d met it again; any-opaque "
-           "right on %d of %d segments, %d of them opaque behind glass\n", hits, same, spawned, self, any_ok, any_n,
-           any_behind);
+           "right on %d of %d segments, %d of them opaque behind glass\n",
+           hits, same, spawned, self, any_ok, any_n, any_behind);
     rt_scene_free(s);
 
     {
@@ -767,7 +791,8 @@ static void test_shortcuts(void)
             q[0] = x / 0.7;
             q[1] = (0.0 - 1e-3 * 0.7 * 1.0) / 0.7;
             q[2] = z / 0.7;
-            for (i = 0; i < 3; ++i) sum += fmod(fabs(floor(q[i])), 2.0);
+            for (i = 0; i < 3; ++i)
+                sum += fmod(fabs(floor(q[i])), 2.0);
             want = fmod(sum, 2.0) < 0.5 ? 1.0 : 0.0;
             ++n;
             wrong += rgb[0] != want;
