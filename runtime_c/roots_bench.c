@@ -26,16 +26,7 @@ static double clock_overhead(void)
         double t1 = now_ns();
         d[i] = t1 - t0;
     }
-    /* partial selection of the median (insertion sort is fine for this size, once) */
-    for (int i = 1; i < N; ++i) {
-        double x = d[i];
-        int j = i - 1;
-        while (j >= 0 && d[j] > x) {
-            d[j + 1] = d[j];
-            --j;
-        }
-        d[j + 1] = x;
-    }
+    ig_sort(d, N); /* insertion sort is fine for this size, once */
     return d[N / 2];
 }
 

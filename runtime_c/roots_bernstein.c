@@ -96,6 +96,17 @@ static int end_sign(const bz_ctx *c, double bv, double t, double *val)
 
 typedef void (*bz_piece_fn)(bz_ctx *c, const double *b, double s0, double s1, double tl, double tr, int sl, int sr,
                             double vl, double vr, int depth);
+typedef void (*bz_basis_fn)(const double *p, int n, double a, double h, double *b);
+
+/* The code specialised per degree (3 to 12); other degrees run the _any version. */
+#define BZ_SPECIAL 13
+#define BZ_ENTRY(d) [d] = {to_bernstein_##d, piece_##d}
+static const struct {
+    bz_basis_fn to_bernstein;
+    bz_piece_fn piece;
+} bz_special[BZ_SPECIAL] = {BZ_ENTRY(3), BZ_ENTRY(4), BZ_ENTRY(5),  BZ_ENTRY(6),  BZ_ENTRY(7),
+                            BZ_ENTRY(8), BZ_ENTRY(9), BZ_ENTRY(10), BZ_ENTRY(11), BZ_ENTRY(12)};
+#undef BZ_ENTRY
 
 static int bernstein(const double *p, int n, double a, double b, int first, double *out)
 {
@@ -116,53 +127,13 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     if (!isfinite(c.tol))
         return ig_bracket_interval(p, n, a, b, out);
     double bz[IG_MAX_DEGREE + 1], vl, vr;
-    bz_piece_fn piece;
-    switch (n) {
-    case 3:
-        to_bernstein_3(p, n, a, h, bz);
-        piece = piece_3;
-        break;
-    case 4:
-        to_bernstein_4(p, n, a, h, bz);
-        piece = piece_4;
-        break;
-    case 5:
-        to_bernstein_5(p, n, a, h, bz);
-        piece = piece_5;
-        break;
-    case 6:
-        to_bernstein_6(p, n, a, h, bz);
-        piece = piece_6;
-        break;
-    case 7:
-        to_bernstein_7(p, n, a, h, bz);
-        piece = piece_7;
-        break;
-    case 8:
-        to_bernstein_8(p, n, a, h, bz);
-        piece = piece_8;
-        break;
-    case 9:
-        to_bernstein_9(p, n, a, h, bz);
-        piece = piece_9;
-        break;
-    case 10:
-        to_bernstein_10(p, n, a, h, bz);
-        piece = piece_10;
-        break;
-    case 11:
-        to_bernstein_11(p, n, a, h, bz);
-        piece = piece_11;
-        break;
-    case 12:
-        to_bernstein_12(p, n, a, h, bz);
-        piece = piece_12;
-        break;
-    default:
-        to_bernstein_any(p, n, a, h, bz);
-        piece = piece_any;
-        break;
+    bz_basis_fn to_bernstein = to_bernstein_any;
+    bz_piece_fn piece = piece_any;
+    if (n < BZ_SPECIAL && bz_special[n].piece) {
+        to_bernstein = bz_special[n].to_bernstein;
+        piece = bz_special[n].piece;
     }
+    to_bernstein(p, n, a, h, bz);
     int sl = end_sign(&c, bz[0], a, &vl), sr = end_sign(&c, bz[n], b, &vr);
     if (sl == 0 || sr == 0) /* a root at an end of the interval (within rounding) */
         return ig_bracket_interval(p, n, a, b, out);

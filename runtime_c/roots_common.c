@@ -101,7 +101,7 @@ int ig_quadratic(double c0, double c1, double c2, double *r)
     return m;
 }
 
-int ig_sort_unique(double *r, int k)
+void ig_sort(double *r, int k)
 {
     for (int i = 1; i < k; ++i) {
         double x = r[i];
@@ -112,6 +112,11 @@ int ig_sort_unique(double *r, int k)
         }
         r[j + 1] = x;
     }
+}
+
+int ig_sort_unique(double *r, int k)
+{
+    ig_sort(r, k);
     int m = 0;
     for (int i = 0; i < k; ++i)
         if (m == 0 || r[i] != r[m - 1])

@@ -44,6 +44,9 @@ double ig_ordered_mid(double l, double r);
 /* Real roots of c0 + c1 x + c2 x^2 (c2 != 0), distinct, ascending; a double root once. */
 int ig_quadratic(double c0, double c1, double c2, double *r);
 
+/* Sort ascending (insertion sort: the lists are short). */
+void ig_sort(double *r, int k);
+
 /* Sort ascending and drop exact duplicates; returns the new count. */
 int ig_sort_unique(double *r, int k);
 
