@@ -29,10 +29,10 @@ void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far)
 }
 
 /* Slab clipping of [*t0, *t1] against an axis-aligned box (sides may be infinite), given the ray's inverse
- * direction inv (any value on an axis where d is 0). An empty or NaN box, or a ray parallel to an axis and
- * outside the box on it, gives 0. f0/f1 (may be NULL) receive the outward face code +-(axis + 1) of the face
- * that moved the bound, or keep their value when the bound did not move. Returns 1 when the clipped interval
- * is non-empty. */
+ * direction inv (any value on an axis where d is 0), or NULL to divide only on the axes reached. An empty or
+ * NaN box, or a ray parallel to an axis and outside the box on it, gives 0. f0/f1 (may be NULL) receive the
+ * outward face code +-(axis + 1) of the face that moved the bound, or keep their value when the bound did not
+ * move. Returns 1 when the clipped interval is non-empty. */
 static inline int clip_slabs(const double box[6], const double o[3], const double d[3], const double inv[3], double *t0,
                              double *t1, int *f0, int *f1)
 {
@@ -49,7 +49,7 @@ static inline int clip_slabs(const double box[6], const double o[3], const doubl
             continue;
         }
         /* outward normal of the face the ray enters through: the min face, or the max one when d < 0 */
-        fa = ig_slab(bmin, bmax, o[a], inv[a], &ta, &tb) ? a + 1 : -(a + 1);
+        fa = ig_slab(bmin, bmax, o[a], inv ? inv[a] : 1.0 / d[a], &ta, &tb) ? a + 1 : -(a + 1);
         if (ta > lo) {
             lo = ta;
             if (f0)
@@ -70,11 +70,7 @@ static inline int clip_slabs(const double box[6], const double o[3], const doubl
 
 int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0, int *f1)
 {
-    double inv[3];
-    int a;
-    for (a = 0; a < 3; ++a)
-        inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
-    return clip_slabs(box, o, d, inv, t0, t1, f0, f1);
+    return clip_slabs(box, o, d, NULL, t0, t1, f0, f1);
 }
 
 /* The BVH's box test: rt_clip_box with the ray's precomputed inverse direction and no face codes. */
