@@ -199,6 +199,7 @@
       state.home = JSON.parse(JSON.stringify(msg.orbit));
       setOptions(msg.options);
       if (msg.mode !== "scene") $("lights").querySelector("option[value=scene]").disabled = true;
+      else for (const id of ["clip", "clip-size", "color", "inside"]) $(id).disabled = true; // the file's own
       showShape(msg);
       requestRender(true);
     } else if (msg.type === "shape") {
