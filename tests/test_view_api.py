@@ -282,3 +282,19 @@ def test_a_scene_written_back_renders_the_same(name: str, tmp_path) -> None:
     a = render(sc, width=48, height=36, spp=1, threads=2)
     b = render(again, width=48, height=36, spp=1, threads=2)
     assert np.array_equal(a, b)
+
+
+def test_a_new_equation_drops_the_old_shapes_bounds() -> None:
+    """The starter torus is bounded to |y| <= b; a sphere typed with the same params must not be cut by that
+    box: the ray down the y-axis from y = 5 meets the unit sphere at t = 4. New defaults alone keep it."""
+    from implgen.view import protocol
+
+    doc = document_factory(None)()
+    doc.options.clip = "none"
+    same = protocol.parse_shape({"equation": doc.spec.equation, "params": {"a": 1.2, "b": 0.3}}, doc.spec)
+    assert same.bounds is not None and same.box() == pytest.approx([-1.5, -0.3, -1.5, 1.5, 0.3, 1.5])
+    ball = protocol.parse_shape({"equation": "x^2 + y^2 + z^2 - a^2", "params": {"a": 1, "b": 0.35}}, doc.spec)
+    assert ball.bounds is None
+    doc.set_spec(ball)
+    sc = doc.scene(8, 8, 1)
+    assert CScene(sc, build.build_scene(sc)).intersect([0, 5, 0], [0, -1, 0]).t == pytest.approx(4.0, abs=1e-12)

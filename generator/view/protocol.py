@@ -72,19 +72,21 @@ def _bounds_text(spec: Spec) -> dict[str, list[str]] | None:
 
 def parse_shape(data: dict, current: Spec) -> Spec:
     """A new equation and param defaults, through the spec parser. The current shape's name is kept, and its
-    bounds while they still make sense with the new params (else the shape is unbounded)."""
+    bounds while the equation stays the same (new defaults only): a box made for one surface would cut
+    another one anywhere."""
     mapping: dict[str, Any] = {"name": current.name, "equation": data.get("equation")}
     if data.get("params"):
         mapping["params"] = _mapping("params", data["params"])
     if data.get("bounds") is not None:  # given: checked like a spec file's
         return parse_spec({**mapping, "bounds": data["bounds"]}, "equation")
+    spec = parse_spec(mapping, "equation")
     bounds = _bounds_text(current)
-    if bounds is not None:
+    if bounds is not None and spec.equation == current.equation:
         try:
             return parse_spec({**mapping, "bounds": bounds}, "equation")
         except UserError:
-            pass  # the bounds named a param that is gone: fall through, without bounds
-    return parse_spec(mapping, "equation")
+            pass  # a param the bounds need was removed: unbounded
+    return spec
 
 
 def parse_values(raw: Any, spec: Spec) -> dict[str, float]:
