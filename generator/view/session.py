@@ -16,6 +16,7 @@ from __future__ import annotations
 import asyncio
 import ctypes
 import io
+import logging
 import os
 import struct
 import tempfile
@@ -40,6 +41,8 @@ FULL_SPP = 4
 MAX_RENDERS_PER_SECOND = 60  # per page: requests beyond this wait (and are overtaken by newer ones)
 KIND_COARSE, KIND_FULL, KIND_SAVE = 0, 1, 2
 HEADER = struct.Struct(">IBxxxHH")  # seq, kind, width, height; the image bytes follow
+
+log = logging.getLogger("implgen.view")
 
 Send = Callable[[dict | bytes], Awaitable[None]]
 
@@ -198,6 +201,12 @@ class Session:
                 await self._frames(req)
             except UserError as err:
                 await self.send({"type": "error", "field": "message", "message": str(err)})
+            except asyncio.CancelledError:
+                raise
+            except Exception as err:  # a bug, not bad input: say so and keep serving the next request
+                log.exception("viewer render failed")
+                text = f"internal error: {type(err).__name__}"
+                await self.send({"type": "error", "field": "message", "message": text})
 
     async def _frames(self, req: protocol.RenderRequest) -> None:
         cw, ch = max(1, req.width // COARSE_DIVISOR), max(1, req.height // COARSE_DIVISOR)
@@ -263,6 +272,10 @@ class Session:
             data = await asyncio.to_thread(work)
         except UserError as err:
             await self.send({"type": "error", "field": "message", "message": str(err)})
+            return
+        except Exception as err:  # a bug: say so, keep serving
+            log.exception("viewer save failed")
+            await self.send({"type": "error", "field": "message", "message": f"internal error: {type(err).__name__}"})
             return
         await self.send(HEADER.pack(0, KIND_SAVE, width, height) + data)
 
