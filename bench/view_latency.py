@@ -29,7 +29,7 @@ from websockets.sync.client import connect
 
 from implgen.codegen.spec import load_spec
 from implgen.view.dump import spec_mapping
-from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL
+from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, MAX_RENDERS_PER_SECOND
 
 ROOT = Path(__file__).resolve().parents[1]
 SHAPES = ROOT / "examples" / "shapes"
@@ -210,7 +210,8 @@ def main() -> int:
         "(target ≤ 0.4).",
         "",
         "Coarse frames are 160×120 at 1 sample per pixel (JPEG), refined frames 640×480 at 4 (PNG); the studio "
-        "light preset (two lights, so two shadow rays per hit), clipped to a ball (a CSG intersection).",
+        "light preset (two lights, so two shadow rays per hit), clipped to a ball (a CSG intersection). The "
+        f"server starts at most {MAX_RENDERS_PER_SECOND} renders a second per page, which caps the orbit rate.",
         "",
     ]
     text = "\n".join(lines)
