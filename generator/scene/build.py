@@ -1,14 +1,16 @@
 """Build a scene's tracer: generate C for exactly the shapes the scene uses, compile it with runtime_c.
 
-Two caches, both under clib.cache_dir() (`$IMPLGEN_CACHE`, else `$XDG_CACHE_HOME/implgen`, else
+Caches, all under clib.cache_dir() (`$IMPLGEN_CACHE`, else `$XDG_CACHE_HOME/implgen`, else
 `~/.cache/implgen`):
+  spec/<key>.json a parsed spec, keyed by its content (scene/speccache.py): what the build needs of it;
   gen/<key>/      generated .c/.h of one shape; the key hashes the spec's content (equation, params, bounds,
                   folded values, name) and implgen's own generator + template sources, so editing a spec or
                   upgrading implgen regenerates, and nothing else does;
   obj/<name>-<hash>.o  one object per C source (clib.compile_object hashes the source and the headers it
                   can see): the runtime's objects are compiled once and shared by every scene;
+  glue/glue-<key>.c the C list of a scene's shapes, keyed by their C names and implgen's fingerprint;
   scene-<hash>.so the linked library (clib.link_shared, keyed by its objects).
-An unchanged scene therefore neither runs SymPy nor the C compiler the second time, and a new shape costs
+An unchanged scene therefore neither imports SymPy nor runs the C compiler the second time, and a new shape costs
 one generation, one small compilation (its .c and the glue) and a link.
 """
 
@@ -19,54 +21,49 @@ import json
 import os
 import tempfile
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from implgen import clib
-from implgen.codegen.spec import Spec
-from implgen.codegen.templating import environment
 from implgen.outputs import atomic_write
-from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, TRACER_SOURCES, runtime_dir, runtime_sources, templates_dir
+from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, TRACER_SOURCES, runtime_dir, runtime_sources
 from implgen.scene.model import Leaf, Scene
+from implgen.scene.speccache import CachedSpec, full_spec, implgen_fingerprint
+
+if TYPE_CHECKING:
+    from implgen.codegen.spec import Spec
 
 
 @dataclass
 class ShapeEntry:
-    spec: Spec  # possibly renamed / with params folded
+    spec: Spec | CachedSpec  # possibly renamed / with params folded
     c_name: str
     folded: bool
 
 
-@lru_cache(maxsize=1)
-def _implgen_fingerprint() -> str:
-    """Hash of the generator's own sources and templates: generated code depends on them."""
-    h = hashlib.sha256()
-    pkg = Path(__file__).resolve().parent.parent
-    for p in sorted(pkg.rglob("*.py")) + sorted(templates_dir().rglob("*.j2")):
-        h.update(str(p.relative_to(p.parents[1])).encode() + b"\0" + p.read_bytes())
-    return h.hexdigest()
-
-
-def spec_key(spec: Spec) -> str:
+def spec_key(spec: Spec | CachedSpec) -> str:
+    """The key of a spec's generated code (a CachedSpec carries the key its full parse had)."""
+    if isinstance(spec, CachedSpec):
+        return spec.spec_key
     ident = {
         "name": spec.name,
         "f": str(spec.f),
         "params": list(spec.params.items()),
         "bounds": None if spec.bounds is None else {a: [str(lo), str(hi)] for a, (lo, hi) in spec.bounds.items()},
         "folded": sorted(spec.folded.items()),
-        "implgen": _implgen_fingerprint(),
+        "implgen": implgen_fingerprint(),
     }
     return hashlib.sha256(json.dumps(ident, sort_keys=True, default=str).encode()).hexdigest()[:24]
 
 
-def generated_dir(spec: Spec) -> tuple[Path, bool]:
+def generated_dir(spec: Spec | CachedSpec) -> tuple[Path, bool]:
     """Folder with <name>.c/.h for this spec, generated on a cache miss. Returns (folder, was_generated)."""
-    from implgen.codegen.emit import generate
-
     target = clib.cache_dir() / "gen" / spec_key(spec)
     if (target / f"{spec.name}.c").exists() and (target / f"{spec.name}.h").exists():
         return target, False
-    files = generate(spec, langs=("c",))
+    from implgen.codegen.emit import generate  # SymPy: only when there is something to generate
+
+    files = generate(full_spec(spec), langs=("c",))
     target.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=".gen-", dir=target.parent))
     for fname, text in files.items():
@@ -116,9 +113,19 @@ def leaf_params(entry: ShapeEntry, leaf: Leaf) -> list[float]:
     return [] if entry.folded else [float(v) for v in leaf.params.values()]
 
 
-def _glue(entries: list[ShapeEntry]) -> str:
-    """The C file that lists the scene's shapes for the tracer (templates/scene/glue.c.j2)."""
-    return environment().get_template("scene/glue.c.j2").render(entries=entries)
+def _glue(entries: list[ShapeEntry]) -> Path:
+    """The C file that lists the scene's shapes for the tracer (templates/scene/glue.c.j2), cached by what it
+    is made of: the shapes' C names and implgen's fingerprint (which covers the template)."""
+    names = "\0".join(e.c_name for e in entries)
+    key = hashlib.sha256(f"{implgen_fingerprint()}\0{names}".encode()).hexdigest()[:20]
+    glue = clib.cache_dir() / "glue" / f"glue-{key}.c"
+    if not glue.exists():
+        from implgen.codegen.templating import environment  # Jinja2, only when the glue is new
+
+        data = environment().get_template("scene/glue.c.j2").render(entries=entries).encode()
+        glue.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write(glue, lambda fh: fh.write(data))
+    return glue
 
 
 @dataclass
@@ -136,13 +143,7 @@ def build_scene(scene: Scene, fold: bool = False) -> BuildResult:
         d, fresh = generated_dir(e.spec)
         dirs.append(d)
         generated += fresh
-    glue_text = _glue(entries)
-    glue_dir = clib.cache_dir() / "glue"
-    glue_dir.mkdir(parents=True, exist_ok=True)
-    glue = glue_dir / f"glue-{hashlib.sha256(glue_text.encode()).hexdigest()[:20]}.c"
-    if not glue.exists():
-        data = glue_text.encode()
-        atomic_write(glue, lambda fh: fh.write(data))
+    glue = _glue(entries)
     rt = runtime_dir()
     # Each runtime source sees only the runtime's headers, so its object is shared by every scene; each shape
     # sees its own folder too, and only the glue sees all of them.

@@ -9,16 +9,20 @@ from __future__ import annotations
 
 import heapq
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from implgen import abi, validate
-from implgen.codegen.spec import Spec, load_spec, parse_spec
 from implgen.errors import UserError
 from implgen.scene import transform as tf
 from implgen.scene.model import Camera, Csg, Leaf, Light, Material, Node, Scene, depth
+from implgen.scene.speccache import load_spec, parse_spec  # codegen.spec's, cached by content
 from implgen.yamlfile import read_yaml
+
+if TYPE_CHECKING:
+    from implgen.codegen.spec import Spec
+    from implgen.scene.speccache import CachedSpec
 
 MAX_CSG_DEPTH = abi.value("RT_MAX_CSG_DEPTH")  # depth of the binary tree the tracer takes
 MAX_CSG_NESTING = 32  # CSG operations nested inside each other, as written in the scene
@@ -72,7 +76,7 @@ class _Ctx:
     def __init__(self, path: Path):
         self.path = path
         self.source = str(path)
-        self.spec_cache: dict[Path, Spec] = {}
+        self.spec_cache: dict[Path, Spec | CachedSpec] = {}
         self.resolved: dict[str, Path] = {}  # `shape:` text -> spec file, looked up once per scene
         self.inline_count = 0
         self.leaves = 0

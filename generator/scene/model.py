@@ -7,11 +7,15 @@ scene/tracer.py (what to hand to the C tracer).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from implgen import abi
-from implgen.codegen.spec import Spec
+
+if TYPE_CHECKING:
+    from implgen.codegen.spec import Spec
+    from implgen.scene.speccache import CachedSpec
 
 
 @dataclass
@@ -47,7 +51,7 @@ class Material:
 
 @dataclass
 class Leaf:
-    spec: Spec
+    spec: Spec | CachedSpec  # a CachedSpec when the spec's content was parsed before (scene/speccache.py)
     params: dict[str, float]  # every param of the spec, in its declared order
     matrix: np.ndarray  # 3x4 object -> world
     material: Material | None
@@ -115,9 +119,9 @@ class Scene:
             walk(o)
         return out
 
-    def specs(self) -> list[Spec]:
+    def specs(self) -> list[Spec | CachedSpec]:
         """The distinct shapes the scene uses (what gets generated and compiled, nothing else)."""
-        seen: dict[int, Spec] = {}
+        seen: dict[int, Spec | CachedSpec] = {}
         for leaf in self.leaves():
             seen.setdefault(id(leaf.spec), leaf.spec)
         return list(seen.values())

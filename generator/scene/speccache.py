@@ -1,0 +1,235 @@
+"""Validated shape specs cached by content, so a scene whose shapes are unchanged loads without SymPy.
+
+Parsing a spec (codegen/spec.py) needs SymPy, whose import alone takes a few hundred milliseconds, yet the
+render of a scene whose shapes were built before needs only what the build and the tracer read: the name,
+the params and their defaults, the degree and the key of the generated code (build.spec_key). After a full
+parse those are written to `spec/<key>.json` in the build cache (clib.cache_dir(), beside `gen/`), keyed by
+the spec's content -- the mapping read from the YAML, every value with its type -- and implgen's own
+fingerprint (the generator's sources and templates, as build.spec_key uses). The next load of the same
+content reads them back as a `CachedSpec`.
+
+Only a spec that parsed is ever written, so a cache keyed by content holds valid specs only: an invalid one
+misses and is refused by the full parse with exactly its usual message. What is read back is checked (form,
+types, ranges, and that it names the same shape and params as the mapping it was looked up for); anything
+unreadable or out of shape is a miss, parsed in full and written again. Anything a `CachedSpec` does not hold
+(the expression, symbolic bounds, `specialise`) is parsed from the same mapping on first use.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import re
+from functools import cache
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from implgen import abi, clib
+from implgen.codegen.names import check_identifier, check_shape_name
+from implgen.errors import UserError
+from implgen.outputs import atomic_write
+from implgen.resources import templates_dir
+from implgen.yamlfile import read_yaml
+
+if TYPE_CHECKING:
+    from implgen.codegen.spec import Spec
+
+FORMAT = 1
+MAX_ENTRY_BYTES = 8 << 20  # an entry holds the printed equation of a spec file of at most 1 MiB
+MAX_NESTING = 8  # a spec mapping is four levels deep (bounds -> axis -> pair -> end); deeper is never valid
+_ENTRY_KEYS = {"format", "key", "name", "equation", "params", "degree", "description", "box", "spec_key"}
+_HEX24 = re.compile(r"[0-9a-f]{24}\Z")
+
+
+@cache
+def implgen_fingerprint() -> str:
+    """Hash of the generator's own sources and templates: generated code and parsed specs depend on them."""
+    h = hashlib.sha256()
+    pkg = Path(__file__).resolve().parent.parent
+    for p in sorted(pkg.rglob("*.py")) + sorted(templates_dir().rglob("*.j2")):
+        h.update(str(p.relative_to(p.parents[1])).encode() + b"\0" + p.read_bytes())
+    return h.hexdigest()
+
+
+class CachedSpec:
+    """A spec read back from the cache: the fields of `Spec` a scene's build and render use, without SymPy.
+
+    Any other attribute (`f`, `bounds`, `specialise`, `param_symbols`, ...) comes from the full `Spec`, parsed
+    on first use from the same content the entry was found for."""
+
+    def __init__(self, entry: dict, content: str, source: str):
+        self.name: str = entry["name"]
+        self.equation: str = entry["equation"]
+        self.params: dict[str, float] = {k: v for k, v in entry["params"]}
+        self.degree: int = entry["degree"]
+        self.description: str = entry["description"]
+        self.source = source
+        self.folded: dict[str, float] = {}
+        self.spec_key: str = entry["spec_key"]  # build.spec_key of the full spec
+        self._box: list[float] | None = entry["box"]
+        self._content = content
+        self._full: Spec | None = None
+
+    def full(self) -> Spec:
+        """The full `Spec` (SymPy), parsed once from the cached content."""
+        if self._full is None:
+            from implgen.codegen.spec import parse_spec
+
+            self._full = parse_spec(json.loads(self._content), self.source)
+        return self._full
+
+    def box(self, values: dict[str, float] | None = None) -> list[float] | None:
+        """As Spec.box: the numeric box for these param values; the defaults' box is cached."""
+        if self._box is None:
+            return None
+        if not values or all(k in self.params and self.params[k] == v for k, v in values.items()):
+            return list(self._box)
+        return self.full().box(values)
+
+    def __getattr__(self, attr: str) -> Any:  # only called for what __init__ did not set
+        if attr.startswith("_"):
+            raise AttributeError(attr)
+        return getattr(self.full(), attr)
+
+    def __repr__(self) -> str:
+        return f"CachedSpec(name={self.name!r}, degree={self.degree}, params={self.params!r})"
+
+
+def full_spec(spec: Spec | CachedSpec) -> Spec:
+    """The SymPy-backed `Spec` of either kind."""
+    return spec.full() if isinstance(spec, CachedSpec) else spec
+
+
+def load_spec(path: str | Path) -> Spec | CachedSpec:
+    """codegen.spec.load_spec through the cache: the same reading, the same errors, the same values."""
+    path = Path(path)
+    return parse_spec(read_yaml(path), str(path))
+
+
+def parse_spec(data: Any, source: str = "<spec>") -> Spec | CachedSpec:
+    """codegen.spec.parse_spec through the cache: a `CachedSpec` when this content parsed before."""
+    content = _canonical(data)
+    if content is None:
+        return _parse(data, source)
+    key = hashlib.sha256(f"{FORMAT}\0{implgen_fingerprint()}\0{content}".encode()).hexdigest()
+    path = _entry_path(key)
+    entry = _read_entry(path, key, data) if path is not None else None
+    if entry is not None:
+        return CachedSpec(entry, content, source)
+    spec = _parse(data, source)  # raises exactly as without a cache
+    if path is not None:
+        _write_entry(path, key, spec)
+    return spec
+
+
+def _parse(data: Any, source: str) -> Spec:
+    from implgen.codegen.spec import parse_spec as parse_full
+
+    return parse_full(data, source)
+
+
+def _plain(value: Any, depth: int = 0) -> bool:
+    """True when `value` is made only of what JSON keeps exactly (str-keyed mappings, lists, text, whole and
+    float numbers, booleans, null), so its JSON text identifies it, types included."""
+    if depth > MAX_NESTING:
+        return False
+    if isinstance(value, dict):
+        return all(isinstance(k, str) and _plain(v, depth + 1) for k, v in value.items())
+    if isinstance(value, list):
+        return all(_plain(v, depth + 1) for v in value)
+    return value is None or isinstance(value, (str, int, float))  # bool is an int
+
+
+def _canonical(data: Any) -> str | None:
+    """The content as JSON text (mapping order kept: params are ordered), or None when it cannot be keyed."""
+    if not isinstance(data, dict) or not _plain(data):
+        return None
+    return json.dumps(data, ensure_ascii=True, allow_nan=True, separators=(",", ":"))
+
+
+def _entry_path(key: str) -> Path | None:
+    try:
+        return clib.cache_dir() / "spec" / f"{key[:40]}.json"
+    except OSError:  # no usable cache folder: parse every time
+        return None
+
+
+def _read_entry(path: Path, key: str, data: dict) -> dict | None:
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_ENTRY_BYTES + 1)
+        if len(raw) > MAX_ENTRY_BYTES:
+            return None
+        entry = json.loads(raw.decode("utf-8"))
+    except (OSError, ValueError, RecursionError):  # missing, unreadable, not UTF-8, not JSON
+        return None
+    return entry if _entry_ok(entry, key, data) else None
+
+
+def _named(check: Any, name: Any) -> bool:
+    try:
+        check("<cache>", "name", name)
+    except UserError:
+        return False
+    return True
+
+
+def _number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _entry_ok(entry: Any, key: str, data: dict) -> bool:
+    """The entry has the form _write_entry gives it and describes the shape `data` declares."""
+    if not isinstance(entry, dict) or set(entry) != _ENTRY_KEYS:
+        return False
+    if entry["format"] != FORMAT or entry["key"] != key:
+        return False
+    name, params, degree, box = entry["name"], entry["params"], entry["degree"], entry["box"]
+    if not isinstance(name, str) or name != data.get("name") or not _named(check_shape_name, name):
+        return False
+    if not isinstance(params, list) or not all(
+        isinstance(p, list) and len(p) == 2 and _named(check_identifier, p[0]) and _number(p[1]) for p in params
+    ):
+        return False
+    declared = data.get("params") or {}
+    if not isinstance(declared, dict) or [p[0] for p in params] != list(declared):
+        return False
+    if not isinstance(degree, int) or isinstance(degree, bool) or not 1 <= degree <= abi.value("IG_MAX_DEGREE"):
+        return False
+    if not isinstance(entry["equation"], str) or not entry["equation"]:
+        return False
+    if not isinstance(entry["description"], str):
+        return False
+    if not isinstance(entry["spec_key"], str) or not _HEX24.match(entry["spec_key"]):
+        return False
+    if box is None:
+        return data.get("bounds") is None
+    if not isinstance(box, list) or len(box) != 6 or data.get("bounds") is None:
+        return False
+    if not all(isinstance(v, float) and not math.isnan(v) for v in box):
+        return False
+    return all(box[i] < box[i + 3] for i in range(3))
+
+
+def _write_entry(path: Path, key: str, spec: Spec) -> None:
+    from implgen.scene.build import spec_key
+
+    box = spec.box()
+    entry = {
+        "format": FORMAT,
+        "key": key,
+        "name": spec.name,
+        "equation": spec.equation,
+        "params": [[k, v] for k, v in spec.params.items()],
+        "degree": spec.degree,
+        "description": spec.description,
+        "box": None if box is None else [float(v) for v in box],
+        "spec_key": spec_key(spec),
+    }
+    data = json.dumps(entry, allow_nan=True).encode()
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write(path, lambda fh: fh.write(data))
+    except OSError:  # a read-only cache: the next load parses again
+        pass
