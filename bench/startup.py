@@ -1,0 +1,128 @@
+"""Whole-process time of a tiny `implgen render` whose scene is already built, against bare Python.
+
+    .venv/bin/python bench/startup.py [--runs 5] [--size 16x12] [-o bench/results/startup.md]
+
+With a fresh build cache (a temporary folder as $IMPLGEN_CACHE), each scene of bench/scenes/ is rendered once
+cold (parse, generate, compile: timed once, for reference), then, round by round and interleaved so a change
+in the machine's load hits every command alike, the same tiny render again (everything cached) beside
+`python -c pass` and `python -c "import numpy"`. Prints the medians and writes them, with the machine, to the
+results file. Each timed command is a new process, measured from spawn to exit, as a user waits for it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = ROOT / "bench" / "scenes"
+TARGET = 0.2  # seconds for a cached render, the whole process
+HEAVY = ("sympy", "matplotlib", "tqdm", "dask", "distributed", "imageio", "starlette", "uvicorn", "jinja2")
+
+
+def machine() -> str:
+    try:
+        out = subprocess.run(["lscpu"], capture_output=True, text=True, check=False).stdout
+        model = next(line.split(":", 1)[1].strip() for line in out.splitlines() if line.startswith("Model name"))
+    except (OSError, StopIteration):
+        model = platform.processor() or "unknown CPU"
+    return f"{model}, {os.cpu_count()} cores, Python {platform.python_version()}"
+
+
+def implgen_command() -> list[str]:
+    script = Path(sys.executable).parent / "implgen"  # the console script a user runs
+    return [str(script)] if script.exists() else [sys.executable, "-m", "implgen.cli"]
+
+
+def timed(cmd: list[str], env: dict) -> float:
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, check=False)
+    seconds = time.perf_counter() - t0
+    if proc.returncode != 0:
+        raise SystemExit(f"bench/startup.py: {' '.join(cmd)} failed:\n{proc.stderr}")
+    return seconds
+
+
+def heavy_imports(render_args: list[str], env: dict) -> list[str]:
+    """Which heavy modules a cached render imports (expected: none)."""
+    code = (
+        "import sys\nfrom implgen.cli import main\n"
+        f"main({render_args!r})\nprint('heavy:' + ','.join(m for m in {HEAVY!r} if m in sys.modules))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True)
+    line = [x for x in out.stdout.splitlines() if x.startswith("heavy:")][-1]
+    return [m for m in line.removeprefix("heavy:").split(",") if m]
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=int, default=5, help="timed rounds (default 5)")
+    ap.add_argument("--size", default="16x12", help="image size of the tiny render (default 16x12)")
+    ap.add_argument("-o", "--output", type=Path, default=ROOT / "bench" / "results" / "startup.md")
+    args = ap.parse_args()
+    width, height = (int(v) for v in args.size.lower().split("x"))
+    scenes = sorted(SCENES.glob("*.yaml"))
+    with tempfile.TemporaryDirectory(prefix="implgen-startup-") as tmp:
+        env = dict(os.environ, IMPLGEN_CACHE=str(Path(tmp) / "cache"))
+        png = str(Path(tmp) / "out.png")
+        render_args = {
+            s.stem: ["render", str(s), "-o", png, "-q", "--width", str(width), "--height", str(height)] for s in scenes
+        }
+        commands = {"python -c pass": [sys.executable, "-c", "pass"]}
+        commands["python -c 'import numpy'"] = [sys.executable, "-c", "import numpy"]
+        cold = {}
+        for name, a in render_args.items():
+            cold[name] = timed(implgen_command() + a, env)  # parse, generate, compile: fills the cache
+            commands[f"implgen render {name} (cached)"] = implgen_command() + a
+        heavy = heavy_imports(next(iter(render_args.values())), env)
+        times: dict[str, list[float]] = {k: [] for k in commands}
+        for _ in range(max(1, args.runs)):
+            for k, cmd in commands.items():
+                times[k].append(timed(cmd, env))
+    med = {k: statistics.median(v) for k, v in times.items()}
+    base, numpy_base = med["python -c pass"], med["python -c 'import numpy'"]
+    lines = [
+        "# Start-up: a tiny cached render against bare Python",
+        "",
+        f"Written by `bench/startup.py --runs {args.runs} --size {args.size}` on {machine()}.",
+        "",
+        f"Whole-process wall time from spawn to exit, median of {args.runs} interleaved rounds. The render is "
+        f"`implgen render SCENE -o OUT.png -q --width {width} --height {height}` with the scene's shapes already "
+        "parsed, generated and compiled (the build cache is warm); the cold column is its first run with an "
+        "empty cache (parse with SymPy, generate, compile), timed once.",
+        "",
+        "| command | median (s) | min (s) | max (s) | × `python -c pass` | × `import numpy` | cold (s) |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for k, v in times.items():
+        name = k.removeprefix("implgen render ").removesuffix(" (cached)")
+        c = f"{cold[name]:.2f}" if name in cold else ""
+        lines.append(
+            f"| {k} | {med[k]:.3f} | {min(v):.3f} | {max(v):.3f} | {med[k] / base:.2f} | "
+            f"{med[k] / numpy_base:.2f} | {c} |"
+        )
+    worst = max(v for k, v in med.items() if k.startswith("implgen"))
+    verdict = "met" if worst <= TARGET else "missed"
+    lines += [
+        "",
+        f"Slowest cached render: {worst:.3f} s, target {TARGET} s: **{verdict}**. "
+        f"Heavy modules a cached render imports ({', '.join(HEAVY)}): {', '.join(heavy) or 'none'}.",
+        "",
+    ]
+    text = "\n".join(lines)
+    print(text)
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    args.output.write_text(text, encoding="utf-8")
+    print(f"wrote {args.output}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
