@@ -4,6 +4,12 @@
  * parts of the output. Samples come from a per-pixel random stream seeded by (seed, pixel), so an image is
  * the same whatever the thread count. The render context holds all mutable state; a mutex guards the row
  * counter, the progress count, the cancel flag and the ray statistics.
+ *
+ * What the threads share is kept off their hot path: each thread counts its rays in its own stack frame and
+ * adds them to the context once, at its end; one lock per row both reports the row done and claims the
+ * next; the mutable fields sit on cache lines of their own, away from the camera frame every pixel reads;
+ * and each thread writes the first touch of its own rows (no serial clearing of the image before the
+ * threads start: only rows a cancelled render never reached are cleared, after it).
  */
 #include "tracer_internal.h"
 
@@ -20,10 +26,13 @@ struct rt_render {
     float *rgb;
     /* camera frame */
     double eye[3], u[3], v[3], w[3], tan_half, aspect;
-    /* shared, under lock */
+    /* shared, under lock, apart from the read-only fields above (which every pixel reads): a line written
+     * by one thread is invalidated in the other's cache */
+    char pad_before[64];
     pthread_mutex_t lock;
     int next_row, rows_done, cancel;
     double stats[RT_NSTATS];
+    char pad_after[64];
 };
 
 static uint64_t splitmix64(uint64_t *x)
@@ -154,26 +163,23 @@ static void *worker(void *arg)
 {
     rt_render *r = arg;
     double stats[RT_NSTATS] = {0.0, 0.0, 0.0, 0.0};
-    int *perm = malloc((size_t)r->spp * sizeof(int)), y, a;
+    int *perm = malloc((size_t)r->spp * sizeof(int)), y = -1, a;
     if (!perm)
         return NULL;
     for (;;) {
-        pthread_mutex_lock(&r->lock);
+        pthread_mutex_lock(&r->lock); /* one lock per row: the row done, and the next one claimed */
+        if (y >= 0)
+            r->rows_done++;
         if (r->cancel || r->next_row >= r->height) {
+            for (a = 0; a < RT_NSTATS; ++a)
+                r->stats[a] += stats[a];
             pthread_mutex_unlock(&r->lock);
             break;
         }
         y = r->next_row++;
         pthread_mutex_unlock(&r->lock);
         render_row(r, y, stats, perm);
-        pthread_mutex_lock(&r->lock);
-        r->rows_done++;
-        pthread_mutex_unlock(&r->lock);
     }
-    pthread_mutex_lock(&r->lock);
-    for (a = 0; a < RT_NSTATS; ++a)
-        r->stats[a] += stats[a];
-    pthread_mutex_unlock(&r->lock);
     free(perm);
     return NULL;
 }
@@ -182,13 +188,13 @@ int rt_render_run(rt_render *r, float *rgb)
 {
     pthread_t *ids;
     pthread_attr_t attr;
-    int n = r->threads < r->height ? r->threads : r->height, started = 0, i, cancelled;
+    int n = r->threads < r->height ? r->threads : r->height, started = 0, i, cancelled, reached;
+    const size_t row_floats = (size_t)r->width * 3;
     r->rgb = rgb;
     pthread_mutex_lock(&r->lock);
     r->next_row = 0;
     r->rows_done = 0;
     pthread_mutex_unlock(&r->lock);
-    memset(rgb, 0, (size_t)r->width * (size_t)r->height * 3 * sizeof(float));
     ids = malloc((size_t)n * sizeof *ids);
     if (!ids)
         return -1;
@@ -208,8 +214,11 @@ int rt_render_run(rt_render *r, float *rgb)
     free(ids);
     pthread_mutex_lock(&r->lock);
     cancelled = r->cancel && r->rows_done < r->height;
+    reached = r->next_row; /* every row claimed was finished: a thread checks cancel only between rows */
     pthread_mutex_unlock(&r->lock);
-    return cancelled ? 1 : 0;
+    if (reached < r->height) /* cancelled, or no thread could get its scratch memory: those rows are black */
+        memset(rgb + (size_t)reached * row_floats, 0, (size_t)(r->height - reached) * row_floats * sizeof(float));
+    return cancelled ? 1 : (reached < r->height ? -1 : 0);
 }
 
 int rt_render_progress(rt_render *r)
