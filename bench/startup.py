@@ -36,6 +36,13 @@ def machine() -> str:
     return f"{model}, {os.cpu_count()} cores, Python {platform.python_version()}"
 
 
+def load_average() -> str:
+    try:
+        return ", ".join(f"{v:.2f}" for v in os.getloadavg())
+    except OSError:
+        return "unknown"
+
+
 def implgen_command() -> list[str]:
     script = Path(sys.executable).parent / "implgen"  # the console script a user runs
     return [str(script)] if script.exists() else [sys.executable, "-m", "implgen.cli"]
@@ -68,6 +75,7 @@ def main() -> int:
     ap.add_argument("-o", "--output", type=Path, default=ROOT / "bench" / "results" / "startup.md")
     args = ap.parse_args()
     width, height = (int(v) for v in args.size.lower().split("x"))
+    load_before = load_average()
     scenes = sorted(SCENES.glob("*.yaml"))
     with tempfile.TemporaryDirectory(prefix="implgen-startup-") as tmp:
         env = dict(os.environ, IMPLGEN_CACHE=str(Path(tmp) / "cache"))
@@ -91,7 +99,8 @@ def main() -> int:
     lines = [
         "# Start-up: a tiny cached render against bare Python",
         "",
-        f"Written by `bench/startup.py --runs {args.runs} --size {args.size}` on {machine()}.",
+        f"Written by `bench/startup.py --runs {args.runs} --size {args.size}` on {machine()}. Load average "
+        f"before: {load_before}; after: {load_average()}.",
         "",
         f"Whole-process wall time from spawn to exit, median of {args.runs} interleaved rounds. The render is "
         f"`implgen render SCENE -o OUT.png -q --width {width} --height {height}` with the scene's shapes already "
