@@ -63,6 +63,7 @@ def render_frames(
     *,
     fold: bool = False,
     progress: bool = False,
+    keep_frames: bool = False,
     on_written: Callable[[int], None] | None = None,
 ) -> BatchReport:
     """Render the frames of `todo` whose output is missing, write them in order, then finish the output
@@ -91,7 +92,7 @@ def render_frames(
         finally:
             if bar is not None:
                 bar.close()
-    out.finish(list(todo), frames.fps)
+    out.finish(list(todo), frames.fps, keep_frames=keep_frames)
     return BatchReport(written=written, skipped=skipped, seconds=time.perf_counter() - t0, bytes_moved=moved)
 
 

@@ -145,7 +145,9 @@ def _run(
         out.write(frame, png)
         print(f"implgen: wrote {out.path(frame)} ({opts.width}x{opts.height}, {args.tiles} tiles, {where})")
         return 0
-    report = render_frames(frames, todo, opts, out, runner, fold=args.fold, progress=not args.quiet)
+    report = render_frames(
+        frames, todo, opts, out, runner, fold=args.fold, progress=not args.quiet, keep_frames=args.keep_frames
+    )
     skipped = f", {len(report.skipped)} already there" if report.skipped else ""
     print(
         f"implgen: wrote {len(report.written)} frames{skipped} of {opts.width}x{opts.height} to {out.target} "
