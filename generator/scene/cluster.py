@@ -57,7 +57,7 @@ def connect(local_workers: int | None = None, address: str | None = None, thread
         threads_per_worker=1,
         processes=True,
         host="127.0.0.1",
-        dashboard_address=None,
+        dashboard_address="127.0.0.1:0",
         silence_logs=logging.ERROR,
     )
     try:
