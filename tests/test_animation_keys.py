@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from implgen.cli import main as cli_main
 from implgen.errors import UserError
@@ -255,3 +257,58 @@ def test_bad_render_options_for_animations(tmp_path, capsys, args, fragment):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and fragment.replace("{d}", str(tmp_path)) in err, err
     assert list(tmp_path.iterdir()) == [path]
+
+
+# ------------------------------------------------------------------------------ any input: a scene or one line
+
+_leaf = st.one_of(
+    st.none(),
+    st.booleans(),
+    st.integers(min_value=-(10**30), max_value=10**30),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.text(max_size=6),
+)
+_value = st.recursive(
+    _leaf,
+    lambda inner: st.one_of(
+        st.lists(inner, max_size=4),
+        st.dictionaries(st.one_of(st.sampled_from(["keys", "ease", "0", "axis"]), _leaf), inner, max_size=4),
+        st.fixed_dictionaries(
+            {"keys": st.dictionaries(st.one_of(st.integers(-3, 60), _leaf), inner, max_size=4)},
+            optional={"ease": st.one_of(st.sampled_from(["linear", "smooth"]), _leaf)},
+        ),
+    ),
+    max_leaves=12,
+)
+_where = st.sampled_from(["fov", "position", "b", "transform", "rotate", "intensity", "frames", "orbit"])
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(where=_where, value=_value, frames=st.one_of(st.integers(-2, 6), _leaf))
+def test_any_keyed_input_is_a_scene_or_a_user_error(where, value, frames):
+    data = scene(animation={"frames": frames})
+    if where == "fov":
+        data["camera"]["fov"] = value
+    elif where == "position":
+        data["camera"]["position"] = [0, value, 6]
+    elif where == "b":
+        data["objects"][0]["params"]["b"] = value
+    elif where == "transform":
+        data["objects"][0]["transform"] = value
+    elif where == "rotate":
+        data["objects"][0]["transform"] = {"rotate": [value, 0, value]}
+    elif where == "intensity":
+        data["lights"][0]["intensity"] = value
+    elif where == "orbit":
+        data["camera"] = {"orbit": {"radius": value, "turns": value}}
+    else:
+        data["animation"] = value
+    try:
+        fr = frames_from_data(data, "fuzz.yaml")
+    except UserError as err:
+        assert "\n" not in str(err)
+        return
+    for f in range(fr.count):
+        sc = fr.scene(f)
+        assert all(math.isfinite(v) for leaf in sc.leaves() for v in leaf.params.values())
+        assert 0 < sc.camera.fov <= 179
