@@ -149,3 +149,29 @@ def test_an_unreachable_scheduler_is_one_line(tmp_path, frames, capsys, monkeypa
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--cluster: cannot reach a Dask scheduler at tcp://127.0.0.1:9" in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_tiled_still_equals_the_still_rendered_in_one_piece(tmp_path, client, frames):
+    from implgen.scene.batch import bands, render_tiles
+    from implgen.scene.frames import decode_png
+
+    sc = frames.scene(2)
+    opts = FrameOptions(width=48, height=37, spp=3, max_depth=3, threads=1)  # 37 rows: bands of 5 and 4 rows
+    whole = render(sc, width=48, height=37, spp=3, max_depth=3, threads=2)
+    # each band, rendered here as floats, is exactly those rows of the whole image
+    edges = bands(37, 8)
+    assert edges[0][0] == 0 and edges[-1][1] == 37 and {b - a for a, b in edges} == {4, 5}
+    for y0, y1 in edges:
+        band = render(sc, width=48, height=37, spp=3, max_depth=3, threads=1, rows=(y0, y1))
+        assert np.array_equal(band, whole[y0:y1]), (y0, y1)
+    # and assembled from tasks on the cluster, bit for bit the 8-bit picture of the whole
+    png, moved = render_tiles(frames, 2, opts, 8, Runner(client=client))
+    assert np.array_equal(decode_png(png), to_uint8(whole)) and moved > 0
+
+
+def test_the_tiles_command(tmp_path, frames, capsys):
+    scene = Path(frames.source)
+    assert cli_main(["render", str(scene), "-o", str(tmp_path / "t.png"), "--frames", "1", "--tiles", "3", "-q"]) == 0
+    assert cli_main(["render", str(scene), "-o", str(tmp_path / "s.png"), "--frames", "1", "-q"]) == 0
+    assert "3 tiles" in capsys.readouterr().out
+    assert np.array_equal(read(tmp_path / "t.png"), read(tmp_path / "s.png"))
