@@ -1,8 +1,9 @@
 """The tracer's C tests: standalone drivers in tests/c/tracer_*.c, built with the sanitizers and run here.
 
-tracer_rays.c checks ray-level answers against analytic values (sphere distances, Snell, TIR, Fresnel, CSG
-event sequences, a transformed torus against the inverse-transformed ray, the piriform in the paper's basis
-form). tracer_offsets.c measures secondary-ray robustness on every example shape at scales 1e-3 .. 1e3.
+tracer_rays.c + tracer_rays_optics.c (one driver) check ray-level answers against analytic values (sphere
+distances, Snell, TIR, Fresnel, CSG event sequences, a transformed torus against the inverse-transformed ray,
+the piriform in the paper's basis form). tracer_offsets.c measures secondary-ray robustness on every example
+shape at scales 1e-3 .. 1e3.
 """
 
 from __future__ import annotations
@@ -37,7 +38,9 @@ def run(exe: Path, *args: str, timeout: float = 300) -> str:
 
 def test_ray_level_analytic(tmp_path: Path) -> None:
     shapes = [GENERATED / f"{n}.c" for n in ("sphere", "torus_z", "piriform")]
-    exe = compile_c(tmp_path / "rays", [CDIR / "tracer_rays.c", *runtime_c_sources(), *shapes])
+    exe = compile_c(
+        tmp_path / "rays", [CDIR / "tracer_rays.c", CDIR / "tracer_rays_optics.c", *runtime_c_sources(), *shapes]
+    )
     out = run(exe)
     assert "0 failures" in out
     assert re.search(r"sphere: 20000 random rays, hit/miss disagreements 0", out)
