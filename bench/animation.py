@@ -20,6 +20,7 @@ Writes the report (which names this script and the machine at its top) and print
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import pickle
 import platform
@@ -74,7 +75,7 @@ def main() -> int:
     todo = range(min(args.frames, frames.count))
     sc = frames.first
     serial_opts = FrameOptions(width=args.width, height=args.height, spp=sc.spp, max_depth=sc.max_depth)
-    worker_opts = FrameOptions(**{**serial_opts.__dict__, "threads": cluster.local_threads(args.workers)})
+    worker_opts = dataclasses.replace(serial_opts, threads=cluster.local_threads(args.workers))
     one_px = FrameOptions(width=1, height=1, spp=1, max_depth=sc.max_depth, threads=1)
 
     # one-off costs: generating and compiling the scene library from an empty cache, and starting a cluster

@@ -8,6 +8,7 @@ then does anything render. A still scene without Dask options takes the path it 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -84,7 +85,7 @@ def main(argv: Sequence[str]) -> int:
     if out.kind == "still" and args.tiles is None and not distributed:
         return _still(args, frames, todo[0], opts, out)
     if args.local_workers is not None and args.threads is None:
-        opts = FrameOptions(**{**opts.__dict__, "threads": cluster.local_threads(args.local_workers)})
+        opts = dataclasses.replace(opts, threads=cluster.local_threads(args.local_workers))
     if not distributed:
         return _run(args, frames, todo, opts, out, Runner(retries=args.retries))
     with cluster.connect(args.local_workers, address) as client:

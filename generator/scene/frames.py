@@ -22,6 +22,7 @@ from implgen.errors import UserError
 from implgen.scene.build import BuildResult, build_scene, plan_shapes
 from implgen.scene.load import parse_scene
 from implgen.scene.model import Scene
+from implgen.scene.render import render, to_uint8
 from implgen.yamlfile import read_yaml
 
 # Objects x frames checked up front (each frame is parsed and validated in full, ~50 us per object).
@@ -142,8 +143,6 @@ def render_frame_png(
 ) -> bytes:
     """One frame (or the band of rows [y0, y1) of it) as PNG bytes. Without `built`, the scene library comes
     from the content-hash cache (compiled on this machine the first time)."""
-    from implgen.scene.render import render, to_uint8
-
     img = render(
         scene,
         width=opts.width,
