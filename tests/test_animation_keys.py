@@ -241,7 +241,7 @@ def test_a_scale_through_zero_is_caught_at_the_frame_it_reaches_zero():
         (["-o", "{d}/a.avi"], "must end in .png or .mp4 or .webm or .gif"),
         (["-o", "{d}/a.mp4", "--width", "47"], "a video needs an even width and height (the image is 47x36)"),
         (["-o", "{d}/f_%d.png", "--frames", "40:50"], "--frames: 40:50: frames must satisfy"),
-        (["-o", "{d}/f_%d.png", "--tiles", "2"], "--tiles: tiles split one still image"),
+        (["-o", "{d}/f_%d.png", "--tiles", "37"], "--tiles: 37 is outside [1, 36]"),
         (["-o", "{d}/f_%d.png", "--cluster", "not an address"], "--cluster: 'not an address' is not a scheduler"),
         (["-o", "{d}/f_%d.png", "--local-workers", "2", "--cluster", "tcp://a:1"], "not allowed with argument"),
         (["-o", "{d}/f_%d.png", "--retries", "-1"], "--retries: -1 is outside [0, 100]"),

@@ -152,8 +152,7 @@ def test_an_unreachable_scheduler_is_one_line(tmp_path, frames, capsys, monkeypa
 
 
 def test_a_tiled_still_equals_the_still_rendered_in_one_piece(tmp_path, client, frames):
-    from implgen.scene.batch import bands, render_tiles
-    from implgen.scene.frames import decode_png
+    from implgen.scene.batch import bands
 
     sc = frames.scene(2)
     opts = FrameOptions(width=48, height=37, spp=3, max_depth=3, threads=1)  # 37 rows: bands of 5 and 4 rows
@@ -165,13 +164,27 @@ def test_a_tiled_still_equals_the_still_rendered_in_one_piece(tmp_path, client, 
         band = render(sc, width=48, height=37, spp=3, max_depth=3, threads=1, rows=(y0, y1))
         assert np.array_equal(band, whole[y0:y1]), (y0, y1)
     # and assembled from tasks on the cluster, bit for bit the 8-bit picture of the whole
-    png, moved = render_tiles(frames, 2, opts, 8, Runner(client=client))
-    assert np.array_equal(decode_png(png), to_uint8(whole)) and moved > 0
+    out = plan_output(tmp_path / "still.png", 1, 2, 48, 37)
+    report = render_frames(frames, range(2, 3), opts, out, Runner(client=client), tiles=8)
+    assert np.array_equal(read(out.target), to_uint8(whole)) and report.written == [2]
 
 
-def test_the_tiles_command(tmp_path, frames, capsys):
+def test_the_tiles_command(tmp_path, client, frames, alone, capsys):
     scene = Path(frames.source)
     assert cli_main(["render", str(scene), "-o", str(tmp_path / "t.png"), "--frames", "1", "--tiles", "3", "-q"]) == 0
-    assert cli_main(["render", str(scene), "-o", str(tmp_path / "s.png"), "--frames", "1", "-q"]) == 0
-    assert "3 tiles" in capsys.readouterr().out
-    assert np.array_equal(read(tmp_path / "t.png"), read(tmp_path / "s.png"))
+    assert "in 3 tiles each" in capsys.readouterr().out
+    assert np.array_equal(read(tmp_path / "t.png"), alone[1])
+    # every frame of an animation in tiles, on the cluster: frames x tiles tasks
+    args = [
+        "render",
+        str(scene),
+        "-o",
+        str(tmp_path / "f%d.png"),
+        "--tiles",
+        "5",
+        "--cluster",
+        client.scheduler.address,
+    ]
+    assert cli_main([*args, "-q"]) == 0
+    for f in range(FRAMES):
+        assert np.array_equal(read(tmp_path / f"f{f}.png"), alone[f]), f

@@ -75,12 +75,12 @@ def local_threads(workers: int) -> int:
 def ordered(
     client: Any,
     fn: Callable[..., Any],
-    jobs: Iterable[tuple[int, tuple]],
+    jobs: Iterable[tuple[Any, tuple]],
     *,
     window: int,
     retries: int,
     name: str = "implgen",
-) -> Iterator[tuple[int, Any]]:
+) -> Iterator[tuple[Any, Any]]:
     """Run fn(*args) for each (index, args) of `jobs` on the cluster; yield (index, result) in job order
     with at most `window` tasks submitted and not yet yielded."""
     run = secrets.token_hex(4)
@@ -92,7 +92,8 @@ def ordered(
         if job is None:
             return False
         index, args = job
-        fut = client.submit(fn, *args, key=f"{name}-{run}-{index}", retries=retries, pure=False)
+        tag = "-".join(map(str, index)) if isinstance(index, tuple) else index
+        fut = client.submit(fn, *args, key=f"{name}-{run}-{tag}", retries=retries, pure=False)
         pending.append((index, fut))
         return True
 
@@ -110,7 +111,7 @@ def ordered(
             fut.cancel()
 
 
-def serial(fn: Callable[..., Any], jobs: Iterable[tuple[int, tuple]]) -> Iterator[tuple[int, Any]]:
+def serial(fn: Callable[..., Any], jobs: Iterable[tuple[Any, tuple]]) -> Iterator[tuple[Any, Any]]:
     """The same contract in this process, one job after the other."""
     for index, args in jobs:
         yield index, fn(*args)

@@ -16,7 +16,7 @@ from typing import Any
 from implgen import validate
 from implgen.errors import UserError
 from implgen.scene import cluster
-from implgen.scene.batch import Runner, render_frames, render_tiles
+from implgen.scene.batch import Runner, render_frames
 from implgen.scene.frameout import FrameOutput, plan_output
 from implgen.scene.frames import FrameOptions, Frames, load_frames, parse_range
 from implgen.scene.keys import MAX_FRAMES
@@ -57,7 +57,7 @@ def _parser() -> _Parser:
     where = ap.add_mutually_exclusive_group()
     where.add_argument("--local-workers", type=_positive, metavar="N", help="a Dask LocalCluster of N processes")
     where.add_argument("--cluster", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://host:8786")
-    ap.add_argument("--tiles", type=_positive, metavar="K", help="split one still into K bands of rows (tasks)")
+    ap.add_argument("--tiles", type=_positive, metavar="K", help="render each frame as K bands of rows (K tasks)")
     ap.add_argument("--retries", type=int, default=3, help="reruns of a failed task (default 3)")
     ap.add_argument("--keep-frames", action="store_true", help="keep a video's or GIF's frame PNGs")
     ap.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -79,8 +79,6 @@ def main(argv: Sequence[str]) -> int:
         raise UserError("--fold", "the scene's shape params change from frame to frame; they cannot be folded")
     if args.tiles is not None:
         validate.whole("--tiles", "", args.tiles, 1, opts.height)
-        if len(todo) != 1 or out.kind not in ("still", "pattern"):
-            raise UserError("--tiles", "tiles split one still image; choose one frame (--frames N) and a .png")
     distributed = args.local_workers is not None or address is not None
     if out.kind == "still" and args.tiles is None and not distributed:
         return _still(args, frames, todo[0], opts, out)
@@ -139,19 +137,22 @@ def _run(
     args: argparse.Namespace, frames: Frames, todo: range, opts: FrameOptions, out: FrameOutput, runner: Runner
 ) -> int:
     where = "this process" if runner.client is None else f"{runner.workers()} Dask workers"
-    if args.tiles is not None:
-        frame = todo[0]
-        out.prepare()
-        png, _ = render_tiles(frames, frame, opts, args.tiles, runner)
-        out.write(frame, png)
-        print(f"implgen: wrote {out.path(frame)} ({opts.width}x{opts.height}, {args.tiles} tiles, {where})")
-        return 0
+    tiles = args.tiles or 1
     report = render_frames(
-        frames, todo, opts, out, runner, fold=args.fold, progress=not args.quiet, keep_frames=args.keep_frames
+        frames,
+        todo,
+        opts,
+        out,
+        runner,
+        tiles=tiles,
+        fold=args.fold,
+        progress=not args.quiet,
+        keep_frames=args.keep_frames,
     )
     skipped = f", {len(report.skipped)} already there" if report.skipped else ""
+    cut = f" in {tiles} tiles each" if tiles > 1 else ""
     print(
-        f"implgen: wrote {len(report.written)} frames{skipped} of {opts.width}x{opts.height} to {out.target} "
+        f"implgen: wrote {len(report.written)} frames{skipped} of {opts.width}x{opts.height}{cut} to {out.target} "
         f"in {report.seconds:.1f} s ({where})"
     )
     return 0
