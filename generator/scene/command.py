@@ -149,10 +149,11 @@ def _run(
         progress=not args.quiet,
         keep_frames=args.keep_frames,
     )
+    n = len(report.written)
     skipped = f", {len(report.skipped)} already there" if report.skipped else ""
     cut = f" in {tiles} tiles each" if tiles > 1 else ""
     print(
-        f"implgen: wrote {len(report.written)} frames{skipped} of {opts.width}x{opts.height}{cut} to {out.target} "
-        f"in {report.seconds:.1f} s ({where})"
+        f"implgen: wrote {n} frame{'' if n == 1 else 's'}{skipped} of {opts.width}x{opts.height}{cut} "
+        f"to {out.target} in {report.seconds:.1f} s ({where})"
     )
     return 0
