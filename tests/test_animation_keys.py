@@ -312,3 +312,35 @@ def test_any_keyed_input_is_a_scene_or_a_user_error(where, value, frames):
         sc = fr.scene(f)
         assert all(math.isfinite(v) for leaf in sc.leaves() for v in leaf.params.values())
         assert 0 < sc.camera.fov <= 179
+
+
+def test_objects_without_keys_are_parsed_once_and_shared_by_every_frame():
+    data = scene(
+        camera={"position": [0, 1, {"keys": {0: 6, 47: 8}}]},
+        objects=[
+            {"equation": "x^2 + y^2 + z^2 - 1", "transform": {"translate": [2, 0, 0]}},
+            {"equation": "x^2 + y^2 + z^2 - r^2", "params": {"r": {"keys": {0: 0.5, 47: 1}}}},
+            {"shape": SPHERE, "transform": {"translate": [-2, 0, 0]}},
+        ],
+    )
+    fr = frames_from_data(data, "s.yaml")
+    a, b = fr.scene(0), fr.scene(30)
+    assert b.objects[0] is a.objects[0] and b.objects[2] is a.objects[2]  # no keyed value: shared
+    assert b.objects[1] is not a.objects[1] and b.objects[1].params["r"] > a.objects[1].params["r"]
+    # the inline shapes keep their names and identity on every frame
+    assert [leaf.spec.name for leaf in b.leaves()] == ["inline1", "inline2", "sphere"]
+    assert all(x.spec is y.spec for x, y in zip(a.leaves(), b.leaves()))
+    # a keyed named material makes every object depend on the frame
+    data["materials"] = {"m": {"reflectivity": {"keys": {0: 0, 47: 1}}}}
+    data["objects"][0]["material"] = "m"
+    fr = frames_from_data(data, "s.yaml")
+    assert fr.scene(30).objects[0].material.reflectivity == pytest.approx(30 / 47)
+
+
+def test_the_frames_times_keyed_objects_limit_is_checked_before_the_frames():
+    keyed = {"shape": SPHERE, "transform": {"translate": [0, {"keys": {0: 0, 1: 1}}, 0]}}
+    data = scene(animation={"frames": 1000}, objects=[keyed] * 101)
+    with pytest.raises(UserError, match=r"1000 frames of 101 keyed objects is more than 100,000 keyed object-frames"):
+        frames_from_data(data, "s.yaml")
+    data = scene(animation={"frames": 1000}, objects=[keyed] * 2)  # 2,000 keyed object-frames: fine
+    assert frames_from_data(data, "s.yaml").count == 1000

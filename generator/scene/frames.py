@@ -20,13 +20,16 @@ import numpy as np
 
 from implgen.errors import UserError
 from implgen.scene.build import BuildResult, build_scene, plan_shapes
+from implgen.scene.keys import contains_keyed
 from implgen.scene.load import parse_scene
-from implgen.scene.model import Scene
+from implgen.scene.model import Leaf, Node, Scene
 from implgen.scene.render import render, to_uint8
 from implgen.yamlfile import read_yaml
 
-# Objects x frames checked up front (each frame is parsed and validated in full, ~50 us per object).
-MAX_OBJECT_FRAMES = 1_000_000
+# Checked up front: objects x frames (an object with no keyed value is parsed once and looked up on later
+# frames), and keyed objects x frames (parsed and validated anew on every frame, ~50 us each).
+MAX_OBJECT_FRAMES = 10_000_000
+MAX_KEYED_OBJECT_FRAMES = 100_000
 
 
 @dataclass
@@ -66,12 +69,17 @@ def frames_from_data(data: dict, source: str | Path = "<scene>") -> Frames:
     if not fr.animated:
         return fr
     leaves0 = first.leaves()
-    if len(leaves0) * fr.count > MAX_OBJECT_FRAMES:
-        raise UserError(
-            fr.source,
-            f"animation.frames: {fr.count} frames of {len(leaves0)} objects is more than {MAX_OBJECT_FRAMES:,} "
-            "object-frames to check; split the animation into several scene files",
-        )
+    keyed_mats = contains_keyed(data.get("materials"))
+    keyed = sum(
+        _count_leaves(node) for node, raw in zip(first.objects, data["objects"]) if keyed_mats or contains_keyed(raw)
+    )
+    for n, limit, what in ((len(leaves0), MAX_OBJECT_FRAMES, ""), (keyed, MAX_KEYED_OBJECT_FRAMES, "keyed ")):
+        if n * fr.count > limit:
+            raise UserError(
+                fr.source,
+                f"animation.frames: {fr.count} frames of {n} {what}objects is more than {limit:,} {what}"
+                "object-frames to check; split the animation into several scene files",
+            )
     for f in range(1, fr.count):
         try:
             sc = parse_scene(data, source, frame=f, memo=memo)
@@ -81,6 +89,10 @@ def frames_from_data(data: dict, source: str | Path = "<scene>") -> Frames:
             assert a.spec is b.spec  # keyed values are numbers: the shapes are the same objects
             fr.params_vary |= a.params != b.params
     return fr
+
+
+def _count_leaves(node: Node) -> int:
+    return 1 if isinstance(node, Leaf) else _count_leaves(node.left) + _count_leaves(node.right)
 
 
 def load_frames(path: str | Path) -> Frames:

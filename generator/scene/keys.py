@@ -29,6 +29,8 @@ DEFAULT_FPS = 24.0
 EASES = ("linear", "smooth")
 KEYED_KEYS = ("keys", "ease")
 ANIMATION_KEYS = ("frames", "fps")
+ORBIT_KEYS = ("center", "radius", "height", "turns")
+MAX_TURNS = 1000
 
 
 @dataclass(frozen=True)
@@ -149,6 +151,52 @@ def number_at(
     for f, v in zip(keyed.frames, keyed.values):
         check(f"{key}.keys.{f}", v)
     return check(key, keyed.at(frame))
+
+
+def contains_keyed(raw: Any) -> bool:
+    """Whether a keyed value appears anywhere in a raw YAML value."""
+    if is_keyed(raw):
+        return True
+    if isinstance(raw, dict):
+        return any(contains_keyed(v) for v in raw.values())
+    if isinstance(raw, list):
+        return any(contains_keyed(v) for v in raw)
+    return False
+
+
+def orbit_camera(
+    source: str, cam: dict, frame: int, frames: int | None, seen: list[str]
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """`camera.orbit` at `frame`: (position, look_at). Its numbers may be keyed too."""
+    for k in ("position", "look_at"):
+        if k in cam:
+            raise UserError(source, f"camera.{k}: not with camera.orbit (the orbit sets it)")
+    raw = cam["orbit"]
+    if not isinstance(raw, dict):
+        raise UserError(source, "camera.orbit: expected a mapping with 'radius' (and center, height, turns)")
+    for k in raw:
+        if k not in ORBIT_KEYS:
+            raise UserError(source, f"camera.orbit.{_name(k)}: unknown key (allowed: {', '.join(ORBIT_KEYS)})")
+    if "radius" not in raw:
+        raise UserError(source, "camera.orbit: missing key 'radius'")
+
+    def num(key: str, value: Any, lo: float, hi: float, lo_open: bool = False) -> float:
+        def check(k: str, v: Any) -> float:
+            return validate.number(source, k, v, lo, hi, lo_open=lo_open)
+
+        return number_at(source, f"camera.orbit.{key}", value, frame, frames, check, seen)
+
+    big = validate.MAX_COORDINATE
+    center = raw.get("center", [0, 0, 0])
+    if isinstance(center, list) and len(center) == 3:
+        center = [num(f"center[{i}]", v, -big, big) for i, v in enumerate(center)]
+    c = validate.vector(source, "camera.orbit.center", center)
+    radius = num("radius", raw["radius"], 0.0, big, lo_open=True)
+    height = num("height", raw.get("height", 0.0), -big, big)
+    turns = num("turns", raw.get("turns", 1.0), -MAX_TURNS, MAX_TURNS)
+    if turns and frames is not None and frames > 1:
+        seen.append("camera.orbit")
+    return orbit(c, radius, height, turns, frame, frames or 1), c
 
 
 def orbit(

@@ -52,8 +52,6 @@ ABSORPTION_MAX = 1e6
 TOP_KEYS = ("image", "camera", "background", "lights", "materials", "objects", "animation")
 IMAGE_KEYS = ("width", "height", "spp", "max_depth")
 CAMERA_KEYS = ("position", "look_at", "up", "fov", "orbit")
-ORBIT_KEYS = ("center", "radius", "height", "turns")
-MAX_TURNS = 1000
 LIGHT_KEYS = ("position", "color", "intensity")
 MATERIAL_KEYS = (
     "color",
@@ -83,6 +81,8 @@ class _Ctx:
         self.frame = frame
         self.frames: int | None = None  # the animation's frame count; None without an `animation` block
         self.keyed: list[str] = []  # key paths of the values that change with the frame
+        self.static: dict[int, tuple] = memo.setdefault("static", {})  # objects the same on every frame
+        self.reused: set[int] = set()  # objects[i] taken from `static` on this frame
 
     def resolve(self, key: str, raw: Any) -> Any:
         """A part of the scene made only of numbers (a transform), with keyed values at this frame."""
@@ -277,6 +277,22 @@ def _node(ctx: _Ctx, key: str, raw: Any, named: dict[str, Material], depth: int)
     return node
 
 
+def _object(ctx: _Ctx, i: int, raw: Any, named: dict[str, Material], fixed: dict | None) -> Node:
+    """objects[i]; one with no keyed value is parsed on the first frame only and shared by later frames."""
+    if fixed is not None and i not in fixed and not keys.contains_keyed(raw):
+        leaves, inline = ctx.leaves, ctx.inline_count
+        node = _node(ctx, f"objects[{i}]", raw, named, 0)
+        fixed[i] = (node, ctx.leaves - leaves, ctx.inline_count - inline)
+        return node
+    if fixed is None or i not in fixed:
+        return _node(ctx, f"objects[{i}]", raw, named, 0)
+    node, leaves, inline = fixed[i]  # the same counts as on the first frame, which passed the limits
+    ctx.reused.add(i)
+    ctx.leaves += leaves
+    ctx.inline_count += inline
+    return node
+
+
 def _balanced(op: str, nodes: list[Node], where: str) -> Csg:
     """One associative operation over a list as the shallowest binary tree: always join the two shallowest
     subtrees (Huffman's merge on depth), ties in list order. A long flat list stays a few levels deep."""
@@ -325,7 +341,7 @@ def parse_scene(data: Any, source: str | Path = "<scene>", *, frame: int = 0, me
     cam = _mapping(ctx, "camera", data.get("camera") or {}, CAMERA_KEYS)
     c = Camera()
     if "orbit" in cam:
-        c.position, c.look_at = _orbit(ctx, cam)
+        c.position, c.look_at = keys.orbit_camera(ctx.source, cam, ctx.frame, ctx.frames, ctx.keyed)
     if "position" in cam:
         c.position = _vec(ctx, "camera.position", cam["position"])
     if "look_at" in cam:
@@ -365,32 +381,17 @@ def parse_scene(data: Any, source: str | Path = "<scene>", *, frame: int = 0, me
     objs = data.get("objects")
     if not isinstance(objs, list) or not objs:
         raise ctx.fail("objects", "expected a non-empty list")
-    sc.objects = [_node(ctx, f"objects[{i}]", raw, named, 0) for i, raw in enumerate(objs)]
+    fixed = ctx.static if not keys.contains_keyed(mats) else None  # no object can change with the frame
+    sc.objects = [_object(ctx, i, raw, named, fixed) for i, raw in enumerate(objs)]
     sc.keyed = tuple(ctx.keyed)
-    for obj in sc.objects:
+    for i, obj in enumerate(sc.objects):
+        if i in ctx.reused:  # checked on the first frame
+            continue
         if depth(obj) > MAX_CSG_DEPTH:  # cannot happen within the documented limits; the tracer's own
             raise ctx.fail(getattr(obj, "where", "objects"), f"CSG tree deeper than {MAX_CSG_DEPTH}")
-    for leaf in sc.leaves():
-        tf.check_matrix(ctx.source, f"{leaf.where}.transform", leaf.matrix)
+        for leaf in Scene(source="", objects=[obj]).leaves():
+            tf.check_matrix(ctx.source, f"{leaf.where}.transform", leaf.matrix)
     return sc
-
-
-def _orbit(ctx: _Ctx, cam: dict) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-    """camera.orbit: the position on a circle about `center` at this frame, looking at the centre."""
-    for k in ("position", "look_at"):
-        if k in cam:
-            raise ctx.fail(f"camera.{k}", "not with camera.orbit (the orbit sets it)")
-    raw = _mapping(ctx, "camera.orbit", cam["orbit"], ORBIT_KEYS)
-    if "radius" not in raw:
-        raise ctx.fail("camera.orbit", "missing key 'radius'")
-    center = _vec(ctx, "camera.orbit.center", raw.get("center", [0, 0, 0]))
-    radius = _num(ctx, "camera.orbit.radius", raw["radius"], 0.0, lo_open=True)
-    height = _num(ctx, "camera.orbit.height", raw.get("height", 0.0))
-    turns = _num(ctx, "camera.orbit.turns", raw.get("turns", 1.0), -MAX_TURNS, MAX_TURNS)
-    frames = ctx.frames or 1
-    if turns and frames > 1:
-        ctx.keyed.append("camera.orbit")
-    return keys.orbit(center, radius, height, turns, ctx.frame, frames), center
 
 
 def load_scene(path: str | Path) -> Scene:
