@@ -103,7 +103,8 @@ def load_frames(path: str | Path) -> Frames:
 def parse_range(text: str, count: int, option: str = "--frames") -> range:
     """`A:B` (both included), `A:`, `:B` or `A`: frames of an animation of `count` frames."""
     parts = text.split(":")
-    if len(parts) > 2 or not all(p.strip().isdigit() or not p.strip() for p in parts) or not text.strip(":"):
+    digits = all(p.strip().isdecimal() or not p.strip() for p in parts)
+    if len(text) > 40 or len(parts) > 2 or not digits or not text.strip(":"):
         raise UserError(option, f"{text[:40]!r} is not a frame range (A:B, A:, :B or A; frames count from 0)")
     if len(parts) == 1:
         parts = [parts[0], parts[0]]
