@@ -43,8 +43,11 @@ typedef struct rt_material {
     double transparency;  /* 0: opaque .. 1: clear; the rest is the local (Phong) term */
     double ior;           /* index of refraction of the inside */
     double absorption[3]; /* Beer-Lambert coefficients per world unit, per channel (inside the solid) */
+    double two_sided;     /* 1: the back of the surface (its f < 0 side, where the normal points away from the
+                             viewer) shows inside instead of the base colour; 0: both sides the same */
+    double inside[3];     /* the back's colour when two_sided (linear, 0..1) */
 } rt_material;
-#define RT_MATERIAL_DOUBLES 19
+#define RT_MATERIAL_DOUBLES 21
 
 /* One ray/scene hit, everything in world space. */
 typedef struct rt_hit {

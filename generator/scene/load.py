@@ -64,6 +64,7 @@ MATERIAL_KEYS = (
     "transparency",
     "ior",
     "absorption",
+    "inside",
 )
 LEAF_KEYS = ("shape", "equation", "name", "params", "bounds", "transform", "material")
 
@@ -160,6 +161,8 @@ def _material(ctx: _Ctx, key: str, raw: Any) -> Material:
         m.ior = _num(ctx, f"{key}.ior", raw["ior"], 0.0, IOR_MAX, lo_open=True)
     if "absorption" in raw:
         m.absorption = _vec(ctx, f"{key}.absorption", raw["absorption"], 0.0, ABSORPTION_MAX)
+    if "inside" in raw:  # two-sided: the colour of the back (f < 0) side of a surface
+        m.inside = _color(ctx, f"{key}.inside", raw["inside"])
     return m
 
 
