@@ -153,6 +153,16 @@ def number_at(
     return check(key, keyed.at(frame))
 
 
+def inline_params(source: str, key: str, raw: Any, frames: int | None) -> tuple[Any, dict]:
+    """An inline equation's `params` as (the shape's defaults, the keyed ones to pass per frame): a keyed
+    param's default is its first key, so the shape is the same on every frame and only the value moves."""
+    if not isinstance(raw, dict):
+        return raw, {}  # the spec parser says what is wrong with it
+    keyed = {k: v for k, v in raw.items() if is_keyed(v)}
+    first = {k: parse_keyed(source, f"{key}.{_name(k)}", v, frames).values[0] for k, v in keyed.items()}
+    return {**raw, **first}, keyed
+
+
 def contains_keyed(raw: Any) -> bool:
     """Whether a keyed value appears anywhere in a raw YAML value."""
     if is_keyed(raw):

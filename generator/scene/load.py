@@ -222,16 +222,9 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
         mapping = {"name": raw.get("name", f"inline{ctx.inline_count}"), "equation": raw["equation"]}
         if "bounds" in raw:
             mapping["bounds"] = raw["bounds"]
-        overrides = {}
+        overrides: Any = {}
         if "params" in raw:
-            mapping["params"] = raw["params"]
-            if isinstance(raw["params"], dict):  # a keyed param: its first key is the default, then overridden
-                overrides = {k: v for k, v in raw["params"].items() if keys.is_keyed(v)}
-                first = {
-                    k: keys.parse_keyed(ctx.source, f"{key}.params.{k}", v, ctx.frames).values[0]
-                    for k, v in overrides.items()
-                }
-                mapping["params"] = {**raw["params"], **first}
+            mapping["params"], overrides = keys.inline_params(ctx.source, f"{key}.params", raw["params"], ctx.frames)
         memo_key = f"{ctx.inline_count}:{mapping!r}"  # the same inline shape on every frame
         if memo_key not in ctx.inline_specs:
             ctx.inline_specs[memo_key] = parse_spec(mapping, f"{ctx.source}: {key}")
