@@ -80,8 +80,7 @@ def test_every_frame_from_the_workers_equals_the_frame_rendered_alone(tmp_path, 
 
 def _dies_once(marker: str, *args):
     """The frame task, except that the third task started anywhere (or a later one, if two start at once) kills
-    its worker process (no cleanup, no
-    exception: as a crash or `kill -9` would) the first time round."""
+    its worker process, once: no cleanup and no exception, as a crash or `kill -9` would."""
     import os
 
     from implgen.scene.frames import render_frame_png
