@@ -188,3 +188,20 @@ def test_the_tiles_command(tmp_path, client, frames, alone, capsys):
     assert cli_main([*args, "-q"]) == 0
     for f in range(FRAMES):
         assert np.array_equal(read(tmp_path / f"f{f}.png"), alone[f]), f
+
+
+def test_workers_need_neither_the_scene_file_nor_its_spec_files(tmp_path, client):
+    """Tasks carry the validated scene, shapes included: the files may be gone (or on another machine)."""
+    spec = tmp_path / "lens.yaml"
+    spec.write_text("name: lens\nequation: x^2 + y^2 + 4*z^2 - r^2\nparams: {r: 1.0}\n")
+    data = anim_scene(frames=3)
+    data["objects"][1]["shape"] = "lens.yaml"
+    scene = tmp_path / "lens_anim.yaml"
+    scene.write_text(yaml.safe_dump(data))
+    frames = frames_from_data(yaml.safe_load(scene.read_text()), scene)
+    spec.unlink()
+    scene.unlink()
+    out = plan_output(tmp_path / "f%d.png", 3, 2, 48, 36)
+    render_frames(frames, range(3), opts_of(frames), out, Runner(client=client))
+    for f in range(3):
+        assert np.array_equal(read(out.path(f)), to_uint8(render(frames.scene(f)))), f
