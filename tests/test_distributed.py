@@ -205,3 +205,29 @@ def test_workers_need_neither_the_scene_file_nor_its_spec_files(tmp_path, client
     render_frames(frames, range(3), opts_of(frames), out, Runner(client=client))
     for f in range(3):
         assert np.array_equal(read(out.path(f)), to_uint8(render(frames.scene(f)))), f
+
+
+def _always_dies(*args):
+    os._exit(1)
+
+
+def test_a_task_that_keeps_killing_workers_ends_in_one_line(tmp_path, frames):
+    import dask
+    from dask.distributed import Client, LocalCluster
+
+    from implgen.errors import UserError
+
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        cluster = LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address="127.0.0.1:0"
+        )
+        try:
+            with Client(cluster) as c:
+                out = plan_output(tmp_path / "out" / "f_%02d.png", FRAMES, FRAMES - 1, 48, 36)
+                runner = Runner(client=c, task=_always_dies)
+                with pytest.raises(UserError) as err:
+                    render_frames(frames, range(FRAMES), opts_of(frames), out, runner)
+        finally:
+            cluster.close()
+    assert "lost its worker" in str(err.value) and "\n" not in str(err.value)
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())

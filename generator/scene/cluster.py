@@ -72,6 +72,11 @@ def local_threads(workers: int) -> int:
     return max(1, (os.cpu_count() or 1) // max(1, workers))
 
 
+def tag_of(index: Any) -> str:
+    """A job index as it appears in task keys and messages: a frame number, or frame-tile."""
+    return "-".join(map(str, index)) if isinstance(index, tuple) else str(index)
+
+
 def ordered(
     client: Any,
     fn: Callable[..., Any],
@@ -83,6 +88,8 @@ def ordered(
 ) -> Iterator[tuple[Any, Any]]:
     """Run fn(*args) for each (index, args) of `jobs` on the cluster; yield (index, result) in job order
     with at most `window` tasks submitted and not yet yielded."""
+    from distributed import KilledWorker
+
     run = secrets.token_hex(4)
     todo = iter(jobs)
     pending: deque = deque()
@@ -92,8 +99,7 @@ def ordered(
         if job is None:
             return False
         index, args = job
-        tag = "-".join(map(str, index)) if isinstance(index, tuple) else index
-        fut = client.submit(fn, *args, key=f"{name}-{run}-{tag}", retries=retries, pure=False)
+        fut = client.submit(fn, *args, key=f"{name}-{run}-{tag_of(index)}", retries=retries, pure=False)
         pending.append((index, fut))
         return True
 
@@ -102,7 +108,12 @@ def ordered(
             pass
         while pending:
             index, fut = pending.popleft()
-            result = fut.result()
+            try:
+                result = fut.result()
+            except KilledWorker:  # every retry lost its worker: one line, not Dask's traceback
+                raise UserError(
+                    "render", f"task {tag_of(index)} lost its worker more often than the scheduler allows"
+                ) from None
             fut.release()
             submit_one()
             yield index, result
