@@ -121,8 +121,13 @@ enum { RT_RAYS_PRIMARY = 0, RT_RAYS_SHADOW = 1, RT_RAYS_SECONDARY = 2, RT_NONFIN
 rt_render *rt_render_new(const rt_scene *s, int width, int height, int spp, int max_depth, int threads,
                          unsigned long seed);
 void rt_render_free(rt_render *r);
-/* Renders into rgb (height * width * 3 floats, row 0 at the top). Blocks; safe to call from a thread the
- * caller does not block on. Returns 0, 1 when cancelled, -1 when threads could not be started. */
+/* Render only the rows [y0, y1) of the image from now on (a tile), each pixel exactly as in the whole image:
+ * samples depend only on the pixel's place in the whole image. Returns 0, or -1 for a range outside
+ * [0, height) or empty. */
+int rt_render_set_rows(rt_render *r, int y0, int y1);
+/* Renders into rgb ((y1 - y0) * width * 3 floats, row y0 first; all rows unless set). Blocks; safe to call
+ * from a thread the caller does not block on. Returns 0, 1 when cancelled, -1 when threads could not be
+ * started. */
 int rt_render_run(rt_render *r, float *rgb);
 int rt_render_progress(rt_render *r); /* rows finished so far (thread-safe) */
 void rt_render_cancel(rt_render *r);  /* ask a running render to stop after the current rows */

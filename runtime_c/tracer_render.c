@@ -2,7 +2,8 @@
  *
  * Threads take image rows from a shared counter (so uneven rows balance themselves) and write disjoint
  * parts of the output. Samples come from a per-pixel random stream seeded by (seed, pixel), so an image is
- * the same whatever the thread count. The render context holds all mutable state; a mutex guards the row
+ * the same whatever the thread count, and a band of rows (rt_render_set_rows, a tile) is exactly those rows
+ * of the whole image. The render context holds all mutable state; a mutex guards the row
  * counter, the progress count, the cancel flag and the ray statistics.
  *
  * What the threads share is kept off their hot path: each thread counts its rays in its own stack frame and
@@ -22,6 +23,7 @@
 struct rt_render {
     const rt_scene *s;
     int width, height, spp, max_depth, threads;
+    int y0, y1; /* the rows rt_render_run renders: [y0, y1) of the image (all of it unless set) */
     unsigned long seed;
     float *rgb;
     /* camera frame */
@@ -76,6 +78,8 @@ rt_render *rt_render_new(const rt_scene *s, int width, int height, int spp, int 
     r->s = s;
     r->width = width;
     r->height = height;
+    r->y0 = 0;
+    r->y1 = height;
     r->spp = spp;
     r->max_depth = max_depth < 0 ? 0 : (max_depth > RT_MAX_DEPTH ? RT_MAX_DEPTH : max_depth);
     r->threads = threads < 1 ? 1 : threads;
@@ -101,6 +105,17 @@ rt_render *rt_render_new(const rt_scene *s, int width, int height, int spp, int 
         return NULL;
     }
     return r;
+}
+
+int rt_render_set_rows(rt_render *r, int y0, int y1)
+{
+    if (!r || y0 < 0 || y1 > r->height || y0 >= y1)
+        return -1;
+    pthread_mutex_lock(&r->lock);
+    r->y0 = y0;
+    r->y1 = y1;
+    pthread_mutex_unlock(&r->lock);
+    return 0;
 }
 
 void rt_render_free(rt_render *r)
@@ -154,7 +169,7 @@ static void render_row(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
         }
         for (a = 0; a < 3; ++a) {
             double v = acc[a] / r->spp;
-            r->rgb[((size_t)y * (size_t)r->width + (size_t)x) * 3 + (size_t)a] = (float)v;
+            r->rgb[((size_t)(y - r->y0) * (size_t)r->width + (size_t)x) * 3 + (size_t)a] = (float)v;
         }
     }
 }
@@ -170,7 +185,7 @@ static void *worker(void *arg)
         pthread_mutex_lock(&r->lock); /* one lock per row: the row done, and the next one claimed */
         if (y >= 0)
             r->rows_done++;
-        if (r->cancel || r->next_row >= r->height) {
+        if (r->cancel || r->next_row >= r->y1) {
             for (a = 0; a < RT_NSTATS; ++a)
                 r->stats[a] += stats[a];
             pthread_mutex_unlock(&r->lock);
@@ -188,11 +203,11 @@ int rt_render_run(rt_render *r, float *rgb)
 {
     pthread_t *ids;
     pthread_attr_t attr;
-    int n = r->threads < r->height ? r->threads : r->height, started = 0, i, cancelled, reached;
+    int rows = r->y1 - r->y0, n = r->threads < rows ? r->threads : rows, started = 0, i, cancelled, reached;
     const size_t row_floats = (size_t)r->width * 3;
     r->rgb = rgb;
     pthread_mutex_lock(&r->lock);
-    r->next_row = 0;
+    r->next_row = r->y0;
     r->rows_done = 0;
     pthread_mutex_unlock(&r->lock);
     ids = malloc((size_t)n * sizeof *ids);
@@ -213,12 +228,12 @@ int rt_render_run(rt_render *r, float *rgb)
         pthread_join(ids[i], NULL);
     free(ids);
     pthread_mutex_lock(&r->lock);
-    cancelled = r->cancel && r->rows_done < r->height;
+    cancelled = r->cancel && r->rows_done < rows;
     reached = r->next_row; /* every row claimed was finished: a thread checks cancel only between rows */
     pthread_mutex_unlock(&r->lock);
-    if (reached < r->height) /* cancelled, or no thread could get its scratch memory: those rows are black */
-        memset(rgb + (size_t)reached * row_floats, 0, (size_t)(r->height - reached) * row_floats * sizeof(float));
-    return cancelled ? 1 : (reached < r->height ? -1 : 0);
+    if (reached < r->y1) /* cancelled, or no thread could get its scratch memory: those rows are black */
+        memset(rgb + (size_t)(reached - r->y0) * row_floats, 0, (size_t)(r->y1 - reached) * row_floats * sizeof(float));
+    return cancelled ? 1 : (reached < r->y1 ? -1 : 0);
 }
 
 int rt_render_progress(rt_render *r)

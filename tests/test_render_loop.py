@@ -25,11 +25,14 @@ def scene() -> CScene:
     return CScene(sc, build_scene(sc))
 
 
-def run(cs: CScene, threads: int, spp: int = 2, cancel_first: bool = False) -> tuple[int, np.ndarray, list, int]:
+def run(
+    cs: CScene, threads: int, spp: int = 2, cancel_first: bool = False, rows: tuple[int, int] = (0, H)
+) -> tuple[int, np.ndarray, list, int]:
     ctx = cs.lib.rt_render_new(cs.ptr, W, H, spp, 4, threads, 7)
     assert ctx
     try:
-        out = np.full((H, W, 3), np.nan, dtype=np.float32)  # stale contents: every pixel must be written
+        assert cs.lib.rt_render_set_rows(ctx, *rows) == 0
+        out = np.full((rows[1] - rows[0], W, 3), np.nan, dtype=np.float32)  # stale: every pixel must be written
         if cancel_first:
             cs.lib.rt_render_cancel(ctx)
         code = cs.lib.rt_render_run(ctx, out.ctypes.data_as(ctypes.POINTER(ctypes.c_float)))
@@ -55,3 +58,12 @@ def test_a_cancelled_render_leaves_unreached_rows_black(scene: CScene) -> None:
     code, img, stats, done = run(scene, 2, cancel_first=True)
     assert code == 1 and done == 0
     assert np.array_equal(img, np.zeros_like(img)) and stats[0] == 0
+
+
+def test_a_band_of_rows_is_those_rows_of_the_whole_image(scene: CScene) -> None:
+    _, whole, _, _ = run(scene, 1)
+    for threads in (1, 2, 5):
+        code, band, _, done = run(scene, threads, rows=(5, 12))
+        assert code == 0 and done == 7 and np.array_equal(band, whole[5:12])
+    code, band, _, done = run(scene, 2, cancel_first=True, rows=(5, 12))
+    assert code == 1 and done == 0 and np.array_equal(band, np.zeros_like(band))

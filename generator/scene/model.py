@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from implgen import abi
+from implgen.scene.keys import Animation
 
 if TYPE_CHECKING:
     from implgen.codegen.spec import Spec
@@ -104,6 +105,8 @@ class Scene:
     background: tuple[float, float, float] = (0.0, 0.0, 0.0)
     lights: list[Light] = field(default_factory=list)
     objects: list[Node] = field(default_factory=list)
+    animation: Animation = field(default_factory=Animation)  # frames and fps; one frame for a still
+    keyed: tuple[str, ...] = ()  # key paths of the values that change from frame to frame
 
     def leaves(self) -> list[Leaf]:
         out: list[Leaf] = []
