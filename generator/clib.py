@@ -19,7 +19,6 @@ import shutil
 import subprocess
 import tempfile
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from functools import cache
 from pathlib import Path
 
@@ -87,9 +86,11 @@ def _build_into(target: Path, suffix: str, cmd_for: Callable[[str], list[str]]) 
     return target
 
 
-def compile_object(source: Path, include_dirs: Sequence[Path] = (), extra_flags: Sequence[str] = ()) -> Path:
-    """Compile one C source into an object file, cached under `obj/` by the source text, every header in
-    `include_dirs`, the flags and the compiler's version. Returns its path."""
+def _object_job(
+    source: Path, include_dirs: Sequence[Path], extra_flags: Sequence[str]
+) -> tuple[Path, Callable[[str], list[str]]]:
+    """The cached object's path for one source (its key: the source text, every header in `include_dirs`, the
+    flags and the compiler's version) and the command that compiles it to a given output name."""
     cc = compiler()
     flags = [*BASE_FLAGS, *extra_flags]
     h = _digest(cc, flags)
@@ -97,15 +98,28 @@ def compile_object(source: Path, include_dirs: Sequence[Path] = (), extra_flags:
     _headers_into(h, include_dirs)
     target = cache_dir() / "obj" / f"{Path(source).stem}-{h.hexdigest()[:20]}.o"
     includes = [f"-I{inc}" for inc in include_dirs]
-    return _build_into(target, ".o", lambda tmp: [cc, *flags, "-c", str(source), "-o", tmp, *includes])
+    return target, lambda tmp: [cc, *flags, "-c", str(source), "-o", tmp, *includes]
+
+
+def compile_object(source: Path, include_dirs: Sequence[Path] = (), extra_flags: Sequence[str] = ()) -> Path:
+    """Compile one C source into an object file, cached under `obj/` by the source text, every header in
+    `include_dirs`, the flags and the compiler's version. Returns its path."""
+    target, cmd_for = _object_job(source, include_dirs, extra_flags)
+    return _build_into(target, ".o", cmd_for)
 
 
 def compile_objects(jobs: Sequence[tuple[Path, Sequence[Path]]], extra_flags: Sequence[str] = ()) -> list[Path]:
     """compile_object for each (source, include_dirs), the missing ones in parallel (one per core)."""
-    if len(jobs) <= 1:
-        return [compile_object(src, inc, extra_flags) for src, inc in jobs]
-    with ThreadPoolExecutor(max_workers=min(len(jobs), os.cpu_count() or 1)) as pool:
-        return list(pool.map(lambda job: compile_object(job[0], job[1], extra_flags), jobs))
+    planned = [_object_job(src, inc, extra_flags) for src, inc in jobs]
+    missing = [job for job in planned if not job[0].exists()]
+    if len(missing) == 1:
+        _build_into(missing[0][0], ".o", missing[0][1])
+    elif missing:
+        from concurrent.futures import ThreadPoolExecutor  # only when there is more than one to compile
+
+        with ThreadPoolExecutor(max_workers=min(len(missing), os.cpu_count() or 1)) as pool:
+            list(pool.map(lambda job: _build_into(job[0], ".o", job[1]), missing))
+    return [target for target, _ in planned]
 
 
 def link_shared(objects: Sequence[Path], libs: Sequence[str] = ("-lm",), tag: str = "lib") -> Path:

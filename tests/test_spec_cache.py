@@ -157,6 +157,9 @@ def _damage(entry: Path, how: str) -> None:
     elif how == "folder":
         entry.unlink()
         entry.mkdir()
+    elif how == "fifo":
+        entry.unlink()
+        os.mkfifo(entry)
     else:
         bad = dict(good)
         if how == "wrong_name":
@@ -191,6 +194,7 @@ DAMAGE = [
     "list",
     "nested",
     "folder",
+    "fifo",
     "wrong_name",
     "param_text",
     "param_nan",
@@ -215,7 +219,7 @@ def test_a_damaged_entry_is_a_miss_and_the_picture_is_unchanged(cache: Path, how
     again = parse_scene(data, "s.yaml")
     assert isinstance(again.leaves()[0].spec, Spec)  # not trusted: parsed in full
     assert np.array_equal(render(again), reference)
-    if how != "folder":  # written again, and good
+    if how != "folder":  # written again (a fifo is replaced), and good
         assert isinstance(parse_scene(data, "s.yaml").leaves()[0].spec, CachedSpec)
 
 
