@@ -12,10 +12,16 @@
  * and each thread writes the first touch of its own rows (no serial clearing of the image before the
  * threads start: only rows a cancelled render never reached are cleared, after it).
  */
+#if defined(__linux__) && !defined(_GNU_SOURCE)
+#define _GNU_SOURCE /* pthread_setaffinity_np, sched_getaffinity: one thread per core when all cores render */
+#endif
 #include "tracer_internal.h"
 
 #include <math.h>
 #include <pthread.h>
+#ifdef __linux__
+#include <sched.h>
+#endif
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -199,6 +205,30 @@ static void *worker(void *arg)
     return NULL;
 }
 
+/* When a render uses exactly the cores it may run on, thread i is kept on the i-th of them. Rows are handed
+ * out dynamically, so a core another process keeps busy only gives its thread fewer rows; but a scheduler
+ * that packs new threads onto the cores already running (some virtual machines' kernels do, for tens of
+ * milliseconds) can no longer run a short render's threads one after the other on one core. */
+static void spread_threads(const pthread_t *ids, int n)
+{
+#ifdef __linux__
+    cpu_set_t allowed, one;
+    int cpu, k = 0;
+    if (n < 2 || sched_getaffinity(0, sizeof allowed, &allowed) != 0 || CPU_COUNT(&allowed) != n)
+        return;
+    for (cpu = 0; cpu < CPU_SETSIZE && k < n; ++cpu) {
+        if (!CPU_ISSET(cpu, &allowed))
+            continue;
+        CPU_ZERO(&one);
+        CPU_SET(cpu, &one);
+        pthread_setaffinity_np(ids[k++], sizeof one, &one); /* a failure leaves the thread where it was */
+    }
+#else
+    (void)ids;
+    (void)n;
+#endif
+}
+
 int rt_render_run(rt_render *r, float *rgb)
 {
     pthread_t *ids;
@@ -224,6 +254,7 @@ int rt_render_run(rt_render *r, float *rgb)
         free(ids);
         return -1;
     }
+    spread_threads(ids, started);
     for (i = 0; i < started; ++i)
         pthread_join(ids[i], NULL);
     free(ids);
