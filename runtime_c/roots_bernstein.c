@@ -14,19 +14,23 @@
  * after a few halvings. In first-root mode the leftmost piece that holds a root ends the search, which is
  * what a ray needs: the nearest hit, not all of them.
  *
- * Rounding: every b_i carries an error below tol = 24 n u M, M = sum |p_k| (|a| + |h|)^k (a priori bound of
- * the Taylor shift, the basis change and up to BZ_MAX_DEPTH halvings: about (6n + 3 + 12n) u M). A coefficient within tol of zero has no
- * certain sign. At the piece ends, where b_0 = p(t_l) and b_n = p(t_r), the compensated evaluation of
- * ig_sign_certified decides instead; inside, uncertain coefficients that might hide sign changes (see
- * variations()) force a split.
+ * Rounding: [a, b] is converted through one Taylor shift to its midpoint m, both halves from it, so every b_i
+ * is within tol = 7 n u M of the exact one, M = sum |p_k| max(|a|, |b|)^k: the scale of p on the interval (a
+ * shift to an end would make it sum |p_k| (|a| + |b - a|)^k, which at degree 20 on [-1, 1] is 3^20 times more).
+ * Each halving adds (n + 1) u max |b_i| to a piece's tol. A coefficient within tol of zero has no certain sign.
+ * At the piece ends, where b_0 = p(t_l) and b_n = p(t_r), the compensated evaluation of ig_sign_certified
+ * decides instead; inside, uncertain coefficients that might hide sign changes (see variations()) force a
+ * split. A piece with uncertain coefficients is first converted afresh from the power form at its own scale,
+ * sum |p_k| max(|t_l|, |t_r|)^k, when that is at least four times below its inherited tol (near the point the
+ * ray polynomial is expanded at, p can be tiny everywhere).
  *
- * Whenever this cannot conclude -- a piece still ambiguous after BZ_MAX_DEPTH halvings (a tangent or nearly
- * tangent ray, a cluster of roots), or p zero within rounding at a piece end -- the derivative-bracketing
- * solver (the one that reports tangent roots) takes over from the left end of that piece to b; the roots
- * already found left of it stand. Pieces are visited left to right in both modes, so the first root in
- * first-root mode is bitwise the first root of the full search.
+ * Whatever this cannot decide -- a piece still ambiguous after BZ_MAX_DEPTH halvings (a tangent or nearly
+ * tangent ray, a cluster of roots), or p zero within rounding at a split point -- goes, that piece alone, to
+ * the derivative-bracketing solver (the one that reports tangent roots). Pieces are visited left to right in
+ * both modes and each undecided piece is bracketed the same way, so the first root in first-root mode is
+ * bitwise the first root of the full search.
  *
- * Speed: the body (roots_bernstein_body.h) is compiled once per degree 3 .. 12 with the degree a constant,
+ * Speed: the body (roots_bernstein_body.h) is compiled once per degree 3 .. 24 with the degree a constant,
  * so the O(n^2) loops unroll into straight-line code, and once more for any degree.
  */
 #include "roots_impl.h"
