@@ -91,7 +91,7 @@ static int solve_general(const double *p, int n, double lo, double hi, int metho
         int k = solve_interval(method, 0, fallbacks, q, n, 1.0 / b, 1.0 / xa, tmp);
         for (int i = 0; i < k; ++i) {
             double x = 1.0 / tmp[i];
-            if (x >= a && x <= b && !(x == 1.0 && a <= 1.0))
+            if (x >= a && x <= b) /* x = 1 from both parts: one is dropped as a duplicate */
                 out[cnt++] = x;
         }
     }
@@ -100,7 +100,7 @@ static int solve_general(const double *p, int n, double lo, double hi, int metho
         int k = solve_interval(method, 0, fallbacks, q, n, 1.0 / xb, 1.0 / a, tmp);
         for (int i = 0; i < k; ++i) {
             double x = 1.0 / tmp[i];
-            if (x >= a && x <= b && !(x == -1.0 && b >= -1.0))
+            if (x >= a && x <= b)
                 out[cnt++] = x;
         }
     }
