@@ -1,9 +1,10 @@
 """implgen against POV-Ray 3.7 on the same scenes, and how intersection cost grows with degree.
 
-    .venv/bin/python bench/povray_compare.py [--quick] [-o bench/results/povray] [--runs N]
+    .venv/bin/python bench/povray_compare.py [--quick] [-o bench/results/povray] [--runs N] [--scenes a,b]
 
-For each scene in bench/scenes/ (torus, piriform, heart sextic, Chmutov octic, and the torus again seen from
-10^4 units through a telephoto lens; ground plane, one light, shadows, 800x600, 1 sample) it
+For each scene in bench/scenes/ (torus, piriform, heart sextic, Chmutov octic, the torus again seen from 10^4
+units through a telephoto lens, Chmutov surfaces of degree 12 and 16, a spiky superellipsoid of degree 20;
+ground plane, one light, shadows, 800x600, 1 sample) it
   1. exports the same scene to POV-Ray (`polynomial { ... sturm }`, expanded exactly from our spec; matched
      camera: POV-Ray is left-handed, so `right -x*aspect`; our fov is vertical, POV-Ray's angle horizontal);
   2. times both programs as subprocesses (wall clock, median of --runs runs, interleaved) on 1 thread and on
@@ -38,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-SCENES = ("torus", "piriform", "heart", "chmutov", "torus_far")
+SCENES = ("torus", "piriform", "heart", "chmutov", "torus_far", "chmutov12", "chmutov16", "spiky20")
 IMPLGEN = Path(sys.executable).parent / "implgen"
 
 
@@ -411,7 +412,12 @@ def main(argv=None) -> int:
         default=300,
         help="agreed silhouette pixels checked exactly per scene (random sample)",
     )
+    ap.add_argument("--scenes", default=",".join(SCENES), help="comma-separated subset of bench/scenes (default: all)")
     args = ap.parse_args(argv)
+    scenes = [s for s in args.scenes.split(",") if s]
+    unknown = sorted(set(scenes) - set(SCENES))
+    if unknown:
+        ap.error(f"--scenes: unknown scene(s) {', '.join(unknown)}; choose from {', '.join(SCENES)}")
     runs = args.runs or (1 if args.quick else 3)
     w, h = (400, 300) if args.quick else (800, 600)
     out = args.out.resolve()
@@ -433,7 +439,7 @@ def main(argv=None) -> int:
     print(f"POV-Ray {results['povray']}; {results['machine']['cpu']} x{ncpu}; {w}x{h}, {runs} run(s) each")
     rng = np.random.default_rng(2024)
 
-    for name in SCENES:
+    for name in scenes:
         path = ROOT / "bench" / "scenes" / f"{name}.yaml"
         scene = load_scene(path)
         pov, povc = povdir / f"{name}.pov", povdir / f"{name}_coverage.pov"
