@@ -64,10 +64,11 @@ static void BZ_FN(split_half)(const double *b, int n, double *L, double *R)
     }
 }
 
-/* Sign changes of b[0..n] with end signs sl, sr (certain, nonzero); -1 when uncertain interior coefficients
+/* Sign changes of b[0..n] with end signs sl, sr (certain, nonzero), and in *unsure how many interior
+ * coefficients are within tol of zero; -1 when uncertain interior coefficients
  * could hide changes: a run of them between two equal signs (+ ? + may be + - +), or a run of two or more
  * between opposite signs (+ ? ? - may be + - + -). A single one between opposite signs changes nothing. */
-static int BZ_FN(variations)(const double *b, int n, double tol, int sl, int sr)
+static int BZ_FN(variations)(const double *b, int n, double tol, int sl, int sr, int *unsure)
 {
     int v = 0, last = sl, pending = 0;
     (void)n;
@@ -79,6 +80,7 @@ static int BZ_FN(variations)(const double *b, int n, double tol, int sl, int sr)
         changes += pos != prev;
         prev = pos;
     }
+    *unsure = N - 1 - certain;
     if (certain == N - 1)
         return changes + ((sr > 0) != prev);
     for (int i = 1; i < N; ++i) {
@@ -122,7 +124,8 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double tl, double tr, int s
     const int n = c->n;
     if (c->first && c->cnt + c->nfb > 0)
         return;
-    int v = BZ_FN(variations)(b, n, tol, sl, sr);
+    int unsure;
+    int v = BZ_FN(variations)(b, n, tol, sl, sr, &unsure);
     if (v == 0)
         return;
     if (v == 1) { /* one simple root: refined now in first-root mode, else with the others at the end */
@@ -144,19 +147,18 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double tl, double tr, int s
         bz_fallback(c, tl, tr);
         return;
     }
-    double L[IG_MAX_DEGREE + 1], R[IG_MAX_DEGREE + 1], vm, big = 0.0, unsure = 0.0;
-    for (int i = 0; i <= N; ++i) {
-        big = fmax(big, fabs(b[i]));
-        unsure += fabs(b[i]) <= tol;
-    }
+    double L[IG_MAX_DEGREE + 1], R[IG_MAX_DEGREE + 1], vm;
     /* Coefficients of uncertain sign: converted afresh on this piece, the rounding is at the scale of p here,
      * sum |p_k| max(|tl|, |tr|)^k, which can be far below the inherited one (p small near the expansion point
      * of the ray polynomial, or a piece far from the larger end of the interval). */
-    double tol_here = unsure > 0.0 ? 7.0 * N * IG_U * ig_horner_abs(c->p, n, fmax(fabs(tl), fabs(tr))) : tol;
+    double tol_here = unsure > 0 ? 7.0 * N * IG_U * ig_horner_abs(c->p, n, fmax(fabs(tl), fabs(tr))) : tol;
     if (tol_here < 0.25 * tol) {
         BZ_FN(to_bernstein_mid)(c->p, n, tm, tm - tl, tr - tm, L, R);
         tol = tol_here;
     } else {
+        double big = 0.0;
+        for (int i = 0; i <= N; ++i)
+            big = fmax(big, fabs(b[i]));
         BZ_FN(split_half)(b, n, L, R);
         /* the halving's own rounding: one per level of averages, each below u times the largest coefficient */
         tol += (N + 1) * IG_U * big;
