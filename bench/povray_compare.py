@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import platform
 import re
@@ -191,8 +192,8 @@ class ExactJudge:
             self.objects.append((terms, inv_f, tr_f, leaf.spec.degree, _padded_box(leaf.spec.box(leaf.params))))
 
     @staticmethod
-    def _mul(a: list[Fraction], b: list[Fraction]) -> list[Fraction]:
-        out = [Fraction(0)] * (len(a) + len(b) - 1)
+    def _mul(a: list[int], b: list[int]) -> list[int]:
+        out = [0] * (len(a) + len(b) - 1)
         for i, x in enumerate(a):
             if x:
                 for j, y in enumerate(b):
@@ -209,21 +210,29 @@ class ExactJudge:
         dd = [sum(inv[i][j] * dw[j] for j in range(3)) for i in range(3)]
         return oo, dd
 
-    def ray_poly(self, obj, o: np.ndarray, d: np.ndarray) -> list[Fraction]:
-        """Exact coefficients (lowest first) of f(o' + t d') with o', d' the object-space ray."""
+    def ray_poly(self, obj, o: np.ndarray, d: np.ndarray) -> list[int]:
+        """Integer coefficients (lowest first) of a positive multiple of f(o' + t d'), o', d' the object-space
+        ray: with o' = A / D and d' = B / D over one denominator D, D^deg f(o' + t d') = sum c_m D^(deg - |m|)
+        prod_k (A_k + B_k t)^(m_k), and the c_m are scaled to integers: all in Python integers, no gcd."""
         terms, _, _, deg, _ = obj
         oo, dd = self.object_ray(obj, o, d)
+        den = 1
+        for v in (*oo, *dd, *(c for _, c in terms)):
+            den = den * v.denominator // math.gcd(den, v.denominator)
+        lin = [[int(oo[k] * den), int(dd[k] * den)] for k in range(3)]
         powers = []
         for k in range(3):
-            pw = [[Fraction(1)]]
+            pw = [[1]]
             for _ in range(deg):
-                pw.append(self._mul(pw[-1], [oo[k], dd[k]]))
+                pw.append(self._mul(pw[-1], lin[k]))
             powers.append(pw)
-        acc = [Fraction(0)] * (deg + 1)
+        acc = [0] * (deg + 1)
+        dpow = [den**e for e in range(deg + 2)]
         for (i, j, k), c in terms:
+            scale = int(c * den) * dpow[deg - (i + j + k)]
             p = self._mul(self._mul(powers[0][i], powers[1][j]), powers[2][k])
             for e, v in enumerate(p):
-                acc[e] += c * v
+                acc[e] += scale * v
         return acc
 
     def hits(self, px: int, py: int) -> bool:

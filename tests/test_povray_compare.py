@@ -161,3 +161,27 @@ def test_povray_renders_the_clipped_ball_like_the_exact_verdict(tmp_path):
     assert mask[24, 32] and not mask[24, 43] and not judge.hits(43, 24)
     whole = pc.ExactJudge(_cut_ball_scene({"x": [-2, 2], "y": [-2, 2], "z": [-2, 2]}), 64, 48)
     assert whole.hits(43, 24)
+
+
+def test_integer_ray_polynomial_is_a_positive_multiple_of_the_exact_one():
+    """ExactJudge.ray_poly works on integers; SymPy's expansion of f(o' + t d') over Q is the reference."""
+    from fractions import Fraction
+
+    import sympy as sp
+
+    scene = load_scene(TORUS)
+    judge = pc.ExactJudge(scene, 80, 60)
+    obj = judge.objects[0]
+    leaf = next(lf for lf in scene.leaves() if lf.spec.degree == 4)
+    o, d = pc.camera_ray(scene, 41.5, 33.5, 80, 60)
+    oo, dd = judge.object_ray(obj, o, d)
+    t = sp.Symbol("t")
+    subs = {pc.param_symbol(k): sp.Rational(Fraction(float(v))) for k, v in leaf.params.items()}
+    f = leaf.spec.f.xreplace(subs)
+    names = {s.name: s for s in f.free_symbols}
+    assert set(names) == {"x", "y", "z"}
+    line = {names[n]: sp.Rational(oo[k]) + sp.Rational(dd[k]) * t for k, n in enumerate("xyz")}
+    want = [Fraction(int(c.p), int(c.q)) for c in reversed(sp.Poly(sp.expand(f.xreplace(line)), t).all_coeffs())]
+    got = judge.ray_poly(obj, o, d)
+    ratio = Fraction(got[-1]) / want[-1]
+    assert ratio > 0 and all(Fraction(g) == ratio * w for g, w in zip(got, want))
