@@ -26,7 +26,7 @@ static void BZ_FN(to_bernstein_mid)(const double *p, int n, double m, double rl,
     for (int i = 0; i < N; ++i) /* Taylor shift: t(y) = p(m + y), repeated synthetic division */
         for (int k = N - 1; k >= i; --k)
             t[k] += m * t[k + 1];
-    double fl = 1.0, fr = 1.0; /* (-rl)^j / C(n, j), rr^j / C(n, j); C(n, j) = C(n, j - 1) (n - j + 1) / j */
+    double fl = 1.0, fr = 1.0;   /* (-rl)^j / C(n, j), rr^j / C(n, j); C(n, j) = C(n, j - 1) (n - j + 1) / j */
     double W[IG_MAX_DEGREE + 1]; /* the left half in the reflected variable (0 at m, 1 at m - rl) */
     W[0] = t[0];
     R[0] = t[0];
