@@ -43,8 +43,11 @@ typedef struct rt_material {
     double transparency;  /* 0: opaque .. 1: clear; the rest is the local (Phong) term */
     double ior;           /* index of refraction of the inside */
     double absorption[3]; /* Beer-Lambert coefficients per world unit, per channel (inside the solid) */
+    double two_sided;     /* 1: the back of the surface (its f < 0 side, where the normal points away from the
+                             viewer) shows inside instead of the base colour; 0: both sides the same */
+    double inside[3];     /* the back's colour when two_sided (linear, 0..1) */
 } rt_material;
-#define RT_MATERIAL_DOUBLES 19
+#define RT_MATERIAL_DOUBLES 21
 
 /* One ray/scene hit, everything in world space. */
 typedef struct rt_hit {
@@ -118,8 +121,13 @@ enum { RT_RAYS_PRIMARY = 0, RT_RAYS_SHADOW = 1, RT_RAYS_SECONDARY = 2, RT_NONFIN
 rt_render *rt_render_new(const rt_scene *s, int width, int height, int spp, int max_depth, int threads,
                          unsigned long seed);
 void rt_render_free(rt_render *r);
-/* Renders into rgb (height * width * 3 floats, row 0 at the top). Blocks; safe to call from a thread the
- * caller does not block on. Returns 0, 1 when cancelled, -1 when threads could not be started. */
+/* Render only the rows [y0, y1) of the image from now on (a tile), each pixel exactly as in the whole image:
+ * samples depend only on the pixel's place in the whole image. Returns 0, or -1 for a range outside
+ * [0, height) or empty. */
+int rt_render_set_rows(rt_render *r, int y0, int y1);
+/* Renders into rgb ((y1 - y0) * width * 3 floats, row y0 first; all rows unless set). Blocks; safe to call
+ * from a thread the caller does not block on. Returns 0, 1 when cancelled, -1 when threads could not be
+ * started. */
 int rt_render_run(rt_render *r, float *rgb);
 int rt_render_progress(rt_render *r); /* rows finished so far (thread-safe) */
 void rt_render_cancel(rt_render *r);  /* ask a running render to stop after the current rows */

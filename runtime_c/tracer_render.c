@@ -2,7 +2,8 @@
  *
  * Threads take image rows from a shared counter (so uneven rows balance themselves) and write disjoint
  * parts of the output. Samples come from a per-pixel random stream seeded by (seed, pixel), so an image is
- * the same whatever the thread count. The render context holds all mutable state; a mutex guards the row
+ * the same whatever the thread count, and a band of rows (rt_render_set_rows, a tile) is exactly those rows
+ * of the whole image. The render context holds all mutable state; a mutex guards the row
  * counter, the progress count, the cancel flag and the ray statistics.
  */
 #include "tracer_internal.h"
@@ -16,6 +17,7 @@
 struct rt_render {
     const rt_scene *s;
     int width, height, spp, max_depth, threads;
+    int y0, y1; /* the rows rt_render_run renders: [y0, y1) of the image (all of it unless set) */
     unsigned long seed;
     float *rgb;
     /* camera frame */
@@ -67,6 +69,8 @@ rt_render *rt_render_new(const rt_scene *s, int width, int height, int spp, int 
     r->s = s;
     r->width = width;
     r->height = height;
+    r->y0 = 0;
+    r->y1 = height;
     r->spp = spp;
     r->max_depth = max_depth < 0 ? 0 : (max_depth > RT_MAX_DEPTH ? RT_MAX_DEPTH : max_depth);
     r->threads = threads < 1 ? 1 : threads;
@@ -92,6 +96,17 @@ rt_render *rt_render_new(const rt_scene *s, int width, int height, int spp, int 
         return NULL;
     }
     return r;
+}
+
+int rt_render_set_rows(rt_render *r, int y0, int y1)
+{
+    if (!r || y0 < 0 || y1 > r->height || y0 >= y1)
+        return -1;
+    pthread_mutex_lock(&r->lock);
+    r->y0 = y0;
+    r->y1 = y1;
+    pthread_mutex_unlock(&r->lock);
+    return 0;
 }
 
 void rt_render_free(rt_render *r)
@@ -145,7 +160,7 @@ static void render_row(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
         }
         for (a = 0; a < 3; ++a) {
             double v = acc[a] / r->spp;
-            r->rgb[((size_t)y * (size_t)r->width + (size_t)x) * 3 + (size_t)a] = (float)v;
+            r->rgb[((size_t)(y - r->y0) * (size_t)r->width + (size_t)x) * 3 + (size_t)a] = (float)v;
         }
     }
 }
@@ -159,7 +174,7 @@ static void *worker(void *arg)
         return NULL;
     for (;;) {
         pthread_mutex_lock(&r->lock);
-        if (r->cancel || r->next_row >= r->height) {
+        if (r->cancel || r->next_row >= r->y1) {
             pthread_mutex_unlock(&r->lock);
             break;
         }
@@ -182,13 +197,13 @@ int rt_render_run(rt_render *r, float *rgb)
 {
     pthread_t *ids;
     pthread_attr_t attr;
-    int n = r->threads < r->height ? r->threads : r->height, started = 0, i, cancelled;
+    int rows = r->y1 - r->y0, n = r->threads < rows ? r->threads : rows, started = 0, i, cancelled;
     r->rgb = rgb;
     pthread_mutex_lock(&r->lock);
-    r->next_row = 0;
+    r->next_row = r->y0;
     r->rows_done = 0;
     pthread_mutex_unlock(&r->lock);
-    memset(rgb, 0, (size_t)r->width * (size_t)r->height * 3 * sizeof(float));
+    memset(rgb, 0, (size_t)r->width * (size_t)rows * 3 * sizeof(float));
     ids = malloc((size_t)n * sizeof *ids);
     if (!ids)
         return -1;
@@ -207,7 +222,7 @@ int rt_render_run(rt_render *r, float *rgb)
         pthread_join(ids[i], NULL);
     free(ids);
     pthread_mutex_lock(&r->lock);
-    cancelled = r->cancel && r->rows_done < r->height;
+    cancelled = r->cancel && r->rows_done < rows;
     pthread_mutex_unlock(&r->lock);
     return cancelled ? 1 : 0;
 }

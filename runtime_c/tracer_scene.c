@@ -158,7 +158,10 @@ int rt_scene_add_material(rt_scene *s, const double *v)
     m->transparency = v[12];
     m->ior = v[13];
     memcpy(m->absorption, v + 14, 3 * sizeof(double));
-    /* v[17], v[18] reserved (zero) */
+    m->two_sided = v[17];
+    memcpy(m->inside, v + 18, 3 * sizeof(double));
+    if (m->two_sided != 0.0 && m->two_sided != 1.0)
+        return fail(s, "two_sided must be 0 or 1");
     if (m->ior <= 0.0)
         return fail(s, "index of refraction must be positive");
     if (m->checker_scale < 0.0)

@@ -108,9 +108,12 @@ static void media_remove(rt_media *m, int mat)
         }
 }
 
-static void base_colour(const rt_material *m, const rt_hit *h, double c[3])
+/* The colour of the surface at h before lighting; back: the ray sees the side the normal points away from. */
+static void base_colour(const rt_material *m, const rt_hit *h, int back, double c[3])
 {
-    if (m->checker_scale > 0.0) {
+    if (back && m->two_sided != 0.0) {
+        memcpy(c, m->inside, 3 * sizeof(double));
+    } else if (m->checker_scale > 0.0) {
         /* A 3-D checker in object space, evaluated a little below the surface (a fraction of a cell) so a
          * surface lying exactly on a cell boundary, like the plane y = 0, does not speckle. The cell index
          * floor(q) of each axis is an integer; the colour is color where their sum is even. Below 2^53 the
@@ -187,7 +190,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
     rt_hit_lazy lazy;
     rt_pending ph;
     double u[3], nf[3], base[3], local[3], col[3], dl;
-    int a, l;
+    int a, l, back;
 
     if (!rt_scene_closest(s, o, d, 0.0, INFINITY, RT_CLOSEST, skip, &ph)) {
         memcpy(rgb, s->background, 3 * sizeof(double));
@@ -200,13 +203,14 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
     dl = sqrt(rt_dot(d, d));
     for (a = 0; a < 3; ++a)
         u[a] = d[a] / dl;
-    if (rt_dot(h.n, u) < 0.0)
+    back = !(rt_dot(h.n, u) < 0.0);
+    if (!back)
         memcpy(nf, h.n, sizeof nf);
     else
         for (a = 0; a < 3; ++a)
             nf[a] = -h.n[a];
 
-    base_colour(m, &h, base);
+    base_colour(m, &h, back, base);
     for (a = 0; a < 3; ++a)
         local[a] = m->ambient * base[a];
     if (m->transparency < 1.0) {
