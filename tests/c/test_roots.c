@@ -147,6 +147,14 @@ int main(void)
         n = from_roots(r6, 6, NULL, 0, 1.0, c);
         expect("degree 6: quadruple and double", c, n, -inf, inf, w6, 2, 1e-15, NO_STURM);
     }
+    { /* real roots spread over 150 decades next to the overflow limit: c0 is about 1e307 */
+        double r[] = {1, 10, 1e152, 1e154};
+        n = from_roots(r, 4, NULL, 0, 1.0, c);
+        expect("roots 1, 10, 1e152, 1e154", c, n, -inf, inf, r, 4, 1e-13, GENERAL);
+        double r2[] = {-1e154, -3, 2, 1e150}, w2[] = {-1e154, -3, 2, 1e150};
+        n = from_roots(r2, 4, NULL, 0, 1.0, c);
+        expect("roots -1e154, -3, 2, 1e150", c, n, -inf, inf, w2, 4, 1e-13, GENERAL);
+    }
     { /* a tiny positive minimum is not a root */
         double q[][2] = {{-2, 1 + 0x1p-40}}, r[] = {-3};
         n = from_roots(NULL, 0, q, 1, 1.0, c);
