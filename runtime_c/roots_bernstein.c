@@ -128,8 +128,8 @@ typedef void (*bz_piece_fn)(bz_ctx *c, const double *b, double tl, double tr, in
 typedef void (*bz_basis_fn)(const double *p, int n, double m, double rl, double rr, double *L, double *R);
 
 /* The code specialised per degree: 3 to 12 and the even degrees to 24 (a closed surface's ray polynomials;
- * each specialisation is 7-15 % faster at degree 16-24 than _any, and every one adds compile time to each
- * library built from the runtime); other degrees run the _any version. */
+ * each specialisation is 7-15 % faster at degree 16-24 than _any, and every one adds compile time to the
+ * first build of the runtime); other degrees run the _any version. */
 #define BZ_SPECIAL (IG_MAX_DEGREE + 1)
 #define BZ_ENTRY(d) [d] = {to_bernstein_mid_##d, piece_##d}
 static const struct {
