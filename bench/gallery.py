@@ -11,11 +11,10 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
-import subprocess
 import sys
 from pathlib import Path
 
+from implgen.bench.machine import describe as machine
 from implgen.scene.batch import Runner, render_frames
 from implgen.scene.frameout import plan_output
 from implgen.scene.frames import FrameOptions, load_frames
@@ -23,15 +22,6 @@ from implgen.scene.load import load_scene
 from implgen.scene.render import RenderInfo, render, write_png
 
 GIF_SCALE = 2  # an animation's GIF is its image size divided by this
-
-
-def machine() -> str:
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True, check=False).stdout
-        model = next(line.split(":", 1)[1].strip() for line in out.splitlines() if line.startswith("Model name"))
-    except (OSError, StopIteration):
-        model = platform.processor() or "unknown CPU"
-    return f"{model}, {os.cpu_count()} cores"
 
 
 def main() -> int:

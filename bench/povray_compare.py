@@ -55,6 +55,7 @@ def _ensure_current_install() -> None:
 
 _ensure_current_install()
 
+from implgen.bench.machine import cpu_model  # noqa: E402
 from implgen.codegen.spec import exact_polynomial, param_symbol  # noqa: E402
 from implgen.export import povray as pv  # noqa: E402
 from implgen.roots.descartes import has_root  # noqa: E402
@@ -560,15 +561,8 @@ def main(argv=None) -> int:
 
 
 def machine_info() -> dict:
-    cpu = platform.processor() or "unknown"
-    try:
-        for line in subprocess.run(["lscpu"], capture_output=True, text=True, check=False).stdout.splitlines():
-            if line.startswith("Model name:"):
-                cpu = line.split(":", 1)[1].strip()
-    except OSError:
-        pass
     return {
-        "cpu": cpu,
+        "cpu": cpu_model(),
         "cores": os.cpu_count(),
         "system": platform.platform(),
         "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -21,26 +20,13 @@ import tempfile
 import time
 from pathlib import Path
 
+from implgen.bench.machine import describe as machine
+from implgen.bench.machine import load_average
+
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "bench" / "scenes"
 TARGET = 0.2  # seconds for a cached render, the whole process
 HEAVY = ("sympy", "matplotlib", "tqdm", "dask", "distributed", "imageio", "starlette", "uvicorn", "jinja2")
-
-
-def machine() -> str:
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True, check=False).stdout
-        model = next(line.split(":", 1)[1].strip() for line in out.splitlines() if line.startswith("Model name"))
-    except (OSError, StopIteration):
-        model = platform.processor() or "unknown CPU"
-    return f"{model}, {os.cpu_count()} cores, Python {platform.python_version()}"
-
-
-def load_average() -> str:
-    try:
-        return ", ".join(f"{v:.2f}" for v in os.getloadavg())
-    except OSError:
-        return "unknown"
 
 
 def implgen_command() -> list[str]:

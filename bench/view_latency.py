@@ -17,7 +17,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -27,6 +26,7 @@ from pathlib import Path
 
 from websockets.sync.client import connect
 
+from implgen.bench.machine import describe as machine
 from implgen.codegen.spec import load_spec
 from implgen.view.dump import spec_mapping
 from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, MAX_RENDERS_PER_SECOND
@@ -35,15 +35,6 @@ ROOT = Path(__file__).resolve().parents[1]
 SHAPES = ROOT / "examples" / "shapes"
 MAX_DEGREE = 8
 WIDTH, HEIGHT = 640, 480
-
-
-def machine() -> str:
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True, check=False).stdout
-        model = next(line.split(":", 1)[1].strip() for line in out.splitlines() if line.startswith("Model name"))
-    except (OSError, StopIteration):
-        model = platform.processor() or "unknown CPU"
-    return f"{model}, {os.cpu_count()} cores"
 
 
 class Page:

@@ -24,7 +24,6 @@ from __future__ import annotations
 import argparse
 import ctypes
 import os
-import platform
 import resource
 import statistics
 import time
@@ -34,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from implgen import validate
+from implgen.bench.machine import cpu_model, load_average
 from implgen.errors import UserError
 from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.build import build_scene
@@ -49,23 +49,6 @@ MIN_SECONDS = 0.1
 def _default_scenes() -> list[Path]:
     here = Path.cwd()
     return sorted((here / "bench" / "scenes").glob("*.yaml")) + sorted((here / "examples" / "scenes").glob("*.yaml"))
-
-
-def _cpu() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown CPU"
-
-
-def _load() -> str:
-    try:
-        return ", ".join(f"{v:.2f}" for v in os.getloadavg())
-    except OSError:
-        return "unknown"
 
 
 def _cpu_seconds() -> float:
@@ -197,8 +180,8 @@ def main(argv: Sequence[str]) -> int:
         "# Render speed and thread scaling",
         "",
         f"Written by `implgen bench render --threads {args.threads} --runs {args.runs} --width {args.width} "
-        f"--height {args.height} --spp {args.spp}{' --fold-compare' if args.fold_compare else ''}` on {_cpu()}, "
-        f"{os.cpu_count()} cores. Load average before: {_load()}.",
+        f"--height {args.height} --spp {args.spp}{' --fold-compare' if args.fold_compare else ''}` on {cpu_model()}, "
+        f"{os.cpu_count()} cores. Load average before: {load_average()}.",
         "",
         f"{args.width}×{args.height}, {args.spp} sample(s) per pixel; median of {args.runs} interleaved rounds. "
         "Speed-up: wall time on the first thread count over the last; work: CPU time on the last over the first "
@@ -208,7 +191,7 @@ def main(argv: Sequence[str]) -> int:
     _scaling(scenes, args, counts, out)
     if args.fold_compare:
         _fold(scenes, args, out)
-    out.add("", f"Load average after: {_load()}.")
+    out.add("", f"Load average after: {load_average()}.")
     data = ("\n".join(out) + "\n").encode()
     atomic_write(args.output, lambda fh: fh.write(data))
     print(f"wrote {args.output}")

@@ -15,8 +15,6 @@ runtime does. Output: DIR/solvers.md, DIR/solvers.png (default DIR: bench/result
 from __future__ import annotations
 
 import argparse
-import platform
-import subprocess
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -24,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from implgen.bench.machine import describe as machine
 from implgen.bench.solvers_high import degree_table, high_targets
 from implgen.errors import UserError
 from implgen.roots.cases import CASE_SETS, HIGH_CASE_SETS, HIGH_RAYS, CaseSet, find_shapes_dir
@@ -156,22 +155,6 @@ def _fmt_share(v: float) -> str:
 
 def _fmt_med(v: list) -> str:
     return f"{np.median(v):.1e}" if v else "-"
-
-
-def machine() -> str:
-    model = platform.processor() or "unknown CPU"
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True, check=False).stdout
-        for line in out.splitlines():
-            if line.startswith("Model name:"):
-                model = line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    import os
-
-    return (
-        f"{model}, {os.cpu_count()} cores, {platform.system()} {platform.machine()}, Python {platform.python_version()}"
-    )
 
 
 def _worst(r: Row) -> float:

@@ -13,7 +13,6 @@ they build each scene's library through their own content-hash cache (docs/anima
 from __future__ import annotations
 
 import logging
-import os
 import re
 import secrets
 from collections import deque
@@ -69,7 +68,9 @@ def connect(local_workers: int | None = None, address: str | None = None, thread
 
 def local_threads(workers: int) -> int:
     """Render threads per task when `workers` processes share this machine's cores."""
-    return max(1, (os.cpu_count() or 1) // max(1, workers))
+    from implgen.scene.render import usable_cores
+
+    return max(1, usable_cores() // max(1, workers))
 
 
 def tag_of(index: Any) -> str:

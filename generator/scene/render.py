@@ -41,6 +41,15 @@ class RenderInfo:
     nonfinite: int = 0  # samples that came out NaN/inf (rendered as 0); should always be 0
 
 
+def usable_cores() -> int:
+    """The cores this process may run on (a container or `taskset` may allow fewer than the machine has):
+    the default thread count, and the count at which the tracer keeps each thread on its own core."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 def _as_scene(scene: Scene | str | Path | dict) -> Scene:
     if isinstance(scene, Scene):
         return scene
@@ -73,7 +82,7 @@ def render(
     h = height or sc.height
     n = spp or sc.spp
     depth = sc.max_depth if max_depth is None else max_depth
-    nthreads = threads or os.cpu_count() or 1
+    nthreads = threads or usable_cores()
     for option, v, lo, hi in (
         ("--width", w, 1, MAX_SIZE),
         ("--height", h, 1, MAX_SIZE),

@@ -17,7 +17,6 @@ import asyncio
 import ctypes
 import io
 import logging
-import os
 import struct
 import tempfile
 import time
@@ -31,7 +30,7 @@ from PIL import Image
 from implgen.errors import UserError
 from implgen.scene.build import BuildResult, build_scene, plan_shapes
 from implgen.scene.model import Scene
-from implgen.scene.render import render, to_uint8, write_png
+from implgen.scene.render import render, to_uint8, usable_cores, write_png
 from implgen.scene.tracer import CScene
 from implgen.view import dump, protocol
 from implgen.view.document import Document
@@ -61,7 +60,7 @@ class Session:
     def __init__(self, doc: Document, send: Send, threads: int | None = None):
         self.doc = doc
         self.send = send
-        self.threads = threads or os.cpu_count() or 1
+        self.threads = threads or usable_cores()
         self._libs: dict[tuple, object] = {}  # spec ids of a scene's shapes -> built library path
         self._pending: protocol.RenderRequest | None = None
         self._wake = asyncio.Event()
