@@ -30,6 +30,28 @@ def describe(value: Any) -> str:
     return f"a {type(value).__name__}"
 
 
+def key_name(k: Any) -> str:
+    """A mapping key as it appears in a message: the key itself when it is a plain name, else described."""
+    return k if isinstance(k, str) and k.isidentifier() else describe(k)
+
+
+def mapping(
+    source: str, key: str, value: Any, allowed: tuple[str, ...], required: tuple[str, ...] = (), what: str = ""
+) -> dict:
+    """`value` is a mapping with only `allowed` keys and every `required` one; `what` says what it should
+    hold, for the message when it is not a mapping at all."""
+    if not isinstance(value, dict):
+        raise _fail(source, key, f"expected a mapping{' with ' + what if what else ''}")
+    for k in value:
+        if k not in allowed:
+            name = key_name(k)
+            raise _fail(source, f"{key}.{name}" if key else name, f"unknown key (allowed: {', '.join(allowed)})")
+    for k in required:
+        if k not in value:
+            raise _fail(source, key, f"missing key {k!r}")
+    return value
+
+
 def _fail(source: str, key: str, message: str) -> UserError:
     return UserError(source, f"{key}: {message}" if key else message)
 

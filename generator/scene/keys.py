@@ -74,13 +74,7 @@ def is_keyed(value: Any) -> bool:
 def parse_animation(source: str, raw: Any) -> Animation:
     if raw is None:
         return Animation()
-    if not isinstance(raw, dict):
-        raise UserError(source, "animation: expected a mapping with 'frames' (and optionally 'fps')")
-    for k in raw:
-        if k not in ANIMATION_KEYS:
-            raise UserError(source, f"animation.{_name(k)}: unknown key (allowed: {', '.join(ANIMATION_KEYS)})")
-    if "frames" not in raw:
-        raise UserError(source, "animation: missing key 'frames'")
+    validate.mapping(source, "animation", raw, ANIMATION_KEYS, ("frames",), "'frames' (and optionally 'fps')")
     frames = validate.whole(source, "animation.frames", raw["frames"], 1, MAX_FRAMES)
     fps = validate.number(source, "animation.fps", raw.get("fps", DEFAULT_FPS), 0.0, MAX_FPS, lo_open=True)
     return Animation(frames=frames, fps=fps)
@@ -91,9 +85,7 @@ def parse_keyed(source: str, key: str, raw: dict, frames: int | None) -> Keyed:
     `animation` block, where a keyed value has no meaning)."""
     if frames is None:
         raise UserError(source, f"{key}: a keyed value needs an 'animation' block at the top level")
-    for k in raw:
-        if k not in KEYED_KEYS:
-            raise UserError(source, f"{key}.{_name(k)}: unknown key (allowed: {', '.join(KEYED_KEYS)})")
+    validate.mapping(source, key, raw, KEYED_KEYS)
     ease = raw.get("ease", "linear")
     if ease not in EASES:
         raise UserError(source, f"{key}.ease: {validate.describe(ease)} is not one of {', '.join(EASES)}")
@@ -116,10 +108,6 @@ def parse_keyed(source: str, key: str, raw: dict, frames: int | None) -> Keyed:
     return Keyed(frames=tuple(f for f, _ in items), values=tuple(v for _, v in items), ease=ease)
 
 
-def _name(k: Any) -> str:
-    return k if isinstance(k, str) and k.isidentifier() else validate.describe(k)
-
-
 def resolve(source: str, key: str, raw: Any, frame: int, frames: int | None, seen: list[str]) -> Any:
     """`raw` with every keyed value inside it replaced by its value at `frame` (for parts of a scene where
     every leaf is a number, such as a transform). The key paths of the keyed values found go to `seen`."""
@@ -127,7 +115,7 @@ def resolve(source: str, key: str, raw: Any, frame: int, frames: int | None, see
         seen.append(key)
         return parse_keyed(source, key, raw, frames).at(frame)
     if isinstance(raw, dict):
-        return {k: resolve(source, f"{key}.{_name(k)}", v, frame, frames, seen) for k, v in raw.items()}
+        return {k: resolve(source, f"{key}.{validate.key_name(k)}", v, frame, frames, seen) for k, v in raw.items()}
     if isinstance(raw, list):
         return [resolve(source, f"{key}[{i}]", v, frame, frames, seen) for i, v in enumerate(raw)]
     return raw
@@ -159,7 +147,7 @@ def inline_params(source: str, key: str, raw: Any, frames: int | None) -> tuple[
     if not isinstance(raw, dict):
         return raw, {}  # the spec parser says what is wrong with it
     keyed = {k: v for k, v in raw.items() if is_keyed(v)}
-    first = {k: parse_keyed(source, f"{key}.{_name(k)}", v, frames).values[0] for k, v in keyed.items()}
+    first = {k: parse_keyed(source, f"{key}.{validate.key_name(k)}", v, frames).values[0] for k, v in keyed.items()}
     return {**raw, **first}, keyed
 
 
@@ -182,13 +170,7 @@ def orbit_camera(
         if k in cam:
             raise UserError(source, f"camera.{k}: not with camera.orbit (the orbit sets it)")
     raw = cam["orbit"]
-    if not isinstance(raw, dict):
-        raise UserError(source, "camera.orbit: expected a mapping with 'radius' (and center, height, turns)")
-    for k in raw:
-        if k not in ORBIT_KEYS:
-            raise UserError(source, f"camera.orbit.{_name(k)}: unknown key (allowed: {', '.join(ORBIT_KEYS)})")
-    if "radius" not in raw:
-        raise UserError(source, "camera.orbit: missing key 'radius'")
+    validate.mapping(source, "camera.orbit", raw, ORBIT_KEYS, ("radius",), "'radius' (and center, height, turns)")
 
     def num(key: str, value: Any, lo: float, hi: float, lo_open: bool = False) -> float:
         def check(k: str, v: Any) -> float:

@@ -102,13 +102,7 @@ class _Ctx:
 
 
 def _mapping(ctx: _Ctx, key: str, value: Any, allowed: tuple[str, ...]) -> dict:
-    if not isinstance(value, dict):
-        raise ctx.fail(key, "expected a mapping")
-    for k in value:
-        if k not in allowed:
-            name = k if isinstance(k, str) and k.isidentifier() else validate.describe(k)
-            raise ctx.fail(f"{key}.{name}" if key else str(name), f"unknown key (allowed: {', '.join(allowed)})")
-    return value
+    return validate.mapping(ctx.source, key, value, allowed)
 
 
 def _num(
