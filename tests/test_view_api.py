@@ -25,7 +25,7 @@ from implgen.view import session as session_mod
 from implgen.view.command import document_factory
 from implgen.view.document import Document
 from implgen.view.protocol import MAX_MESSAGE
-from implgen.view.server import create_app
+from implgen.view.server import create_app, origin_allowed
 from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_SAVE, Session
 
 SCENES = ROOT / "examples" / "scenes"
@@ -298,3 +298,44 @@ def test_a_new_equation_drops_the_old_shapes_bounds() -> None:
     doc.set_spec(ball)
     sc = doc.scene(8, 8, 1)
     assert CScene(sc, build.build_scene(sc)).intersect([0, 5, 0], [0, -1, 0]).t == pytest.approx(4.0, abs=1e-12)
+
+
+@pytest.mark.parametrize(
+    "headers, allowed, ok",
+    [
+        ({"host": "127.0.0.1:8765", "origin": "http://127.0.0.1:8765"}, ("127.0.0.1", "localhost", "::1"), True),
+        ({"host": "localhost:8765", "origin": "http://localhost:8765"}, ("127.0.0.1", "localhost", "::1"), True),
+        ({"host": "[::1]:8765", "origin": "http://[::1]:8765"}, ("127.0.0.1", "localhost", "::1"), True),
+        ({"host": "127.0.0.1:8765"}, ("127.0.0.1",), True),  # not a browser: no Origin
+        ({"host": "127.0.0.1:8765", "origin": "http://evil.example"}, ("127.0.0.1",), False),  # another site
+        ({"host": "127.0.0.1:8765", "origin": "http://127.0.0.1:9999"}, ("127.0.0.1",), False),  # another port
+        ({"host": "evil.example:8765", "origin": "http://evil.example:8765"}, ("127.0.0.1",), False),  # rebinding
+        ({"host": "evil.example:8765", "origin": "http://evil.example:8765"}, None, True),  # --host 0.0.0.0
+        ({"host": "10.0.0.5:8765", "origin": "http://evil.example"}, None, False),
+    ],
+)
+def test_the_socket_takes_only_the_pages_own_origin(headers, allowed, ok):
+    assert origin_allowed(headers, allowed) is ok
+
+
+def test_a_foreign_origin_or_host_is_turned_away_before_any_work():
+    from starlette.websockets import WebSocketDisconnect
+
+    made = []
+
+    def make():
+        made.append(1)
+        return document_factory(None)()
+
+    with TestClient(create_app(make, threads=2)) as c:
+        with pytest.raises(WebSocketDisconnect) as err:
+            with c.websocket_connect("/ws", headers={"origin": "http://evil.example"}) as ws:
+                ws.receive_json()
+        assert err.value.code == 1008
+        with c.websocket_connect("/ws", headers={"origin": "http://testserver"}) as ws:
+            assert ws.receive_json()["type"] == "hello"
+    with TestClient(create_app(make, threads=2, allowed_hosts=("127.0.0.1", "localhost", "::1"))) as c:
+        with pytest.raises(WebSocketDisconnect):  # the test client's Host is `testserver`, as a rebound name
+            with c.websocket_connect("/ws") as ws:
+                ws.receive_json()
+    assert len(made) == 1  # only the accepted page got a document

@@ -63,11 +63,12 @@ def serve(sock: socket.socket, make_document, threads: int | None = None, on_rea
     import uvicorn
 
     from implgen.view.protocol import MAX_MESSAGE
-    from implgen.view.server import create_app
+    from implgen.view.server import LOOPBACK_HOSTS, create_app
 
-    config = uvicorn.Config(
-        create_app(make_document, threads=threads), log_level="warning", ws_max_size=MAX_MESSAGE, lifespan="off"
-    )
+    host = sock.getsockname()[0]
+    loopback = host in LOOPBACK_HOSTS or host.startswith("127.")
+    app = create_app(make_document, threads=threads, allowed_hosts=(*LOOPBACK_HOSTS, host) if loopback else None)
+    config = uvicorn.Config(app, log_level="warning", ws_max_size=MAX_MESSAGE, lifespan="off")
     server = uvicorn.Server(config)
     if on_ready is not None:
         on_ready(server)

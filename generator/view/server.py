@@ -2,12 +2,17 @@
 
 Nothing else is served: the static files are a fixed table read from the package, not a folder mapped onto
 URLs. Messages are bounded (uvicorn's ws_max_size and protocol.MAX_MESSAGE); each page gets its own Session.
+
+Browsers let any web page open a WebSocket to 127.0.0.1, so the socket accepts a browser's connection only
+from the page's own origin (Origin equal to the Host the request was sent to), and, when the server listens
+on a loopback address, only under a loopback host name: a foreign site, or one that re-binds its DNS name to
+127.0.0.1, cannot drive the renderer.
 """
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from importlib import resources
 
 from starlette.applications import Starlette
@@ -31,6 +36,24 @@ HEADERS = {
     "Content-Security-Policy": "default-src 'self'; img-src 'self' blob: data:; connect-src 'self'",
 }
 MAX_PAGES = 8  # pages connected at once
+LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "::1")
+
+
+def _host_name(host: str) -> str:
+    """`Host` header -> host name without the port (`[::1]:8765` -> `::1`)."""
+    if host.startswith("["):
+        return host[1 : host.find("]")] if "]" in host else host
+    return host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+
+
+def origin_allowed(headers, allowed_hosts: Sequence[str] | None) -> bool:
+    """Whether a request with these headers may use the socket: its Host among `allowed_hosts` (None: any),
+    and an Origin, when the client sends one (browsers always do), equal to the page's own."""
+    host = headers.get("host", "")
+    if allowed_hosts is not None and _host_name(host).lower() not in allowed_hosts:
+        return False
+    origin = headers.get("origin")
+    return origin is None or origin.lower() in (f"http://{host}".lower(), f"https://{host}".lower())
 
 
 def _static(name: str, media: str) -> Callable:
@@ -42,11 +65,17 @@ def _static(name: str, media: str) -> Callable:
     return serve
 
 
-def create_app(make_document: Callable[[], Document], threads: int | None = None) -> Starlette:
-    """The app; `make_document` gives each new page its own copy of the starting state."""
+def create_app(
+    make_document: Callable[[], Document], threads: int | None = None, allowed_hosts: Sequence[str] | None = None
+) -> Starlette:
+    """The app; `make_document` gives each new page its own copy of the starting state. `allowed_hosts`: the
+    host names the page may be reached under (None: any, for a server listening beyond this machine)."""
     pages = {"open": 0}
 
     async def frames(ws: WebSocket) -> None:
+        if not origin_allowed(ws.headers, allowed_hosts):
+            await ws.close(code=1008, reason="not this page's origin")
+            return
         await ws.accept()
         if pages["open"] >= MAX_PAGES:
             await ws.close(code=1013, reason="too many pages open")
