@@ -58,7 +58,10 @@ def main(argv: Sequence[str]) -> int:
         fold=args.fold or DEFAULT_FOLD,
         info=info,
     )
-    write_png(img, args.output)
+    try:
+        write_png(img, args.output)
+    except OSError as err:  # what the early check could not foresee: a full disk, a folder removed meanwhile
+        raise UserError(f"-o {args.output}", f"cannot write: {err.strerror or err}") from None
     total = sum(info.rays.values())
     print(
         f"implgen: wrote {args.output} ({img.shape[1]}x{img.shape[0]}, {info.seconds:.3f} s on "
