@@ -8,6 +8,7 @@ the CLI prints one line and exits with status 2 before anything is compiled or w
 from __future__ import annotations
 
 import heapq
+import os
 from pathlib import Path
 from typing import Any
 
@@ -165,6 +166,8 @@ def _find_spec_file(ctx: _Ctx, key: str, p: Path) -> Path:
         for c in candidates:
             if c.exists():
                 return c.resolve()  # whatever it is: read_yaml says what is wrong with it
+            if os.path.lexists(c):
+                raise ctx.fail(key, f"{c} is a link to nothing (a missing target or a loop of links)")
     except (OSError, RuntimeError) as err:  # a name too long, a loop of links
         raise ctx.fail(key, f"cannot use this path ({getattr(err, 'strerror', None) or err})") from None
     tried = " or ".join(str(c) for c in candidates)
@@ -189,7 +192,10 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
         path = _resolve_shape_path(ctx, f"{key}.shape", raw["shape"])
         if path not in ctx.spec_cache:
             ctx.count_shape(f"{key}.shape")
-            ctx.spec_cache[path] = load_spec(path)
+            try:
+                ctx.spec_cache[path] = load_spec(path)
+            except UserError as err:  # the spec file's own message, after the scene's key that names it
+                raise ctx.fail(f"{key}.shape", str(err)) from None
         spec = ctx.spec_cache[path]
         overrides = raw.get("params") or {}
     else:
