@@ -14,6 +14,7 @@ import pytest
 from bad_input_harness import FIFO, FOLDER, SPHERE, Case, Link, check, run_batch
 
 BIG = "9" * 400
+TORUS = SPHERE.replace("sphere.yaml", "torus_y.yaml")
 OBJ = f"objects: [{{shape: {SPHERE}}}]\n"
 LEAF = f"{{shape: {SPHERE}}}"
 
@@ -231,6 +232,22 @@ CASES += [
     leaf("param-unknown", "params: {q: 1}", "objects[0].params.q: shape 'sphere' has no param 'q'"),
     leaf("param-huge", f"params: {{r: {BIG}}}", "objects[0].params.r: a number of about 1e400"),
     leaf("param-nan", "params: {r: .nan}", "objects[0].params.r: expected a finite number"),
+    leaf(
+        "param-bounds-empty",
+        "params: {r: -1}",
+        "objects[0].params: with these params the bounds of shape 'sphere' are empty",
+    ),
+    objects(
+        "param-bounds-beyond",
+        f"[{{shape: {TORUS}, params: {{a: 1e9, b: 1e9}}}}]",
+        "objects[0].params: with these params the bounds of shape 'torus_y' leave",
+    ),
+    scene(
+        "param-power-overflow",
+        "objects: [{shape: p.yaml, params: {a: 1e9}}]\n",
+        "objects[0].params: with these params a coefficient of shape 'p' reaches 2^1196",
+        {"p.yaml": "name: p\nequation: x^2 + y^2 + z^2 - a^40 + 1\nparams: {a: 1}\n"},
+    ),
     leaf("params-list", "params: [1]", "objects[0].params: expected a mapping"),
     leaf("leaf-unknown-key", "colour: red", "objects[0].colour: unknown key"),
     objects("inline-injection", "[{equation: 'y # */ int pwned; /*'}]", "objects[0]: equation: character '#'"),

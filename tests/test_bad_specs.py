@@ -145,6 +145,13 @@ CASES += [
     equation("degree-bomb-huge-exponent", "(x+1)^99999999999999999999", "degree would exceed 24"),
     equation("degree-product-chain", "*".join(["(x+y+1)"] * 30), "degree would exceed 24"),
     equation("degree-mult-chain", "*".join(["x"] * 3000), "nested"),
+    equation(
+        "param-power-overflow",
+        "x^2 + y^2 + z^2 - a^40",
+        "params: with these params a coefficient",
+        "params: {a: 1e9}\n",
+    ),
+    equation("param-power-overflow-product", "x*a^20*b^20 + y", "reaches 2^", "params: {a: 1e9, b: 1e9}\n"),
     equation("param-degree-bomb", "x + a^100", "parameters raised to a degree above 64", "params: {a: 1}\n"),
     equation("exponent-float", "x^2.5 + y", "non-negative integer"),
     equation("exponent-param", "x^a", "exponent must be a constant", "params: {a: 2}\n"),

@@ -363,3 +363,32 @@ def test_python_syntax_warnings_are_syntax_errors_and_print_nothing(text, recwar
     with pytest.raises(UserError, match="equation: syntax error|not a polynomial"):
         parse_spec({"name": "s", "equation": text}, "<t>")
     assert not [w for w in recwarn if issubclass(w.category, SyntaxWarning)]
+
+
+# ------------------------------------------------------------------------------------ param values
+
+
+def test_param_values_that_overflow_a_coefficient_are_refused():
+    """Each param is within range, but a^40 with a = 1e9 is 1e360: refused with the key named. The test is on
+    the exact terms (log2 |c| + sum e log2 |p|), so a = 1e9 to the 30th power (2^897) passes, and a zero param
+    makes its terms vanish."""
+    from implgen.codegen.spec import parse_spec
+
+    spec = parse_spec({"name": "p", "equation": "x^2 + y^2 + z^2 - a^30 - b^40", "params": {"a": 1, "b": 1}}, "<t>")
+    spec.check_values({"a": 1e9, "b": 0.0}, "<t>", "objects[0].params")
+    with pytest.raises(UserError, match=r"objects\[0\].params: with these params a coefficient of shape 'p' reaches"):
+        spec.check_values({"a": 1.0, "b": 1e9}, "<t>", "objects[0].params")
+    with pytest.raises(UserError, match="params: with these params"):
+        parse_spec({"name": "p", "equation": "x - a^40", "params": {"a": 1e9}}, "<t>")
+
+
+def test_param_values_must_keep_the_bounds_a_box():
+    from implgen.codegen.spec import load_spec
+
+    torus = load_spec(ROOT / "examples" / "shapes" / "torus_y.yaml")
+    torus.check_values({"a": 2.0, "b": 0.5}, "<t>", "k")
+    assert torus.box({"a": 2.0, "b": 0.5}) == [-2.5, -0.5, -2.5, 2.5, 0.5, 2.5]
+    with pytest.raises(UserError, match="k: with these params the bounds of shape 'torus_y' are empty along y"):
+        torus.check_values({"b": -0.5}, "<t>", "k")
+    with pytest.raises(UserError, match="leave"):
+        torus.check_values({"a": 1e9, "b": 1e9}, "<t>", "k")

@@ -217,6 +217,8 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
             where = f"{key}.params.{name}" if isinstance(name, str) and name.isidentifier() else f"{key}.params"
             raise ctx.fail(where, f"shape {spec.name!r} has no param {validate.describe(name)} (params: {known})")
         params[name] = _num(ctx, f"{key}.params.{name}", v)
+    if overrides:
+        spec.check_values(params, ctx.source, f"{key}.params")
     m = tf.parse_transform(ctx.source, f"{key}.transform", raw.get("transform"))
     mat = _material_ref(ctx, f"{key}.material", raw["material"], named) if "material" in raw else None
     return Leaf(spec=spec, params=params, matrix=m, material=mat, where=key)
