@@ -34,6 +34,8 @@ MAX_NESTING = 100  # parentheses / operator nesting a user could mean
 MAX_CONST_BITS = 256  # numerators and denominators of constants stay below 2^256 (about 1e77)
 MAX_DIGITS = 80  # digits in one number as written
 _LONG_NUMBER = re.compile(rf"[0-9_]{{{MAX_DIGITS + 1},}}")
+MAX_EXPONENT = 400  # |e| in 1.5e-7 as written; every constant stays within 2^±256 anyway
+_EXPONENT = re.compile(r"[eE]([-+]?[0-9_]+)$")
 ALPHABET = frozenset(string.ascii_letters + string.digits + " \t\n._+-*/^()=")
 
 
@@ -114,6 +116,10 @@ class _Builder:
                 raise ParseError("number is not finite")
             # The literal as written ("0.1") is exact as a decimal fraction: keep it exact.
             segment = ast.get_source_segment(self.text, node) or repr(value)
+            exponent = _EXPONENT.search(segment)
+            if exponent and abs(int(exponent.group(1).replace("_", ""))) > MAX_EXPONENT:
+                # 1e-99999999 underflows to a finite 0.0, but its exact value needs 10^99999999
+                raise ParseError(f"number {segment[:30]!r} has an exponent beyond ±{MAX_EXPONENT}")
             try:
                 frac = Fraction(segment.replace("_", ""))
             except ValueError:
@@ -194,7 +200,8 @@ class _Builder:
 def _bounded(value: sympy.Rational) -> sympy.Rational:
     if max(abs(value.p).bit_length(), abs(value.q).bit_length()) > MAX_CONST_BITS:
         raise ParseError(
-            f"constant too large: numerator and denominator must stay below 2^{MAX_CONST_BITS} (about 1e77)"
+            f"constant too large or too small: numerator and denominator must stay below 2^{MAX_CONST_BITS} "
+            "(about 1e77)"
         )
     return value
 
