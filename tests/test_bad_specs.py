@@ -116,6 +116,9 @@ BIG = "9" * 400
 CASES += [
     spec("param-huge-int", f"name: s\nequation: x - a\nparams: {{a: {BIG}}}\n", "a number of about 1e400 is outside"),
     spec("param-huge-negative", f"name: s\nequation: x - a\nparams: {{a: -{BIG}}}\n", "is outside"),
+    spec(
+        "param-over-4300-digits", "name: s\nequation: x - a\nparams: {a: " + "9" * 5000 + "}\n", "more than 4300 digits"
+    ),
     spec("param-1e400", "name: s\nequation: x - a\nparams: {a: 1e400}\n", "finite number, not inf"),
     spec("param-text-1e400", "name: s\nequation: x - a\nparams: {a: '1e400'}\n", "finite number, not inf"),
     spec("param-text-nan", "name: s\nequation: x - a\nparams: {a: 'nan'}\n", "finite number, not nan"),

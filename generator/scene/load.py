@@ -85,6 +85,13 @@ class _Ctx:
             raise self.fail(key, f"more than {MAX_SHAPES} distinct shapes in one scene")
 
 
+def _given(raw: dict, key: str, default: Any) -> Any:
+    """raw[key], or `default` when the key is left out or empty (`lights:`); `0` or `[]` where a mapping
+    belongs is an error the caller reports, not a default."""
+    value = raw.get(key)
+    return default if value is None else value
+
+
 def _mapping(ctx: _Ctx, key: str, value: Any, allowed: tuple[str, ...]) -> dict:
     if not isinstance(value, dict):
         raise ctx.fail(key, "expected a mapping")
@@ -197,7 +204,7 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
             except UserError as err:  # the spec file's own message, after the scene's key that names it
                 raise ctx.fail(f"{key}.shape", str(err)) from None
         spec = ctx.spec_cache[path]
-        overrides = raw.get("params") or {}
+        overrides = _given(raw, "params", {})
     else:
         ctx.count_shape(f"{key}.equation")
         ctx.inline_count += 1
@@ -288,12 +295,12 @@ def parse_scene(data: Any, source: str | Path = "<scene>") -> Scene:
         raise UserError(ctx.source, "a scene must be a mapping with at least 'objects'")
     _mapping(ctx, "", data, TOP_KEYS)
     sc = Scene(source=ctx.source)
-    img = _mapping(ctx, "image", data.get("image") or {}, IMAGE_KEYS)
+    img = _mapping(ctx, "image", _given(data, "image", {}), IMAGE_KEYS)
     sc.width = _int(ctx, "image.width", img.get("width", sc.width), 1, MAX_SIZE)
     sc.height = _int(ctx, "image.height", img.get("height", sc.height), 1, MAX_SIZE)
     sc.spp = _int(ctx, "image.spp", img.get("spp", sc.spp), 1, MAX_SPP)
     sc.max_depth = _int(ctx, "image.max_depth", img.get("max_depth", sc.max_depth), 0, MAX_DEPTH)
-    cam = _mapping(ctx, "camera", data.get("camera") or {}, CAMERA_KEYS)
+    cam = _mapping(ctx, "camera", _given(data, "camera", {}), CAMERA_KEYS)
     c = Camera()
     if "position" in cam:
         c.position = _vec(ctx, "camera.position", cam["position"])
@@ -311,7 +318,7 @@ def parse_scene(data: Any, source: str | Path = "<scene>") -> Scene:
     sc.camera = c
     if "background" in data:
         sc.background = _color(ctx, "background", data["background"])
-    lights = data.get("lights") or []
+    lights = _given(data, "lights", [])
     if not isinstance(lights, list):
         raise ctx.fail("lights", "expected a list")
     for i, raw in enumerate(lights):
@@ -322,7 +329,7 @@ def parse_scene(data: Any, source: str | Path = "<scene>") -> Scene:
         k = _num(ctx, f"lights[{i}].intensity", raw.get("intensity", 1.0), 0.0, INTENSITY_MAX)
         sc.lights.append(Light(_vec(ctx, f"lights[{i}].position", raw["position"]), tuple(k * x for x in col)))
     named: dict[str, Material] = {}
-    mats = data.get("materials") or {}
+    mats = _given(data, "materials", {})
     if not isinstance(mats, dict):
         raise ctx.fail("materials", "expected a mapping name -> material")
     for name, raw in mats.items():
