@@ -349,6 +349,19 @@ def broken(draw: st.DrawFn, documents: st.SearchStrategy[Any]) -> tuple[str, Any
     return how, doc
 
 
+# Values no key of a spec or scene accepts, wherever they are put: a document holding one must be refused.
+NEVER_VALID = [10**400, -(10**400), float("nan"), float("inf"), _deep_list(60), {"zq": []}, [[[]]]]
+
+
+@st.composite
+def poisoned(draw: st.DrawFn, documents: st.SearchStrategy[Any]) -> tuple[tuple, Any]:
+    """(the path, the document) from a valid document with one value replaced by one no key accepts."""
+    doc = copy.deepcopy(draw(documents))
+    path = draw(st.sampled_from(_paths(doc)[::-1]))
+    _container(doc, path)[path[-1]] = copy.deepcopy(draw(st.sampled_from(NEVER_VALID)))
+    return path, doc
+
+
 # ------------------------------------------------------------------------------------------------ scenes
 
 colours = vec(unit)

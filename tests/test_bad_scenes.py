@@ -165,6 +165,7 @@ CASES += [
     leaf("axes-with-scale", "transform: {axes: [[1, 0, 0], [0, 1, 0], [0, 0, 1]], scale: 2}", "transform.scale"),
     leaf("transform-unknown", "transform: {shear: 1}", "transform.shear: unknown key"),
     leaf("transform-text", "transform: big", "objects[0].transform: expected a mapping"),
+    leaf("transform-nested-list", "transform: [[{scale: 2}]]", "objects[0].transform[0]: expected a mapping"),
     objects(
         "csg-transform-composed",
         f"[{{union: [{{shape: {SPHERE}, transform: {{scale: 1e3}}}}, {LEAF}], transform: {{scale: 1e4}}}}]",

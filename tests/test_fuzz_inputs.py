@@ -35,6 +35,7 @@ from fuzz_strategies import (
     example_files,
     expressions,
     mutated,
+    poisoned,
     scenes,
     specs,
 )
@@ -159,6 +160,19 @@ def test_spec_loader_broken_specs(work, case):
     assert spec is not None or message.startswith(f"{path}: "), message
 
 
+@fuzz_settings(150)
+@given(poisoned(specs()))
+def test_spec_with_a_value_no_key_accepts_is_refused(work, case):
+    """A huge integer, NaN, inf, a deep list or a stray mapping anywhere in a spec: refused, never read as
+    something else (left out, a default, text)."""
+    where, doc = case
+    path = work / "specs" / "poisoned.yaml"
+    path.write_text(dump(doc), encoding="utf-8")
+    spec, message = outcome(load_spec, path)
+    assert spec is None, f"accepted with {where} poisoned"
+    assert message.startswith(f"{path}: "), message
+
+
 @fuzz_settings(40)
 @given(st.one_of(specs().map(lambda d: ("valid", d)), broken(specs())))
 def test_spec_generation_writes_only_the_parsed_text(work, case):
@@ -207,6 +221,17 @@ def test_scene_loader_broken_scenes(work, case):
     if scene is None:
         assert message.startswith(f"{path}: "), message
         _refusal_through_cli(work, path)
+
+
+@fuzz_settings(150)
+@given(poisoned(scenes()))
+def test_scene_with_a_value_no_key_accepts_is_refused(work, case):
+    where, doc = case
+    path = work / "scenes" / "poisoned.yaml"
+    path.write_text(dump(doc), encoding="utf-8")
+    scene, message = outcome(load_scene, path)
+    assert scene is None, f"accepted with {where} poisoned"
+    assert message.startswith(f"{path}: "), message
 
 
 # ---------------------------------------------------------------------------------- raw text mutation
