@@ -263,6 +263,10 @@ CASES += [
     Case("option-no-spec", ["-o", "out"], "the following arguments are required: SPEC.yaml", names="command line"),
     Case("option-o-without-value", [SPHERE, "-o"], "expected one argument", names="-o"),
     Case("bench-unknown", ["bench", "nothing"], "choose one of", names="bench"),
+    Case("bench-gen-option", ["bench", "gen", "--nope"], "unrecognized arguments: --nope", names="implgen bench gen"),
+    Case("bench-solvers-option", ["bench", "solvers", "--timed", "x"], "argument --timed", names="bench solvers"),
+    Case("bench-render-option", ["bench", "render", "--width", "x"], "argument --width", names="bench render"),
+    Case("demo-option", ["demo", "--x"], "unrecognized arguments: --x", names="implgen demo"),
     Case(
         "two-specs-same-name",
         ["a.yaml", "b.yaml", "-o", "out"],

@@ -10,12 +10,12 @@ interleaved, best of 3).
 
 from __future__ import annotations
 
-import argparse
 import os
 import platform
 from collections.abc import Sequence
 from pathlib import Path
 
+from implgen.cli import ArgumentParser
 from implgen.errors import UserError
 from implgen.scene.build import build_scene
 from implgen.scene.load import load_scene
@@ -38,7 +38,7 @@ def _cpu() -> str:
 
 
 def main(argv: Sequence[str]) -> int:
-    ap = argparse.ArgumentParser(prog="implgen bench render")
+    ap = ArgumentParser(prog="implgen bench render")
     ap.add_argument("scenes", nargs="*", type=Path)
     ap.add_argument("--width", type=int, default=800)
     ap.add_argument("--height", type=int, default=600)

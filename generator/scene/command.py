@@ -9,8 +9,8 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
+from implgen.cli import ArgumentParser
 from implgen.errors import UserError
 from implgen.outputs import check_output_file
 from implgen.scene.load import load_scene
@@ -27,13 +27,8 @@ def _positive(text: str) -> int:
     return v
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> Any:  # one line, exit 2, through UserError like every bad input
-        raise UserError("render", message)
-
-
 def main(argv: Sequence[str]) -> int:
-    ap = _Parser(prog="implgen render", description="Render a scene file to a PNG.")
+    ap = ArgumentParser(label="render", prog="implgen render", description="Render a scene file to a PNG.")
     ap.add_argument("scene", type=Path)
     ap.add_argument("-o", "--output", type=Path, required=True, help="PNG to write")
     ap.add_argument("--width", type=_positive)
