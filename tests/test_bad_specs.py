@@ -150,6 +150,15 @@ CASES += [
     equation("degree-bomb-tower", "x^(2^64)", "degree would exceed 24"),
     equation("degree-bomb-huge-exponent", "(x+1)^99999999999999999999", "degree would exceed 24"),
     equation("degree-product-chain", "*".join(["(x+y+1)"] * 30), "degree would exceed 24"),
+    equation(
+        "expanded-degree-24-too-large",
+        " + ".join(
+            f"{i % 7 + 1}*x^{a}*y^{b}*z^{24 - a - b}"
+            for i, (a, b) in enumerate((a, b) for a in range(25) for b in range(25 - a))
+            if i < 200
+        ),
+        "too large to generate in bounded time",
+    ),
     equation("degree-mult-chain", "*".join(["x"] * 3000), "nested"),
     equation(
         "param-power-overflow",

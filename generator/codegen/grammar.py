@@ -75,6 +75,19 @@ class _Builder:
         self.params = params
         self.max_degree = max_degree
         self.max_param_degree = max_param_degree
+        self._line_starts: list[int] | None = None
+
+    def _segment(self, node: ast.AST) -> str | None:
+        """The text of `node`. ast.get_source_segment splits the whole text into lines on every call: once per
+        number, that made a long equation take quadratic time. The text is ASCII, so offsets are characters."""
+        if self._line_starts is None:
+            self._line_starts = [0] + [i + 1 for i, ch in enumerate(self.text) if ch == "\n"]
+        try:
+            start = self._line_starts[node.lineno - 1] + node.col_offset
+            end = self._line_starts[node.end_lineno - 1] + node.end_col_offset
+        except (AttributeError, TypeError, IndexError):
+            return None
+        return self.text[start:end]
 
     def build(self, node: ast.AST, depth: int = 0) -> Parsed:
         if depth > 4 * MAX_NESTING:
@@ -94,7 +107,7 @@ class _Builder:
         raise ParseError(self._refusal(node))
 
     def _refusal(self, node: ast.AST) -> str:
-        segment = ast.get_source_segment(self.text, node) or type(node).__name__
+        segment = self._segment(node) or type(node).__name__
         if isinstance(node, ast.Call):
             what = "function calls are not allowed"
         elif isinstance(node, ast.Attribute):
@@ -115,7 +128,7 @@ class _Builder:
             if value != value or value in (float("inf"), float("-inf")):
                 raise ParseError("number is not finite")
             # The literal as written ("0.1") is exact as a decimal fraction: keep it exact.
-            segment = ast.get_source_segment(self.text, node) or repr(value)
+            segment = self._segment(node) or repr(value)
             exponent = _EXPONENT.search(segment)
             if exponent and abs(int(exponent.group(1).replace("_", ""))) > MAX_EXPONENT:
                 # 1e-99999999 underflows to a finite 0.0, but its exact value needs 10^99999999
@@ -141,36 +154,53 @@ class _Builder:
             return self._power(node, depth)
         if not isinstance(op, (ast.Add, ast.Sub, ast.Mult, ast.Div)):
             raise ParseError(self._refusal(node))
+        if isinstance(op, (ast.Add, ast.Sub, ast.Mult)):
+            return self._chain(node, depth)
         left = self.build(node.left, depth + 1)
         right = self.build(node.right, depth + 1)
-        if isinstance(op, (ast.Add, ast.Sub)):
-            expr = left.expr + right.expr if isinstance(op, ast.Add) else left.expr - right.expr
-            return self._constant_checked(
-                Parsed(
-                    expr,
-                    max(left.degree_bound, right.degree_bound),
-                    max(left.param_degree_bound, right.param_degree_bound),
-                )
-            )
-        if isinstance(op, ast.Mult):
-            return self._checked(
-                left.expr * right.expr,
-                left.degree_bound + right.degree_bound,
-                left.param_degree_bound + right.param_degree_bound,
-            )
         # Division: by a non-zero constant only.
         if right.degree_bound or right.param_degree_bound or not right.expr.is_Rational:
-            segment = ast.get_source_segment(self.text, node.right) or "?"
+            segment = self._segment(node.right) or "?"
             raise ParseError(f"division by a non-constant ({segment[:40]}) is not polynomial")
         if right.expr == 0:
             raise ParseError("division by zero")
         return self._constant_checked(Parsed(left.expr / right.expr, left.degree_bound, left.param_degree_bound))
 
+    def _chain(self, node: ast.BinOp, depth: int) -> Parsed:
+        """`a + b - c + ...` or `a * b * c ...`: Python's parser makes a left-leaning tree as deep as the list
+        is long; walk it as the flat list it is, so a sum of 500 terms is not "nested too deeply"."""
+        adding = isinstance(node.op, (ast.Add, ast.Sub))
+        kinds = (ast.Add, ast.Sub) if adding else (ast.Mult,)
+        steps = []
+        while isinstance(node, ast.BinOp) and isinstance(node.op, kinds):
+            steps.append((node.op, node.right))
+            node = node.left
+        result = self.build(node, depth + 1)
+        terms = [result.expr]
+        for op, right in reversed(steps):
+            item = self.build(right, depth + 1)
+            if adding:
+                terms.append(-item.expr if isinstance(op, ast.Sub) else item.expr)
+                result = Parsed(
+                    result.expr,
+                    max(result.degree_bound, item.degree_bound),
+                    max(result.param_degree_bound, item.param_degree_bound),
+                )
+            else:
+                result = self._checked(
+                    result.expr * item.expr,
+                    result.degree_bound + item.degree_bound,
+                    result.param_degree_bound + item.param_degree_bound,
+                )
+        if adding:
+            result = Parsed(sympy.Add(*terms), result.degree_bound, result.param_degree_bound)
+        return self._constant_checked(result)
+
     def _power(self, node: ast.BinOp, depth: int) -> Parsed:
         base = self.build(node.left, depth + 1)
         exponent = self.build(node.right, depth + 1)
-        segment = (ast.get_source_segment(self.text, node.right) or "?")[:40]
         if exponent.degree_bound or exponent.param_degree_bound or not exponent.expr.is_Rational:
+            segment = (self._segment(node.right) or "?")[:40]
             raise ParseError(f"exponent must be a constant non-negative integer, not {segment!r}")
         if not exponent.expr.is_integer or exponent.expr < 0:
             raise ParseError(f"exponent must be a non-negative integer, not {exponent.expr}")

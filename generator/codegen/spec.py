@@ -34,6 +34,10 @@ MAX_PARAMS = 64
 MAX_DESCRIPTION = 2_000
 MAX_COEFF_BITS = 900  # |numerator|, |denominator| of every expanded coefficient (2^900 ~ 8e270: room
 # for the multinomial factors the ray coefficients multiply them by)
+# Generation time grows with the size of f as written times its degree (Taylor coefficients, then one cse):
+# about 1 s per 700 on the 2-core test machine, and faster than linear past that (an expanded degree-24
+# polynomial of 1150 terms, size 169,000, took 8.5 minutes). The example shapes are below 400.
+MAX_SIZE_DEGREE = 10_000
 AXES = ("x", "y", "z")
 KEYS = ("name", "equation", "params", "bounds", "description")
 X, Y, Z = sympy.symbols("x y z", real=True)
@@ -211,6 +215,13 @@ def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[s
         raise UserError(source, "equation: has no x, y or z (a constant, not a surface)")
     if degree > MAX_DEGREE:
         raise UserError(source, f"equation: degree {degree} is above the highest supported, {MAX_DEGREE}")
+    ops = int(sympy.count_ops(f))
+    if ops * degree > MAX_SIZE_DEGREE:
+        raise UserError(
+            source,
+            f"equation: too large to generate in bounded time: {ops} operations at degree {degree} "
+            f"(operations x degree at most {MAX_SIZE_DEGREE}; a factored form such as (x+y+z+1)^24 is small)",
+        )
     for coeff in poly.coeffs():
         if max(abs(int(coeff.numerator)).bit_length(), int(coeff.denominator).bit_length()) > MAX_COEFF_BITS:
             raise UserError(
