@@ -5,10 +5,11 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.implgen-installed
-SOURCES := pyproject.toml $(shell find generator templates runtime_c -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' \) 2>/dev/null)
+SOURCES := pyproject.toml $(shell find generator templates runtime_c -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' \
+                       -o -name '*.html' -o -name '*.js' -o -name '*.css' \) 2>/dev/null)
 C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c)
 
-.PHONY: demo test lint tools install regen gallery bench clean
+.PHONY: demo test lint tools browser screenshot install regen gallery bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -25,8 +26,17 @@ install: $(STAMP)
 demo: install
 	$(BIN)/implgen demo
 
-test: install
+test: install browser
 	$(BIN)/python -m pytest -q tests
+
+# Headless Chromium and its driver for the viewer's browser test (Debian packages; run as root, as CI does).
+browser:
+	@command -v chromium >/dev/null && command -v chromedriver >/dev/null || \
+	  { apt-get update -qq && apt-get install -y -qq chromium chromium-driver >/dev/null; }
+
+# The README's picture of `implgen view`, taken by the browser test.
+screenshot: install browser
+	IMPLGEN_SCREENSHOT=docs/gallery/view.png $(BIN)/python -m pytest -q tests/test_view_browser.py
 
 # Style, checked not changed: ruff (lint + format) for Python, clang-format (.clang-format) for the C runtime.
 lint: install

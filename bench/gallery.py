@@ -3,7 +3,8 @@
     .venv/bin/python bench/gallery.py [--scenes DIR] [-o DIR] [--threads N]   (or: make gallery)
 
 Prints a Markdown table (scene, size, samples, seconds, threads, rays by kind) and writes it next to the
-images as times.md, with the machine it ran on.
+images as times.md, with the machine it ran on. An animated scene (docs/animation.md) becomes a GIF of all
+its frames at half its size (GIF_SCALE), to stay small enough for the README.
 """
 
 from __future__ import annotations
@@ -15,8 +16,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+from implgen.scene.batch import Runner, render_frames
+from implgen.scene.frameout import plan_output
+from implgen.scene.frames import FrameOptions, load_frames
 from implgen.scene.load import load_scene
 from implgen.scene.render import RenderInfo, render, write_png
+
+GIF_SCALE = 2  # an animation's GIF is its image size divided by this
 
 
 def machine() -> str:
@@ -40,6 +46,11 @@ def main() -> int:
         "|---|---|---|---|---|---|",
     ]
     for path in sorted(args.scenes.glob("*.yaml")):
+        frames = load_frames(path)
+        if frames.animated:
+            rows.append(animation_row(path, frames, args))
+            print(rows[-1], flush=True)
+            continue
         scene = load_scene(path)
         info = RenderInfo()
         image = render(scene, threads=args.threads, progress=sys.stderr.isatty(), info=info)
@@ -54,6 +65,23 @@ def main() -> int:
     (args.output / "times.md").write_text(text, encoding="utf-8")
     print(f"\nwrote {args.output}/*.png and times.md")
     return 0
+
+
+def animation_row(path: Path, frames, args: argparse.Namespace) -> str:
+    """All frames of an animated scene as docs/gallery/<name>.gif (made afresh: old frames are not reused)."""
+    sc = frames.first
+    w, h = sc.width // GIF_SCALE // 2 * 2, sc.height // GIF_SCALE // 2 * 2
+    opts = FrameOptions(width=w, height=h, spp=sc.spp, max_depth=sc.max_depth, threads=args.threads)
+    target = args.output / f"{path.stem}.gif"
+    out = plan_output(target, frames.count, frames.count - 1, w, h)
+    for f in range(frames.count):
+        out.path(f).unlink(missing_ok=True)
+    report = render_frames(frames, range(frames.count), opts, out, Runner(), progress=sys.stderr.isatty())
+    size = target.stat().st_size / 1e6
+    return (
+        f"| [{path.name}](../../{path.as_posix()}) | {frames.count} frames of {w}×{h}, {size:.1f} MB GIF | "
+        f"{sc.spp} | {report.seconds:.1f} | {args.threads} | - |"
+    )
 
 
 if __name__ == "__main__":

@@ -31,15 +31,19 @@ SCENES = sorted((ROOT / "bench" / "scenes").glob("*.yaml")) + sorted((ROOT / "ex
 
 
 def _use_runtime(runtime: Path) -> None:
-    """Compile scenes against `runtime` (a runtime_c folder) instead of the installed package's; with
-    $PICTURE_DIFF_DEBUG set, with -g too (same code, line-level callgrind annotation)."""
+    """Compile scenes against `runtime` (a runtime_c folder: its sources and headers) instead of the installed
+    package's; with $PICTURE_DIFF_DEBUG set, with -g too (same code, line-level callgrind annotation). The
+    source lists are this checkout's (implgen.resources): to compare across a change of the file list, render
+    each side from its own checkout."""
     import os
 
     import implgen.clib as cbuild
+    import implgen.resources as resources
     import implgen.scene.build as build
 
     runtime = runtime.resolve()
     build.runtime_dir = lambda: runtime  # type: ignore[assignment]
+    resources.runtime_dir = lambda: runtime  # type: ignore[assignment]
     if os.environ.get("PICTURE_DIFF_DEBUG") and "-g" not in cbuild.BASE_FLAGS:
         cbuild.BASE_FLAGS = (*cbuild.BASE_FLAGS, "-g")
 

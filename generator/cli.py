@@ -2,6 +2,7 @@
 
     implgen SPEC.yaml [SPEC.yaml ...] --lang c|python|all [-o DIR]   generate intersectors
     implgen render SCENE.yaml -o OUT.png [...]                       render a scene
+    implgen view [SPEC.yaml | SCENE.yaml] [--port --host --no-browser]  the interactive viewer
     implgen bench solvers|gen|render [...]                           measure
     implgen demo                                                     the main job of `make demo`
 
@@ -22,6 +23,7 @@ from implgen.errors import UserError
 _COMMANDS: dict[str, str] = {
     "render": "implgen.scene.command:main",
     "demo": "implgen.demo:main",
+    "view": "implgen.view.command:main",
 }
 _BENCHES: dict[str, str] = {
     "solvers": "implgen.bench.solvers:main",

@@ -12,10 +12,18 @@ from pathlib import Path
 
 _PACKAGE_DIR = Path(__file__).resolve().parent
 
-SOLVER_SOURCES = ("roots.c", "roots_closed.c", "roots_sturm.c", "roots_bernstein.c")
+SOLVER_SOURCES = (
+    "roots.c",
+    "roots_common.c",
+    "roots_refine.c",
+    "roots_closed.c",
+    "roots_sturm.c",
+    "roots_bracket.c",
+    "roots_bernstein.c",
+)
 BENCH_SOURCES = ("roots_bench.c",)  # clock_gettime around every solve: `implgen bench solvers`
 SHAPE_SOURCES = ("shape.c",)
-TRACER_SOURCES = ("tracer_scene.c", "tracer_csg.c", "tracer_shade.c", "tracer_render.c")
+TRACER_SOURCES = ("tracer_scene.c", "tracer_hit.c", "tracer_csg.c", "tracer_shade.c", "tracer_render.c")
 
 
 def templates_dir() -> Path:

@@ -15,10 +15,10 @@
 #define IG_MAX_DEGREE 24
 
 typedef enum {
-    IG_ROOTS_AUTO = 0,    /* the best method for the degree, as the solver report shows */
-    IG_ROOTS_CLOSED = 1,  /* closed forms up to degree 4 (falls back to IG_ROOTS_BRACKET above) */
-    IG_ROOTS_STURM = 2,   /* Sturm sequence isolation + safeguarded refinement */
-    IG_ROOTS_BRACKET = 3, /* derivative bracketing (recursive roots of p') + safeguarded refinement */
+    IG_ROOTS_AUTO = 0,     /* the best method for the degree, as the solver report shows */
+    IG_ROOTS_CLOSED = 1,   /* closed forms up to degree 4 (falls back to IG_ROOTS_BRACKET above) */
+    IG_ROOTS_STURM = 2,    /* Sturm sequence isolation + safeguarded refinement */
+    IG_ROOTS_BRACKET = 3,  /* derivative bracketing (recursive roots of p') + safeguarded refinement */
     IG_ROOTS_BERNSTEIN = 4 /* isolation by Bernstein subdivision + the same refinement; bracketing where unsure */
 } ig_root_method;
 

@@ -26,24 +26,15 @@ static double clock_overhead(void)
         double t1 = now_ns();
         d[i] = t1 - t0;
     }
-    /* partial selection of the median (insertion sort is fine for this size, once) */
-    for (int i = 1; i < N; ++i) {
-        double x = d[i];
-        int j = i - 1;
-        while (j >= 0 && d[j] > x) {
-            d[j + 1] = d[j];
-            --j;
-        }
-        d[j + 1] = x;
-    }
+    ig_sort(d, N); /* insertion sort is fine for this size, once */
     return d[N / 2];
 }
 
 /* One timed pass (a clock read either side of every solve) and one untimed pass (throughput; the checksum
  * keeps the work from being optimised away). first != 0: ig_first_root's path (at most one root each, so
  * `roots` holds `count` entries); else all roots (`roots` holds count * n, NaN-padded). */
-static double bench_batch(const double *c, int n, long count, const double *lo, const double *hi, int method,
-                          int first, double *roots, int *counts, double *ns)
+static double bench_batch(const double *c, int n, long count, const double *lo, const double *hi, int method, int first,
+                          double *roots, int *counts, double *ns)
 {
     double r[IG_MAX_DEGREE];
     double over = clock_overhead();

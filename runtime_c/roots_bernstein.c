@@ -39,9 +39,9 @@
 typedef struct {
     const double *p; /* power-form coefficients, exact degree n */
     int n;
-    double a, h;    /* the interval [a, a + h]; t = a + s h */
-    double tol;     /* |b_i| <= tol: the sign of b_i is not certain */
-    int first;      /* stop at the leftmost root */
+    double a, h; /* the interval [a, a + h]; t = a + s h */
+    double tol;  /* |b_i| <= tol: the sign of b_i is not certain */
+    int first;   /* stop at the leftmost root */
     double *out;
     int cnt;
     double fallback_from; /* NaN, or the left end of the first piece that was not certain: bracketing decides
@@ -51,10 +51,10 @@ typedef struct {
 } bz_ctx;
 
 /* 1/k, k = 0 .. IG_MAX_DEGREE (entry 0 unused): turns the binomial scaling into products. */
-static const double bz_inv[IG_MAX_DEGREE + 1] = {
-    0.0,       1.0,        1.0 / 2,  1.0 / 3,  1.0 / 4,  1.0 / 5,  1.0 / 6,  1.0 / 7,  1.0 / 8,
-    1.0 / 9,   1.0 / 10,   1.0 / 11, 1.0 / 12, 1.0 / 13, 1.0 / 14, 1.0 / 15, 1.0 / 16, 1.0 / 17,
-    1.0 / 18,  1.0 / 19,   1.0 / 20, 1.0 / 21, 1.0 / 22, 1.0 / 23, 1.0 / 24};
+static const double bz_inv[IG_MAX_DEGREE + 1] = {0.0,      1.0,      1.0 / 2,  1.0 / 3,  1.0 / 4,  1.0 / 5,  1.0 / 6,
+                                                 1.0 / 7,  1.0 / 8,  1.0 / 9,  1.0 / 10, 1.0 / 11, 1.0 / 12, 1.0 / 13,
+                                                 1.0 / 14, 1.0 / 15, 1.0 / 16, 1.0 / 17, 1.0 / 18, 1.0 / 19, 1.0 / 20,
+                                                 1.0 / 21, 1.0 / 22, 1.0 / 23, 1.0 / 24};
 
 /* Certain sign of p at t given the Bernstein value bv there (b_0 or b_n of a piece): the plain value when it
  * is clear of the rounding band, else the compensated evaluation (0: p is zero within rounding). */
@@ -96,6 +96,17 @@ static int end_sign(const bz_ctx *c, double bv, double t, double *val)
 
 typedef void (*bz_piece_fn)(bz_ctx *c, const double *b, double s0, double s1, double tl, double tr, int sl, int sr,
                             double vl, double vr, int depth);
+typedef void (*bz_basis_fn)(const double *p, int n, double a, double h, double *b);
+
+/* The code specialised per degree (3 to 12); other degrees run the _any version. */
+#define BZ_SPECIAL 13
+#define BZ_ENTRY(d) [d] = {to_bernstein_##d, piece_##d}
+static const struct {
+    bz_basis_fn to_bernstein;
+    bz_piece_fn piece;
+} bz_special[BZ_SPECIAL] = {BZ_ENTRY(3), BZ_ENTRY(4), BZ_ENTRY(5),  BZ_ENTRY(6),  BZ_ENTRY(7),
+                            BZ_ENTRY(8), BZ_ENTRY(9), BZ_ENTRY(10), BZ_ENTRY(11), BZ_ENTRY(12)};
+#undef BZ_ENTRY
 
 static int bernstein(const double *p, int n, double a, double b, int first, double *out)
 {
@@ -111,27 +122,18 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     c.out = out;
     c.cnt = 0;
     c.fallback_from = NAN;
-    double x = fabs(a) + h, M = 0.0;
-    for (int k = n; k >= 0; --k)
-        M = M * x + fabs(p[k]);
+    double M = ig_horner_abs(p, n, fabs(a) + h);
     c.tol = 24.0 * n * IG_U * M;
     if (!isfinite(c.tol))
         return ig_bracket_interval(p, n, a, b, out);
     double bz[IG_MAX_DEGREE + 1], vl, vr;
-    bz_piece_fn piece;
-    switch (n) {
-    case 3: to_bernstein_3(p, n, a, h, bz); piece = piece_3; break;
-    case 4: to_bernstein_4(p, n, a, h, bz); piece = piece_4; break;
-    case 5: to_bernstein_5(p, n, a, h, bz); piece = piece_5; break;
-    case 6: to_bernstein_6(p, n, a, h, bz); piece = piece_6; break;
-    case 7: to_bernstein_7(p, n, a, h, bz); piece = piece_7; break;
-    case 8: to_bernstein_8(p, n, a, h, bz); piece = piece_8; break;
-    case 9: to_bernstein_9(p, n, a, h, bz); piece = piece_9; break;
-    case 10: to_bernstein_10(p, n, a, h, bz); piece = piece_10; break;
-    case 11: to_bernstein_11(p, n, a, h, bz); piece = piece_11; break;
-    case 12: to_bernstein_12(p, n, a, h, bz); piece = piece_12; break;
-    default: to_bernstein_any(p, n, a, h, bz); piece = piece_any; break;
+    bz_basis_fn to_bernstein = to_bernstein_any;
+    bz_piece_fn piece = piece_any;
+    if (n < BZ_SPECIAL && bz_special[n].piece) {
+        to_bernstein = bz_special[n].to_bernstein;
+        piece = bz_special[n].piece;
     }
+    to_bernstein(p, n, a, h, bz);
     int sl = end_sign(&c, bz[0], a, &vl), sr = end_sign(&c, bz[n], b, &vr);
     if (sl == 0 || sr == 0) /* a root at an end of the interval (within rounding) */
         return ig_bracket_interval(p, n, a, b, out);

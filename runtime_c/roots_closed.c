@@ -129,16 +129,25 @@ static int finish(double *y, int k, int e, double lo, double hi, double *r)
 
 /* ------------------------------------------------------------------------------------------- plain */
 
-static int is_zero_classic(double x)
+static int is_zero_classic(double x) { return x > -1e-9 && x < 1e-9; }
+
+/* *r = sqrt(x), with x within 1e-9 of zero taken as zero; 0 when x is negative (no real square root). */
+static int sqrt_classic(double x, double *r)
 {
-    return x > -1e-9 && x < 1e-9;
+    if (is_zero_classic(x))
+        *r = 0.0;
+    else if (x > 0.0)
+        *r = sqrt(x);
+    else
+        return 0;
+    return 1;
 }
 
 /* Classic cubic on the monic x^3 + A x^2 + B x + C (Cardano, trigonometric for three real roots). */
 static int cubic_classic(double A, double B, double C, double *x)
 {
     double sub = A / 3.0;
-    double p = (B - A * sub) / 3.0;                          /* depressed y^3 + 3p y + 2q */
+    double p = (B - A * sub) / 3.0; /* depressed y^3 + 3p y + 2q */
     double q = 0.5 * (2.0 / 27.0 * A * A * A - A * B / 3.0 + C);
     double D = q * q + p * p * p;
     int k;
@@ -185,17 +194,7 @@ static int quartic_classic(const double *c, double *x)
         cubic_classic(-0.5 * p, -r, 0.5 * r * p - 0.125 * q * q, zs);
         double z = zs[0];
         double u = z * z - r, v = 2.0 * z - p;
-        if (is_zero_classic(u))
-            u = 0.0;
-        else if (u > 0.0)
-            u = sqrt(u);
-        else
-            return 0;
-        if (is_zero_classic(v))
-            v = 0.0;
-        else if (v > 0.0)
-            v = sqrt(v);
-        else
+        if (!sqrt_classic(u, &u) || !sqrt_classic(v, &v))
             return 0;
         double w = q < 0.0 ? -u : u; /* (x^2 + z)^2 - (v x - w)^2 with 2 v w = q */
         double qa[2][2] = {{z + w, -v}, {z - w, v}};

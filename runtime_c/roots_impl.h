@@ -1,10 +1,12 @@
-/* Internals shared by the root solvers (roots.c, roots_closed.c, roots_sturm.c, roots_bench.c).
+/* Internals shared by the root solvers (roots*.c: the dispatcher, the methods, roots_common.c, roots_refine.c
+ * and roots_bench.c).
  * Not part of the public contract: only roots.h is. Every symbol carries the ig_ prefix because all
  * runtime .c files are compiled into one library.
  */
 #ifndef IMPLGEN_ROOTS_IMPL_H
 #define IMPLGEN_ROOTS_IMPL_H
 
+#include "numerics.h"
 #include "roots.h"
 
 /* Room for intermediate root lists (a method returns at most n + 1 candidates per piece, three pieces). */
@@ -17,7 +19,7 @@
  * i.e. what Schwarze's Graphics Gems code does. Used by `implgen bench solvers` as the baseline. */
 #define IG_ROOTS_CLOSED_PLAIN 10
 
-/* Horner evaluation of c[0..n] at x: value and derivative. */
+/* Horner evaluation of c[0..n] at x: value and derivative (roots_common.c). */
 void ig_horner2(const double *c, int n, double x, double *p, double *dp);
 
 /* Sign of p(x) that rounding cannot flip: -1 or +1, or 0 when |p(x)| is within the rounding error even of
@@ -33,14 +35,17 @@ double ig_refine(const double *c, int n, double l, double r, double vl, double v
 
 /* ig_refine on k brackets of the same polynomial at once (four evaluation chains in flight): roots[i] is
  * bitwise what ig_refine(c, n, l[i], r[i], vl[i], vr[i], tol, x0[i]) returns. */
-void ig_refine_many(const double *c, int n, int k, const double *l, const double *r, const double *vl,
-                    const double *vr, double tol, const double *x0, double *roots);
+void ig_refine_many(const double *c, int n, int k, const double *l, const double *r, const double *vl, const double *vr,
+                    double tol, const double *x0, double *roots);
 
 /* Midpoint of [l, r] in the ordering of doubles (halves the number of doubles between them). */
 double ig_ordered_mid(double l, double r);
 
 /* Real roots of c0 + c1 x + c2 x^2 (c2 != 0), distinct, ascending; a double root once. */
 int ig_quadratic(double c0, double c1, double c2, double *r);
+
+/* Sort ascending (insertion sort: the lists are short). */
+void ig_sort(double *r, int k);
 
 /* Sort ascending and drop exact duplicates; returns the new count. */
 int ig_sort_unique(double *r, int k);

@@ -80,10 +80,7 @@ static int variations(const sturm_seq *s, double x)
     int prev = ig_sign_certified(s->c[0], s->deg[0], x, &v0);
     int count = 0;
     for (int k = 1; k < s->len; ++k) {
-        const double *c = s->c[k];
-        double v = c[s->deg[k]];
-        for (int i = s->deg[k] - 1; i >= 0; --i)
-            v = v * x + c[i];
+        double v = ig_horner(s->c[k], s->deg[k], x);
         int sg = (v > 0.0) - (v < 0.0);
         if (sg != 0) {
             if (prev != 0 && sg != prev)

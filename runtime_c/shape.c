@@ -11,13 +11,15 @@
  * implemented in NumPy by implgen.raycast for the generated Python modules.
  */
 #include "shape.h"
+#include "numerics.h"
 
 #include <math.h>
 
 void ig_shape_prepare(const ig_shape *shape, const double *params, ig_shape_prep *prep)
 {
     double box[6] = {-INFINITY, -INFINITY, -INFINITY, INFINITY, INFINITY, INFINITY};
-    prep->degree = (shape && shape->coeffs && shape->degree >= 0 && shape->degree <= IG_MAX_DEGREE) ? shape->degree : -1;
+    prep->degree =
+        (shape && shape->coeffs && shape->degree >= 0 && shape->degree <= IG_MAX_DEGREE) ? shape->degree : -1;
     prep->bounded = (shape && shape->bounds) ? shape->bounds(params, box) : 0;
     prep->nclip = prep->nfinite = 0;
     for (int i = 0; i < 3; ++i) {
@@ -44,7 +46,9 @@ void ig_shape_prepare(const ig_shape *shape, const double *params, ig_shape_prep
     }
 }
 
-/* Slab clip of [*t0, *t1] against the grown box; an infinite bound imposes nothing on its side. 0 when empty. */
+/* Slab clip of [*t0, *t1] against the grown box; an infinite bound imposes nothing on its side. 0 when empty.
+ * Unlike the tracer's rt_clip_box it neither tests the box for emptiness nor stops early: prepare() built the
+ * box, and only its clipping axes are visited. */
 static int clip_box(const ig_shape_prep *prep, const double o[3], const double d[3], double *t0, double *t1)
 {
     for (int k = 0; k < prep->nclip; ++k) {
@@ -55,13 +59,8 @@ static int clip_box(const ig_shape_prep *prep, const double o[3], const double d
                 return 0;
             continue;
         }
-        double inv = 1.0 / d[i];
-        double ta = (lo - o[i]) * inv, tb = (hi - o[i]) * inv;
-        if (ta > tb) {
-            double t = ta;
-            ta = tb;
-            tb = t;
-        }
+        double ta, tb;
+        ig_slab(lo, hi, o[i], 1.0 / d[i], &ta, &tb);
         if (ta > *t0)
             *t0 = ta;
         if (tb < *t1)
@@ -131,8 +130,8 @@ int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_p
 }
 
 /* Clip, shift, coefficients, solve (all roots, or only the first), shift back. */
-static int shape_solve(const ig_shape *shape, const double *params, const double o[3], const double d[3],
-                       double tmin, double tmax, ig_root_method method, int first, double *roots)
+static int shape_solve(const ig_shape *shape, const double *params, const double o[3], const double d[3], double tmin,
+                       double tmax, ig_root_method method, int first, double *roots)
 {
     ig_shape_prep prep;
     if (!shape || !shape->coeffs || !roots)
@@ -141,14 +140,14 @@ static int shape_solve(const ig_shape *shape, const double *params, const double
     return ig_shape_solve(shape, params, &prep, o, d, tmin, tmax, method, first, roots);
 }
 
-int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3], const double d[3],
-                   double tmin, double tmax, ig_root_method method, double *roots)
+int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3], const double d[3], double tmin,
+                   double tmax, ig_root_method method, double *roots)
 {
     return shape_solve(shape, params, o, d, tmin, tmax, method, 0, roots);
 }
 
-int ig_shape_first_root(const ig_shape *shape, const double *params, const double o[3], const double d[3],
-                        double tmin, double tmax, ig_root_method method, double *t)
+int ig_shape_first_root(const ig_shape *shape, const double *params, const double o[3], const double d[3], double tmin,
+                        double tmax, ig_root_method method, double *t)
 {
     return shape_solve(shape, params, o, d, tmin, tmax, method, 1, t);
 }

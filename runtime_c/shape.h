@@ -11,7 +11,7 @@
 
 typedef struct ig_shape {
     const char *name;
-    int degree;   /* total degree of f in x, y, z */
+    int degree; /* total degree of f in x, y, z */
     int nparams;
     /* c[0..degree] of f(o + t d), lowest power first */
     void (*coeffs)(const double o[3], const double d[3], const double *params, double *c);
@@ -27,13 +27,13 @@ typedef struct ig_shape {
  * close to the object (the clipped interval's point closest to the box centre, or to the coordinate origin
  * for an unbounded shape), solves in the shifted parameter and shifts back, so a far-away ray loses nothing
  * to cancellation. roots[] needs room for IG_MAX_DEGREE entries. */
-int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3], const double d[3],
-                   double tmin, double tmax, ig_root_method method, double *roots);
+int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3], const double d[3], double tmin,
+                   double tmax, ig_root_method method, double *roots);
 
 /* The nearest of those roots (what ig_shape_roots would list first) into *t: 1, or 0 when there is none.
  * The same clip and shift; the solver stops at the first root instead of isolating all (ig_first_root). */
-int ig_shape_first_root(const ig_shape *shape, const double *params, const double o[3], const double d[3],
-                        double tmin, double tmax, ig_root_method method, double *t);
+int ig_shape_first_root(const ig_shape *shape, const double *params, const double o[3], const double d[3], double tmin,
+                        double tmax, ig_root_method method, double *t);
 
 /* ---- The same solve for a caller that solves one shape many times (the tracer) ----
  *
@@ -42,12 +42,12 @@ int ig_shape_first_root(const ig_shape *shape, const double *params, const doubl
  * ig_shape_roots (first == 0) or ig_shape_first_root (first != 0) give for the same arguments; both are
  * written on top of it. The prep holds no pointers: it stays valid as long as shape and params are unchanged. */
 typedef struct ig_shape_prep {
-    int degree;         /* shape->degree; -1 when out of range or the shape has no coefficients (no roots) */
-    int bounded;        /* shape->bounds returned 1 */
-    int nclip, clip[3]; /* axes with a finite side, in ascending order: the only ones the clip can move */
-    double lo[3], hi[3]; /* per axis, the box grown by 1e-9 of its finite extent (see shape.c) */
+    int degree;             /* shape->degree; -1 when out of range or the shape has no coefficients (no roots) */
+    int bounded;            /* shape->bounds returned 1 */
+    int nclip, clip[3];     /* axes with a finite side, in ascending order: the only ones the clip can move */
+    double lo[3], hi[3];    /* per axis, the box grown by 1e-9 of its finite extent (see shape.c) */
     int nfinite, finite[3]; /* axes with both sides finite, ascending: they place the shift point */
-    double centre[3];   /* centre of each axis in finite[] (of the box as the spec gives it) */
+    double centre[3];       /* centre of each axis in finite[] (of the box as the spec gives it) */
 } ig_shape_prep;
 
 void ig_shape_prepare(const ig_shape *shape, const double *params, ig_shape_prep *prep);

@@ -35,33 +35,36 @@ enum { RT_LEAF = 0, RT_UNION = 1, RT_INTERSECTION = 2, RT_DIFFERENCE = 3 };
 
 /* Material, passed as RT_MATERIAL_DOUBLES packed doubles in this order. */
 typedef struct rt_material {
-    double color[3];       /* base colour (linear, 0..1) */
-    double color2[3];      /* second checker colour */
-    double checker_scale;  /* > 0: 3-D checker of colour/color2 with this cell size in object units; 0: solid */
+    double color[3];      /* base colour (linear, 0..1) */
+    double color2[3];     /* second checker colour */
+    double checker_scale; /* > 0: 3-D checker of colour/color2 with this cell size in object units; 0: solid */
     double ambient, diffuse, specular, shininess;
-    double reflectivity;   /* mirror weight, 0..1 */
-    double transparency;   /* 0: opaque .. 1: clear; the rest is the local (Phong) term */
-    double ior;            /* index of refraction of the inside */
-    double absorption[3];  /* Beer-Lambert coefficients per world unit, per channel (inside the solid) */
+    double reflectivity;  /* mirror weight, 0..1 */
+    double transparency;  /* 0: opaque .. 1: clear; the rest is the local (Phong) term */
+    double ior;           /* index of refraction of the inside */
+    double absorption[3]; /* Beer-Lambert coefficients per world unit, per channel (inside the solid) */
+    double two_sided;     /* 1: the back of the surface (its f < 0 side, where the normal points away from the
+                             viewer) shows inside instead of the base colour; 0: both sides the same */
+    double inside[3];     /* the back's colour when two_sided (linear, 0..1) */
 } rt_material;
-#define RT_MATERIAL_DOUBLES 19
+#define RT_MATERIAL_DOUBLES 21
 
 /* One ray/scene hit, everything in world space. */
 typedef struct rt_hit {
-    double t;        /* ray parameter: p = o + t d */
-    double p[3];     /* hit point */
-    double n[3];     /* unit normal, pointing out of the solid that was hit (for a CSG difference, out of
+    double t;     /* ray parameter: p = o + t d */
+    double p[3];  /* hit point */
+    double n[3];  /* unit normal, pointing out of the solid that was hit (for a CSG difference, out of
                         the result: the subtracted part's normal is flipped); for a top-level surface,
                         grad f / |grad f| */
-    double err;      /* bound on the hit point's distance from the true surface, world units */
-    double po[3];    /* hit point in the leaf's object space (for textures) */
-    double no[3];    /* the leaf's object-space unit normal, oriented like n */
-    int object;      /* index of the top-level object (order of rt_scene_add_object) */
-    int leaf;        /* node index of the leaf whose surface was hit */
-    int face;        /* 0: the leaf's surface f = 0; +-(1..3): a face of the leaf's bounds box (CSG only) */
-    int material;    /* material index */
-    int entering;    /* 1: the ray goes into the solid at p, 0: it comes out */
-    int singular;    /* 1: grad f vanished at p; n is a fallback facing the ray */
+    double err;   /* bound on the hit point's distance from the true surface, world units */
+    double po[3]; /* hit point in the leaf's object space (for textures) */
+    double no[3]; /* the leaf's object-space unit normal, oriented like n */
+    int object;   /* index of the top-level object (order of rt_scene_add_object) */
+    int leaf;     /* node index of the leaf whose surface was hit */
+    int face;     /* 0: the leaf's surface f = 0; +-(1..3): a face of the leaf's bounds box (CSG only) */
+    int material; /* material index */
+    int entering; /* 1: the ray goes into the solid at p, 0: it comes out */
+    int singular; /* 1: grad f vanished at p; n is a fallback facing the ray */
 } rt_hit;
 
 typedef struct rt_scene rt_scene;
@@ -90,15 +93,14 @@ double rt_scene_far(const rt_scene *s);
 /* World box of a node: returns 1 and fills box when bounded, 0 when unbounded. */
 int rt_scene_node_box(const rt_scene *s, int node, double box[6]);
 
-/* ---- ray queries (tracer_scene.c, tracer_csg.c) ---- */
+/* ---- ray queries (tracer_hit.c, tracer_csg.c) ---- */
 /* Closest hit with tmin < t < tmax (tmax may be INFINITY). Returns 1 and fills *hit, or 0. */
-int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax,
-                       rt_hit *hit);
+int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, rt_hit *hit);
 /* The inside-intervals of a node (leaf solid or CSG) along the ray, clipped to [tmin, tmax]: writes
  * pairs t_in[i] < t_out[i] ascending, with the leaf node of each endpoint (-1 where the interval is open
  * because the ray starts or ends inside). Returns the interval count (<= max). For tests and debugging. */
-int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d[3], double tmin,
-                  double tmax, double *t_in, double *t_out, int *leaf_in, int *leaf_out, int max);
+int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d[3], double tmin, double tmax,
+                  double *t_in, double *t_out, int *leaf_in, int *leaf_out, int max);
 
 /* ---- optics (tracer_shade.c); directions need not be unit, results are unit ---- */
 void rt_reflect(const double d[3], const double n[3], double r[3]);
@@ -119,8 +121,13 @@ enum { RT_RAYS_PRIMARY = 0, RT_RAYS_SHADOW = 1, RT_RAYS_SECONDARY = 2, RT_NONFIN
 rt_render *rt_render_new(const rt_scene *s, int width, int height, int spp, int max_depth, int threads,
                          unsigned long seed);
 void rt_render_free(rt_render *r);
-/* Renders into rgb (height * width * 3 floats, row 0 at the top). Blocks; safe to call from a thread the
- * caller does not block on. Returns 0, 1 when cancelled, -1 when threads could not be started. */
+/* Render only the rows [y0, y1) of the image from now on (a tile), each pixel exactly as in the whole image:
+ * samples depend only on the pixel's place in the whole image. Returns 0, or -1 for a range outside
+ * [0, height) or empty. */
+int rt_render_set_rows(rt_render *r, int y0, int y1);
+/* Renders into rgb ((y1 - y0) * width * 3 floats, row y0 first; all rows unless set). Blocks; safe to call
+ * from a thread the caller does not block on. Returns 0, 1 when cancelled, -1 when threads could not be
+ * started. */
 int rt_render_run(rt_render *r, float *rgb);
 int rt_render_progress(rt_render *r); /* rows finished so far (thread-safe) */
 void rt_render_cancel(rt_render *r);  /* ask a running render to stop after the current rows */

@@ -18,18 +18,20 @@ int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], doub
 {
     double L = sqrt(rt_dot(od, od)), u[3];
     int k, i;
-    if (!(L > 0.0) || !isfinite(L)) return 0;
+    if (!(L > 0.0) || !isfinite(L))
+        return 0;
     u[0] = od[0] / L;
     u[1] = od[1] / L;
     u[2] = od[2] / L;
     k = ig_shape_solve(n->shape, n->params, &n->prep, oo, u, lo * L, hi * L, IG_ROOTS_AUTO, 0, r);
-    for (i = 0; i < k; ++i) r[i] /= L;
+    for (i = 0; i < k; ++i)
+        r[i] /= L;
     return k;
 }
 
 /* Spans of one leaf solid over [a, b]. */
-static int leaf_spans(const rt_scene *s, int k, const double o[3], const double d[3], double a, double b,
-                      rt_span *out, int max)
+static int leaf_spans(const rt_scene *s, int k, const double o[3], const double d[3], double a, double b, rt_span *out,
+                      int max)
 {
     const rt_node *n = &s->nodes[k];
     double oo[3], od[3], r[IG_MAX_DEGREE + 2], x[IG_MAX_DEGREE + 2];
@@ -37,8 +39,10 @@ static int leaf_spans(const rt_scene *s, int k, const double o[3], const double 
     rt_end start;
 
     rt_to_object(n, o, d, oo, od);
-    if (!rt_clip_box(n->obox, oo, od, &a, &b, &f0, &f1)) return 0;
-    if (!(b > a)) return 0;
+    if (!rt_clip_box(n->obox, oo, od, &a, &b, &f0, &f1))
+        return 0;
+    if (!(b > a))
+        return 0;
     nr = rt_leaf_roots(n, oo, od, a, b, r);
     /* Breakpoints a = x[0] <= roots <= x[nx - 1] = b. A root within rounding of a box face means the surface
      * touches its box there (a cylinder tangent to its box's side): the endpoint is the surface, not the face. */
@@ -47,14 +51,17 @@ static int leaf_spans(const rt_scene *s, int k, const double o[3], const double 
     {
         double tol = 1e-9 * (b - a);
         for (i = 0; i < nr; ++i) {
-            if (f0 && fabs(r[i] - a) <= tol) f0 = 0;
-            if (f1 && fabs(r[i] - b) <= tol) f1 = 0;
+            if (f0 && fabs(r[i] - a) <= tol)
+                f0 = 0;
+            if (f1 && fabs(r[i] - b) <= tol)
+                f1 = 0;
         }
     }
     nx = 0;
     x[nx++] = a;
     for (i = 0; i < nr; ++i)
-        if (r[i] > x[nx - 1] && r[i] < b) x[nx++] = r[i];
+        if (r[i] > x[nx - 1] && r[i] < b)
+            x[nx++] = r[i];
     x[nx++] = b;
     start.t = a;
     start.leaf = -1;
@@ -100,9 +107,12 @@ static int leaf_spans(const rt_scene *s, int k, const double o[3], const double 
 static int op_state(int op, int in_a, int in_b)
 {
     switch (op) {
-    case RT_UNION: return in_a || in_b;
-    case RT_INTERSECTION: return in_a && in_b;
-    default: return in_a && !in_b; /* difference: A and not B */
+    case RT_UNION:
+        return in_a || in_b;
+    case RT_INTERSECTION:
+        return in_a && in_b;
+    default:
+        return in_a && !in_b; /* difference: A and not B */
     }
 }
 
@@ -146,21 +156,25 @@ static int combine(int op, const rt_span *A, int na, const rt_span *B, int nb, r
     return n;
 }
 
-int rt_spans(const rt_scene *s, int k, const double o[3], const double d[3], double a, double b, rt_span *out,
-             int max)
+int rt_spans(const rt_scene *s, int k, const double o[3], const double d[3], double a, double b, rt_span *out, int max)
 {
     const rt_node *n = &s->nodes[k];
     rt_span L[RT_MAX_SPANS], R[RT_MAX_SPANS];
     int nl, nr;
-    if (n->kind == RT_LEAF) return leaf_spans(s, k, o, d, a, b, out, max);
+    if (n->kind == RT_LEAF)
+        return leaf_spans(s, k, o, d, a, b, out, max);
     /* The node's box bounds everything below it (an unbounded leaf inside an intersection included). */
-    if (n->wbounded && !rt_clip_box(n->wbox, o, d, &a, &b, NULL, NULL)) return 0;
+    if (n->wbounded && !rt_clip_box(n->wbox, o, d, &a, &b, NULL, NULL))
+        return 0;
     nl = rt_spans(s, n->left, o, d, a, b, L, RT_MAX_SPANS);
-    if (nl == 0 && n->kind != RT_UNION) return 0;
+    if (nl == 0 && n->kind != RT_UNION)
+        return 0;
     nr = rt_spans(s, n->right, o, d, a, b, R, RT_MAX_SPANS);
     if (nr == 0) {
-        if (n->kind == RT_INTERSECTION) return 0;
-        if (nl > max) nl = max;
+        if (n->kind == RT_INTERSECTION)
+            return 0;
+        if (nl > max)
+            nl = max;
         memcpy(out, L, (size_t)nl * sizeof *L);
         return nl;
     }
@@ -172,15 +186,20 @@ int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d
 {
     rt_span sp[RT_MAX_SPANS];
     int n, i;
-    if (!s->committed || node < 0 || node >= s->nnodes) return 0;
-    if (tmax > s->far) tmax = s->far;
+    if (!s->committed || node < 0 || node >= s->nnodes)
+        return 0;
+    if (tmax > s->far)
+        tmax = s->far;
     n = rt_spans(s, node, o, d, tmin, tmax, sp, RT_MAX_SPANS);
-    if (n > max) n = max;
+    if (n > max)
+        n = max;
     for (i = 0; i < n; ++i) {
         t_in[i] = sp[i].in.t;
         t_out[i] = sp[i].out.t;
-        if (leaf_in) leaf_in[i] = sp[i].in.leaf;
-        if (leaf_out) leaf_out[i] = sp[i].out.leaf;
+        if (leaf_in)
+            leaf_in[i] = sp[i].in.leaf;
+        if (leaf_out)
+            leaf_out[i] = sp[i].out.leaf;
     }
     return n;
 }
@@ -195,8 +214,10 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
      * which the world box contains with room (its corners transformed, then padded by 1e-9 of its size). An
      * unbounded one is solved up to `far` (rt_scene_far). */
     if (!n->wbounded) {
-        if (hi > ray->far_t) hi = ray->far_t;
-        if (!(hi > lo)) return 0;
+        if (hi > ray->far_t)
+            hi = ray->far_t;
+        if (!(hi > lo))
+            return 0;
     }
     hit->object = object;
     if (n->kind == RT_LEAF) {
@@ -211,7 +232,8 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
             rt_xform_point(n->minv, ray->o, oo);
             rt_xform_vector(n->minv, ray->d, od);
             L = sqrt(rt_dot(od, od));
-            if (!(L > 0.0) || !isfinite(L)) return 0;
+            if (!(L > 0.0) || !isfinite(L))
+                return 0;
             u[0] = od[0] / L;
             u[1] = od[1] / L;
             u[2] = od[2] / L;

@@ -2,49 +2,50 @@
 #ifndef IMPLGEN_TRACER_INTERNAL_H
 #define IMPLGEN_TRACER_INTERNAL_H
 
+#include "numerics.h"
 #include "tracer.h"
 
 typedef struct rt_node {
-    int kind;            /* RT_LEAF, RT_UNION, RT_INTERSECTION, RT_DIFFERENCE */
-    int left, right;     /* children (CSG) */
-    int material;        /* -1: none given (the Python side resolves inheritance before it gets here) */
-    int depth;           /* CSG nesting depth below this node */
+    int kind;        /* RT_LEAF, RT_UNION, RT_INTERSECTION, RT_DIFFERENCE */
+    int left, right; /* children (CSG) */
+    int material;    /* -1: none given (the Python side resolves inheritance before it gets here) */
+    int depth;       /* CSG nesting depth below this node */
     /* leaf */
     const ig_shape *shape;
-    double *params;      /* owned copy, shape->nparams entries */
-    double m[12];        /* object -> world */
-    double minv[12];     /* world -> object */
-    double mnorm;        /* Frobenius norm of M's linear part: bounds how much M stretches a distance */
-    int identity;        /* M is exactly the identity: rays need no transforming */
-    double obox[6];      /* object-space bounds box */
-    int obounded;        /* the spec gives bounds (some sides may still be infinite) */
-    ig_shape_prep prep;  /* shape.c's per-shape clip and shift data, worked out once (ig_shape_solve) */
+    double *params;     /* owned copy, shape->nparams entries */
+    double m[12];       /* object -> world */
+    double minv[12];    /* world -> object */
+    double mnorm;       /* Frobenius norm of M's linear part: bounds how much M stretches a distance */
+    int identity;       /* M is exactly the identity: rays need no transforming */
+    double obox[6];     /* object-space bounds box */
+    int obounded;       /* the spec gives bounds (some sides may still be infinite) */
+    ig_shape_prep prep; /* shape.c's per-shape clip and shift data, worked out once (ig_shape_solve) */
     /* any node */
-    double wbox[6];      /* world-space box, slightly padded; valid when wbounded */
+    double wbox[6]; /* world-space box, slightly padded; valid when wbounded */
     int wbounded;
 } rt_node;
 
 typedef struct rt_bvh_node {
     double box[6];
-    int left, right;     /* children; -1 for a leaf */
-    int first, count;    /* leaf: bounded objects order[first .. first + count) */
+    int left, right;  /* children; -1 for a leaf */
+    int first, count; /* leaf: bounded objects order[first .. first + count) */
 } rt_bvh_node;
 
 struct rt_scene {
     rt_node *nodes;
     int nnodes, cap_nodes;
-    int *objects;        /* node index of each top-level object */
+    int *objects; /* node index of each top-level object */
     int nobjects, cap_objects;
     rt_material *materials;
     int nmaterials, cap_materials;
-    double *lights;      /* 6 per light: position, colour x intensity */
+    double *lights; /* 6 per light: position, colour x intensity */
     int nlights, cap_lights;
     double eye[3], look_at[3], up[3], vfov;
     double background[3];
     /* after commit */
     int committed;
-    double far;          /* stands in for t = infinity on unbounded shapes: 1e5 x the scene's size */
-    int *unbounded;      /* objects outside the BVH */
+    double far;     /* stands in for t = infinity on unbounded shapes: 1e5 x the scene's size */
+    int *unbounded; /* objects outside the BVH */
     int nunbounded;
     unsigned char *flat; /* per object: a top-level leaf of degree 1 (part of a plane), which no ray leaving
                             it can meet again: rays spawned from it need not test it (rt_scene_closest) */
@@ -57,8 +58,8 @@ struct rt_scene {
 /* One end of an inside-interval: where it is and which surface makes it. */
 typedef struct rt_end {
     double t;
-    int leaf;            /* node index of the leaf, -1: open (the ray's range starts/ends inside) */
-    int face;            /* 0: the surface f = 0; +-(axis + 1): outward face of the leaf's bounds box */
+    int leaf; /* node index of the leaf, -1: open (the ray's range starts/ends inside) */
+    int face; /* 0: the surface f = 0; +-(axis + 1): outward face of the leaf's bounds box */
 } rt_end;
 
 typedef struct rt_span {
@@ -75,10 +76,10 @@ typedef struct rt_pending {
 /* A world ray with what every object test along it would otherwise work out again. */
 typedef struct rt_ray {
     double o[3], d[3];
-    double inv[3];       /* 1 / d[a]; not used where d[a] == 0 */
-    double len;          /* |d| */
-    double u[3];         /* d / |d|: the unit direction an identity leaf solves along */
-    double far_t;        /* far / |d|: where an unbounded object's solve stops (INFINITY when d = 0) */
+    double inv[3]; /* 1 / d[a]; not used where d[a] == 0 */
+    double len;    /* |d| */
+    double u[3];   /* d / |d|: the unit direction an identity leaf solves along */
+    double far_t;  /* far / |d|: where an unbounded object's solve stops (INFINITY when d = 0) */
 } rt_ray;
 
 /* What rt_hit_error needs to work out hit->err after rt_finish_hit, kept so that a hit that spawns no ray
@@ -100,13 +101,13 @@ enum { RT_CLOSEST = 0, RT_ANY_OPAQUE = 1 };
 int rt_spawn_skip(const rt_scene *s, const rt_hit *h);
 
 /* tracer_scene.c */
+void rt_xform_point(const double m[12], const double p[3], double out[3]);
+void rt_xform_vector(const double m[12], const double v[3], double out[3]);
+/* tracer_hit.c */
 void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far);
 int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
                      int skip, rt_pending *out);
-void rt_xform_point(const double m[12], const double p[3], double out[3]);
-void rt_xform_vector(const double m[12], const double v[3], double out[3]);
-int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0,
-                int *f1);
+int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0, int *f1);
 /* Fills hit (normal, object-space point, ...) for the pending hit of the ray o + t d. With lazy == NULL the
  * error bound hit->err too; otherwise hit->err is left for rt_hit_error, and lazy keeps what it needs. */
 void rt_finish_hit(const rt_scene *s, const rt_pending *p, const double o[3], const double d[3], rt_hit *hit,
@@ -119,12 +120,17 @@ void rt_to_object(const rt_node *n, const double o[3], const double d[3], double
 
 /* tracer_csg.c */
 int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r);
-int rt_spans(const rt_scene *s, int node, const double o[3], const double d[3], double a, double b,
-             rt_span *out, int max);
+int rt_spans(const rt_scene *s, int node, const double o[3], const double d[3], double a, double b, rt_span *out,
+             int max);
 /* Closest hit of one top-level object with tmin < t < tmax: 1 and *hit filled, or 0. */
 int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, rt_pending *hit);
 
 /* small vector helpers */
 static inline double rt_dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static inline double rt_maxabs3(const double v[3])
+{
+    double a = fabs(v[0]), b = fabs(v[1]), c = fabs(v[2]);
+    return a > b ? (a > c ? a : c) : (b > c ? b : c);
+}
 
 #endif

@@ -2,7 +2,8 @@
  *
  * Threads take image rows from a shared counter (so uneven rows balance themselves) and write disjoint
  * parts of the output. Samples come from a per-pixel random stream seeded by (seed, pixel), so an image is
- * the same whatever the thread count. The render context holds all mutable state; a mutex guards the row
+ * the same whatever the thread count, and a band of rows (rt_render_set_rows, a tile) is exactly those rows
+ * of the whole image. The render context holds all mutable state; a mutex guards the row
  * counter, the progress count, the cancel flag and the ray statistics.
  */
 #include "tracer_internal.h"
@@ -13,10 +14,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-
 struct rt_render {
     const rt_scene *s;
     int width, height, spp, max_depth, threads;
+    int y0, y1; /* the rows rt_render_run renders: [y0, y1) of the image (all of it unless set) */
     unsigned long seed;
     float *rgb;
     /* camera frame */
@@ -47,7 +48,8 @@ static void cross3(const double a[3], const double b[3], double c[3])
 static int unit3(double v[3])
 {
     double l = sqrt(rt_dot(v, v));
-    if (!(l > 0.0) || !isfinite(l)) return 0;
+    if (!(l > 0.0) || !isfinite(l))
+        return 0;
     v[0] /= l;
     v[1] /= l;
     v[2] /= l;
@@ -59,23 +61,30 @@ rt_render *rt_render_new(const rt_scene *s, int width, int height, int spp, int 
 {
     rt_render *r;
     int a;
-    if (!s || !s->committed || width <= 0 || height <= 0 || spp <= 0 || spp > RT_MAX_SPP) return NULL;
+    if (!s || !s->committed || width <= 0 || height <= 0 || spp <= 0 || spp > RT_MAX_SPP)
+        return NULL;
     r = calloc(1, sizeof *r);
-    if (!r) return NULL;
+    if (!r)
+        return NULL;
     r->s = s;
     r->width = width;
     r->height = height;
+    r->y0 = 0;
+    r->y1 = height;
     r->spp = spp;
     r->max_depth = max_depth < 0 ? 0 : (max_depth > RT_MAX_DEPTH ? RT_MAX_DEPTH : max_depth);
     r->threads = threads < 1 ? 1 : threads;
     r->seed = seed;
     memcpy(r->eye, s->eye, sizeof r->eye);
-    for (a = 0; a < 3; ++a) r->w[a] = s->eye[a] - s->look_at[a];
-    if (!unit3(r->w)) r->w[2] = 1.0;
+    for (a = 0; a < 3; ++a)
+        r->w[a] = s->eye[a] - s->look_at[a];
+    if (!unit3(r->w))
+        r->w[2] = 1.0;
     cross3(s->up, r->w, r->u);
     if (!unit3(r->u)) { /* up parallel to the view direction: pick any perpendicular */
         double alt[3] = {1.0, 0.0, 0.0};
-        if (fabs(r->w[0]) > 0.9) alt[0] = 0.0, alt[1] = 1.0;
+        if (fabs(r->w[0]) > 0.9)
+            alt[0] = 0.0, alt[1] = 1.0;
         cross3(alt, r->w, r->u);
         unit3(r->u);
     }
@@ -89,9 +98,21 @@ rt_render *rt_render_new(const rt_scene *s, int width, int height, int spp, int 
     return r;
 }
 
+int rt_render_set_rows(rt_render *r, int y0, int y1)
+{
+    if (!r || y0 < 0 || y1 > r->height || y0 >= y1)
+        return -1;
+    pthread_mutex_lock(&r->lock);
+    r->y0 = y0;
+    r->y1 = y1;
+    pthread_mutex_unlock(&r->lock);
+    return 0;
+}
+
 void rt_render_free(rt_render *r)
 {
-    if (!r) return;
+    if (!r)
+        return;
     pthread_mutex_destroy(&r->lock);
     free(r);
 }
@@ -108,7 +129,8 @@ static void render_row(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
             rng = (uint64_t)r->seed * 0x100000001B3ULL ^ ((uint64_t)y * (uint64_t)r->width + (uint64_t)x);
             splitmix64(&rng);
             /* N-rooks stratification: sample k sits in column stratum k and row stratum perm[k]. */
-            for (k = 0; k < r->spp; ++k) perm[k] = k;
+            for (k = 0; k < r->spp; ++k)
+                perm[k] = k;
             for (k = r->spp - 1; k > 0; --k) {
                 int j = (int)(splitmix64(&rng) % (uint64_t)(k + 1)), t = perm[k];
                 perm[k] = perm[j];
@@ -126,17 +148,19 @@ static void render_row(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
                 px = (2.0 * (x + sx) / r->width - 1.0) * r->tan_half * r->aspect;
                 py = (1.0 - 2.0 * (y + sy) / r->height) * r->tan_half;
             }
-            for (a = 0; a < 3; ++a) d[a] = px * r->u[a] + py * r->v[a] - r->w[a];
+            for (a = 0; a < 3; ++a)
+                d[a] = px * r->u[a] + py * r->v[a] - r->w[a];
             rt_trace_ray(r->s, r->eye, d, r->max_depth, c, stats);
             if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {
                 stats[RT_NONFINITE] += 1.0;
                 continue;
             }
-            for (a = 0; a < 3; ++a) acc[a] += c[a];
+            for (a = 0; a < 3; ++a)
+                acc[a] += c[a];
         }
         for (a = 0; a < 3; ++a) {
             double v = acc[a] / r->spp;
-            r->rgb[((size_t)y * (size_t)r->width + (size_t)x) * 3 + (size_t)a] = (float)v;
+            r->rgb[((size_t)(y - r->y0) * (size_t)r->width + (size_t)x) * 3 + (size_t)a] = (float)v;
         }
     }
 }
@@ -146,10 +170,11 @@ static void *worker(void *arg)
     rt_render *r = arg;
     double stats[RT_NSTATS] = {0.0, 0.0, 0.0, 0.0};
     int *perm = malloc((size_t)r->spp * sizeof(int)), y, a;
-    if (!perm) return NULL;
+    if (!perm)
+        return NULL;
     for (;;) {
         pthread_mutex_lock(&r->lock);
-        if (r->cancel || r->next_row >= r->height) {
+        if (r->cancel || r->next_row >= r->y1) {
             pthread_mutex_unlock(&r->lock);
             break;
         }
@@ -161,7 +186,8 @@ static void *worker(void *arg)
         pthread_mutex_unlock(&r->lock);
     }
     pthread_mutex_lock(&r->lock);
-    for (a = 0; a < RT_NSTATS; ++a) r->stats[a] += stats[a];
+    for (a = 0; a < RT_NSTATS; ++a)
+        r->stats[a] += stats[a];
     pthread_mutex_unlock(&r->lock);
     free(perm);
     return NULL;
@@ -171,29 +197,32 @@ int rt_render_run(rt_render *r, float *rgb)
 {
     pthread_t *ids;
     pthread_attr_t attr;
-    int n = r->threads < r->height ? r->threads : r->height, started = 0, i, cancelled;
+    int rows = r->y1 - r->y0, n = r->threads < rows ? r->threads : rows, started = 0, i, cancelled;
     r->rgb = rgb;
     pthread_mutex_lock(&r->lock);
-    r->next_row = 0;
+    r->next_row = r->y0;
     r->rows_done = 0;
     pthread_mutex_unlock(&r->lock);
-    memset(rgb, 0, (size_t)r->width * (size_t)r->height * 3 * sizeof(float));
+    memset(rgb, 0, (size_t)r->width * (size_t)rows * 3 * sizeof(float));
     ids = malloc((size_t)n * sizeof *ids);
-    if (!ids) return -1;
+    if (!ids)
+        return -1;
     /* CSG recursion keeps span lists on the stack: ask for a generous stack. */
     pthread_attr_init(&attr);
     pthread_attr_setstacksize(&attr, (size_t)16 << 20);
     for (i = 0; i < n; ++i)
-        if (pthread_create(&ids[started], &attr, worker, r) == 0) ++started;
+        if (pthread_create(&ids[started], &attr, worker, r) == 0)
+            ++started;
     pthread_attr_destroy(&attr);
     if (started == 0) {
         free(ids);
         return -1;
     }
-    for (i = 0; i < started; ++i) pthread_join(ids[i], NULL);
+    for (i = 0; i < started; ++i)
+        pthread_join(ids[i], NULL);
     free(ids);
     pthread_mutex_lock(&r->lock);
-    cancelled = r->cancel && r->rows_done < r->height;
+    cancelled = r->cancel && r->rows_done < rows;
     pthread_mutex_unlock(&r->lock);
     return cancelled ? 1 : 0;
 }

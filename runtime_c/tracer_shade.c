@@ -34,7 +34,8 @@ void rt_reflect(const double d[3], const double n[3], double r[3])
     memcpy(u, d, sizeof u);
     normalize3(u);
     k = 2.0 * rt_dot(u, n);
-    for (a = 0; a < 3; ++a) r[a] = u[a] - k * n[a];
+    for (a = 0; a < 3; ++a)
+        r[a] = u[a] - k * n[a];
     normalize3(r);
 }
 
@@ -46,8 +47,10 @@ int rt_refract(const double d[3], const double n[3], double eta, double t[3])
     normalize3(u);
     ci = -rt_dot(u, n);
     k = 1.0 - eta * eta * (1.0 - ci * ci);
-    if (k < 0.0) return 0;
-    for (a = 0; a < 3; ++a) t[a] = eta * u[a] + (eta * ci - sqrt(k)) * n[a];
+    if (k < 0.0)
+        return 0;
+    for (a = 0; a < 3; ++a)
+        t[a] = eta * u[a] + (eta * ci - sqrt(k)) * n[a];
     normalize3(t);
     return 1;
 }
@@ -55,10 +58,13 @@ int rt_refract(const double d[3], const double n[3], double eta, double t[3])
 double rt_fresnel(double ci, double eta)
 {
     double st2, ct, rs, rp;
-    if (ci < 0.0) ci = -ci;
-    if (ci > 1.0) ci = 1.0;
+    if (ci < 0.0)
+        ci = -ci;
+    if (ci > 1.0)
+        ci = 1.0;
     st2 = eta * eta * (1.0 - ci * ci);
-    if (st2 >= 1.0) return 1.0;
+    if (st2 >= 1.0)
+        return 1.0;
     ct = sqrt(1.0 - st2);
     rs = (eta * ci - ct) / (eta * ci + ct);
     rp = (ci - eta * ct) / (ci + eta * ct);
@@ -69,7 +75,8 @@ void rt_spawn_origin(const rt_hit *h, const double d[3], double origin[3])
 {
     double side = rt_dot(d, h->n) >= 0.0 ? h->err : -h->err;
     int a;
-    for (a = 0; a < 3; ++a) origin[a] = h->p[a] + side * h->n[a];
+    for (a = 0; a < 3; ++a)
+        origin[a] = h->p[a] + side * h->n[a];
 }
 
 /* ------------------------------------------------------------------ shading */
@@ -101,9 +108,12 @@ static void media_remove(rt_media *m, int mat)
         }
 }
 
-static void base_colour(const rt_material *m, const rt_hit *h, double c[3])
+/* The colour of the surface at h before lighting; back: the ray sees the side the normal points away from. */
+static void base_colour(const rt_material *m, const rt_hit *h, int back, double c[3])
 {
-    if (m->checker_scale > 0.0) {
+    if (back && m->two_sided != 0.0) {
+        memcpy(c, m->inside, 3 * sizeof(double));
+    } else if (m->checker_scale > 0.0) {
         /* A 3-D checker in object space, evaluated a little below the surface (a fraction of a cell) so a
          * surface lying exactly on a cell boundary, like the plane y = 0, does not speckle. The cell index
          * floor(q) of each axis is an integer; the colour is color where their sum is even. Below 2^53 the
@@ -116,7 +126,8 @@ static void base_colour(const rt_material *m, const rt_hit *h, double c[3])
                 odd = 1;
                 break;
             }
-            if (k < 0x1p53) odd ^= (int)((long long)k & 1);
+            if (k < 0x1p53)
+                odd ^= (int)((long long)k & 1);
         }
         memcpy(c, odd ? m->color2 : m->color, 3 * sizeof(double));
     } else {
@@ -134,14 +145,18 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
     rt_pending ph;
     int i, a, skip = rt_spawn_skip(s, from);
     T[0] = T[1] = T[2] = 1.0;
-    for (a = 0; a < 3; ++a) dd[a] = light[a] - from->p[a];
+    for (a = 0; a < 3; ++a)
+        dd[a] = light[a] - from->p[a];
     rt_spawn_origin(from, dd, q);
     for (i = 0; i < RT_MAX_SHADOW_CROSSINGS; ++i) {
         const rt_material *m;
-        for (a = 0; a < 3; ++a) dd[a] = light[a] - q[a];
-        if (tr->stats) tr->stats[RT_RAYS_SHADOW] += 1.0;
+        for (a = 0; a < 3; ++a)
+            dd[a] = light[a] - q[a];
+        if (tr->stats)
+            tr->stats[RT_RAYS_SHADOW] += 1.0;
         /* any opaque hit before the light is full shadow, whether or not it is the closest */
-        if (!rt_scene_closest(s, q, dd, 0.0, 1.0, RT_ANY_OPAQUE, skip, &ph)) return;
+        if (!rt_scene_closest(s, q, dd, 0.0, 1.0, RT_ANY_OPAQUE, skip, &ph))
+            return;
         m = &s->materials[s->nodes[ph.leaf].material];
         if (m->transparency <= 0.0) {
             T[0] = T[1] = T[2] = 0.0;
@@ -149,10 +164,12 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
         }
         rt_finish_hit(s, &ph, q, dd, &h, NULL);
         if (h.entering) {
-            for (a = 0; a < 3; ++a) T[a] *= m->transparency;
+            for (a = 0; a < 3; ++a)
+                T[a] *= m->transparency;
         } else {
             double len = h.t * sqrt(rt_dot(dd, dd));
-            for (a = 0; a < 3; ++a) T[a] *= exp(-m->absorption[a] * len);
+            for (a = 0; a < 3; ++a)
+                T[a] *= exp(-m->absorption[a] * len);
         }
         if (T[0] + T[1] + T[2] < 1e-4) {
             T[0] = T[1] = T[2] = 0.0;
@@ -164,8 +181,8 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
 }
 
 /* The colour seen along o + t d; skip: an object the ray need not test (rt_spawn_skip), or -1. */
-static void trace(const rt_tracer *tr, const double o[3], const double d[3], int skip, int depth,
-                  const rt_media *media, double weight, double rgb[3])
+static void trace(const rt_tracer *tr, const double o[3], const double d[3], int skip, int depth, const rt_media *media,
+                  double weight, double rgb[3])
 {
     const rt_scene *s = tr->s;
     const rt_material *m;
@@ -173,7 +190,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
     rt_hit_lazy lazy;
     rt_pending ph;
     double u[3], nf[3], base[3], local[3], col[3], dl;
-    int a, l;
+    int a, l, back;
 
     if (!rt_scene_closest(s, o, d, 0.0, INFINITY, RT_CLOSEST, skip, &ph)) {
         memcpy(rgb, s->background, 3 * sizeof(double));
@@ -184,36 +201,49 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
     rt_finish_hit(s, &ph, o, d, &h, &lazy);
     m = &s->materials[h.material];
     dl = sqrt(rt_dot(d, d));
-    for (a = 0; a < 3; ++a) u[a] = d[a] / dl;
-    if (rt_dot(h.n, u) < 0.0) memcpy(nf, h.n, sizeof nf);
+    for (a = 0; a < 3; ++a)
+        u[a] = d[a] / dl;
+    back = !(rt_dot(h.n, u) < 0.0);
+    if (!back)
+        memcpy(nf, h.n, sizeof nf);
     else
-        for (a = 0; a < 3; ++a) nf[a] = -h.n[a];
+        for (a = 0; a < 3; ++a)
+            nf[a] = -h.n[a];
 
-    base_colour(m, &h, base);
-    for (a = 0; a < 3; ++a) local[a] = m->ambient * base[a];
+    base_colour(m, &h, back, base);
+    for (a = 0; a < 3; ++a)
+        local[a] = m->ambient * base[a];
     if (m->transparency < 1.0) {
         for (l = 0; l < s->nlights; ++l) {
             const double *lp = s->lights + 6 * l, *lc = lp + 3;
             double L[3], ll, ndl, T[3], spec = 0.0;
-            for (a = 0; a < 3; ++a) L[a] = lp[a] - h.p[a];
+            for (a = 0; a < 3; ++a)
+                L[a] = lp[a] - h.p[a];
             ll = sqrt(rt_dot(L, L));
-            if (!(ll > 0.0)) continue;
+            if (!(ll > 0.0))
+                continue;
             ndl = rt_dot(nf, L) / ll;
-            if (ndl <= 0.0) continue; /* the light is behind the surface as seen from the ray */
+            if (ndl <= 0.0)
+                continue; /* the light is behind the surface as seen from the ray */
             rt_hit_error(s, &h, &lazy);
             shadow_transmittance(tr, &h, lp, T);
-            if (T[0] + T[1] + T[2] <= 0.0) continue;
+            if (T[0] + T[1] + T[2] <= 0.0)
+                continue;
             if (m->specular > 0.0) {
                 double hv[3], ndh;
-                for (a = 0; a < 3; ++a) hv[a] = L[a] / ll - u[a];
+                for (a = 0; a < 3; ++a)
+                    hv[a] = L[a] / ll - u[a];
                 normalize3(hv);
                 ndh = rt_dot(nf, hv);
-                if (ndh > 0.0) spec = m->specular * pow(ndh, m->shininess);
+                if (ndh > 0.0)
+                    spec = m->specular * pow(ndh, m->shininess);
             }
-            for (a = 0; a < 3; ++a) local[a] += T[a] * lc[a] * (m->diffuse * base[a] * ndl + spec);
+            for (a = 0; a < 3; ++a)
+                local[a] += T[a] * lc[a] * (m->diffuse * base[a] * ndl + spec);
         }
     }
-    for (a = 0; a < 3; ++a) col[a] = (1.0 - m->transparency) * local[a];
+    for (a = 0; a < 3; ++a)
+        col[a] = (1.0 - m->transparency) * local[a];
 
     if (depth < tr->max_depth) {
         double ci = -rt_dot(u, nf), F = 0.0, kr, kt, tdir[3] = {0.0, 0.0, 0.0};
@@ -224,7 +254,8 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
             if (h.entering) {
                 n1 = media_ior(s, media);
                 n2 = m->ior;
-                if (next.n < RT_MAX_MEDIA) next.mat[next.n++] = h.material;
+                if (next.n < RT_MAX_MEDIA)
+                    next.mat[next.n++] = h.material;
             } else {
                 n1 = m->ior;
                 media_remove(&next, h.material);
@@ -234,31 +265,37 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
             F = can_refract ? rt_fresnel(ci, n1 / n2) : 1.0;
         }
         kr = m->reflectivity + m->transparency * F;
-        if (kr > 1.0) kr = 1.0;
+        if (kr > 1.0)
+            kr = 1.0;
         kt = can_refract ? m->transparency * (1.0 - F) : 0.0;
         if (kr * weight > RT_MIN_WEIGHT) {
             double r[3], q[3], c[3];
             rt_reflect(u, nf, r);
             rt_hit_error(s, &h, &lazy);
             rt_spawn_origin(&h, r, q);
-            if (tr->stats) tr->stats[RT_RAYS_SECONDARY] += 1.0;
+            if (tr->stats)
+                tr->stats[RT_RAYS_SECONDARY] += 1.0;
             trace(tr, q, r, rt_spawn_skip(s, &h), depth + 1, media, weight * kr, c);
-            for (a = 0; a < 3; ++a) col[a] += kr * c[a];
+            for (a = 0; a < 3; ++a)
+                col[a] += kr * c[a];
         }
         if (kt * weight > RT_MIN_WEIGHT) {
             double q[3], c[3];
             rt_hit_error(s, &h, &lazy);
             rt_spawn_origin(&h, tdir, q);
-            if (tr->stats) tr->stats[RT_RAYS_SECONDARY] += 1.0;
+            if (tr->stats)
+                tr->stats[RT_RAYS_SECONDARY] += 1.0;
             trace(tr, q, tdir, rt_spawn_skip(s, &h), depth + 1, &next, weight * kt, c);
-            for (a = 0; a < 3; ++a) col[a] += kt * c[a];
+            for (a = 0; a < 3; ++a)
+                col[a] += kt * c[a];
         }
     }
     /* Beer-Lambert over the segment just travelled, if it ran inside an absorbing medium. */
     if (media->n > 0) {
         const rt_material *mm = &s->materials[media->mat[media->n - 1]];
         double len = h.t * dl;
-        for (a = 0; a < 3; ++a) col[a] *= exp(-mm->absorption[a] * len);
+        for (a = 0; a < 3; ++a)
+            col[a] *= exp(-mm->absorption[a] * len);
     }
     memcpy(rgb, col, 3 * sizeof(double));
 }
@@ -272,7 +309,8 @@ void rt_trace_ray(const rt_scene *s, const double o[3], const double d[3], int m
     tr.max_depth = max_depth < 0 ? 0 : (max_depth > RT_MAX_DEPTH ? RT_MAX_DEPTH : max_depth);
     tr.stats = stats;
     media.n = 0;
-    if (stats) stats[RT_RAYS_PRIMARY] += 1.0;
+    if (stats)
+        stats[RT_RAYS_PRIMARY] += 1.0;
     if (!s->committed) {
         rgb[0] = rgb[1] = rgb[2] = 0.0;
         return;

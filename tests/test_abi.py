@@ -69,7 +69,7 @@ def test_struct_layouts_match(tmp_path):
         assert getattr(RtHit, name).offset == seen[f"hit.{name}"], name
     # a packed material lists rt_material's doubles in memory order, padded to RT_MATERIAL_DOUBLES
     assert seen["sizeof_mat"] <= 8 * abi.value("RT_MATERIAL_DOUBLES")
-    m = Material(color=(0.1, 0.2, 0.3), ior=1.7, absorption=(4.0, 5.0, 6.0))
+    m = Material(color=(0.1, 0.2, 0.3), ior=1.7, absorption=(4.0, 5.0, 6.0), inside=(0.7, 0.8, 0.9))
     packed = m.packed()
     assert len(packed) == abi.value("RT_MATERIAL_DOUBLES")
     for name, count in abi.material_fields():

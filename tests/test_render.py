@@ -130,6 +130,25 @@ def test_cache_second_build_compiles_nothing(tmp_path: Path, monkeypatch) -> Non
     assert third.generated == 1 and third.library != first.library and len(calls) == 1
 
 
+def test_a_new_shape_compiles_only_itself_and_the_glue(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.setenv("IMPLGEN_CACHE", str(tmp_path / "cache"))
+    build.build_scene(parse_scene(base_scene(objects=[{"equation": "y + 0.25*x", "name": "tilted"}]), "a.yaml"))
+    compiled: list[str] = []
+    real = clib.subprocess.run
+
+    def spy(cmd, *a, **k):
+        if "-c" in cmd:
+            compiled.append(Path(cmd[cmd.index("-c") + 1]).name)
+        return real(cmd, *a, **k)
+
+    monkeypatch.setattr(clib.subprocess, "run", spy)
+    sc = parse_scene(base_scene(objects=[{"equation": "x^2 + y^2 + z^2 - 1", "name": "ball"}]), "b.yaml")
+    res = build.build_scene(sc)
+    assert len(compiled) == 2 and "ball.c" in compiled and any(c.startswith("glue-") for c in compiled)
+    # the library works: the ray along -z from z = 5 meets the unit sphere at t = 4
+    assert CScene(sc, res).intersect([0, 0, 5], [0, 0, -1]).t == pytest.approx(4.0)
+
+
 def test_only_the_scenes_shapes_are_compiled(tmp_path: Path, monkeypatch) -> None:
     monkeypatch.setenv("IMPLGEN_CACHE", str(tmp_path / "cache"))
     sc = load_scene(SCENES / "csg_trio.yaml")

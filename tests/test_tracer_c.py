@@ -1,8 +1,10 @@
 """The tracer's C tests: standalone drivers in tests/c/tracer_*.c, built with the sanitizers and run here.
 
-tracer_rays.c checks ray-level answers against analytic values (sphere distances, Snell, TIR, Fresnel, CSG
-event sequences, a transformed torus against the inverse-transformed ray, the piriform in the paper's basis
-form). tracer_offsets.c measures secondary-ray robustness on every example shape at scales 1e-3 .. 1e3.
+tracer_rays.c + tracer_rays_optics.c (one driver) check ray-level answers against analytic values (sphere
+distances, Snell, TIR, Fresnel, CSG event sequences, a transformed torus against the inverse-transformed ray,
+the piriform in the paper's basis form). tracer_offsets.c measures secondary-ray robustness on every example
+shape at scales 1e-3 .. 1e3. tracer_render_rows.c checks that a band of rows renders exactly those rows of the
+whole image.
 """
 
 from __future__ import annotations
@@ -37,11 +39,19 @@ def run(exe: Path, *args: str, timeout: float = 300) -> str:
 
 def test_ray_level_analytic(tmp_path: Path) -> None:
     shapes = [GENERATED / f"{n}.c" for n in ("sphere", "torus_z", "piriform")]
-    exe = compile_c(tmp_path / "rays", [CDIR / "tracer_rays.c", *runtime_c_sources(), *shapes])
+    exe = compile_c(
+        tmp_path / "rays", [CDIR / "tracer_rays.c", CDIR / "tracer_rays_optics.c", *runtime_c_sources(), *shapes]
+    )
     out = run(exe)
     assert "0 failures" in out
     assert re.search(r"sphere: 20000 random rays, hit/miss disagreements 0", out)
     assert re.search(r"transformed torus: 20000 rays \(\d+ hits\), hit/miss disagreements 0", out)
+
+
+def test_a_band_of_rows_is_exactly_those_rows_of_the_image(tmp_path: Path) -> None:
+    shapes = [GENERATED / f"{n}.c" for n in ("sphere", "torus_z")]
+    exe = compile_c(tmp_path / "rows", [CDIR / "tracer_render_rows.c", *runtime_c_sources(), *shapes])
+    assert "render rows: 6 bands, 0 failures" in run(exe)
 
 
 def shape_table(path: Path, names: list[str]) -> Path:

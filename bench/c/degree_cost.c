@@ -45,7 +45,8 @@ int degree_cost(int n, int reps, unsigned long long seed, double *out)
     double *tt = malloc(sizeof(double) * (size_t)reps);
     long total_roots = 0, hit = 0;
     volatile double sink = 0.0;
-    if (!o || !d || !o2 || !lo || !hi || !c || !tc || !ts || !tt || !s->bounds(NULL, box)) return 1;
+    if (!o || !d || !o2 || !lo || !hi || !c || !tc || !ts || !tt || !s->bounds(NULL, box))
+        return 1;
     rng_state = seed;
     for (k = 0; k < 3; ++k) {
         ctr[k] = 0.5 * (box[k] + box[3 + k]);
@@ -62,29 +63,39 @@ int degree_cost(int n, int reps, unsigned long long seed, double *out)
         }
         for (k = 0; k < 3; ++k) { /* slab clip: the same interval ig_shape_roots solves on */
             double a = (box[k] - o[3 * i + k]) / d[3 * i + k], b = (box[3 + k] - o[3 * i + k]) / d[3 * i + k];
-            if (a > b) { double t = a; a = b; b = t; }
-            if (a > t0) t0 = a;
-            if (b < t1) t1 = b;
+            if (a > b) {
+                double t = a;
+                a = b;
+                b = t;
+            }
+            if (a > t0)
+                t0 = a;
+            if (b < t1)
+                t1 = b;
             num += d[3 * i + k] * (ctr[k] - o[3 * i + k]);
             den += d[3 * i + k] * d[3 * i + k];
         }
-        if (t0 < 0.0) t0 = 0.0;
+        if (t0 < 0.0)
+            t0 = 0.0;
         tsh = num / den;
         tsh = tsh < t0 ? t0 : (tsh > t1 ? t1 : tsh);
-        for (k = 0; k < 3; ++k) o2[3 * i + k] = o[3 * i + k] + tsh * d[3 * i + k];
+        for (k = 0; k < 3; ++k)
+            o2[3 * i + k] = o[3 * i + k] + tsh * d[3 * i + k];
         lo[i] = t0 - tsh;
         hi[i] = t1 - tsh;
     }
     for (r = 0; r < reps; ++r) {
         double t = now();
-        for (i = 0; i < n; ++i) s->coeffs(o2 + 3 * i, d + 3 * i, NULL, c + (size_t)(deg + 1) * (size_t)i);
+        for (i = 0; i < n; ++i)
+            s->coeffs(o2 + 3 * i, d + 3 * i, NULL, c + (size_t)(deg + 1) * (size_t)i);
         tc[r] = now() - t;
         t = now();
         total_roots = 0;
         for (i = 0; i < n; ++i) {
             int m = ig_real_roots(c + (size_t)(deg + 1) * (size_t)i, deg, lo[i], hi[i], IG_ROOTS_AUTO, roots);
             total_roots += m;
-            if (m) sink += roots[0];
+            if (m)
+                sink += roots[0];
         }
         ts[r] = now() - t;
         t = now();
@@ -92,7 +103,8 @@ int degree_cost(int n, int reps, unsigned long long seed, double *out)
         for (i = 0; i < n; ++i) {
             int m = ig_shape_roots(s, NULL, o + 3 * i, d + 3 * i, 0.0, INFINITY, IG_ROOTS_AUTO, roots);
             hit += m > 0;
-            if (m) sink += roots[0];
+            if (m)
+                sink += roots[0];
         }
         tt[r] = now() - t;
     }
@@ -104,7 +116,15 @@ int degree_cost(int n, int reps, unsigned long long seed, double *out)
     out[2] = 1e9 * tt[reps / 2] / n;
     out[3] = (double)total_roots / n;
     out[4] = (double)hit / n;
-    free(o); free(d); free(o2); free(lo); free(hi); free(c); free(tc); free(ts); free(tt);
+    free(o);
+    free(d);
+    free(o2);
+    free(lo);
+    free(hi);
+    free(c);
+    free(tc);
+    free(ts);
+    free(tt);
     (void)sink;
     return 0;
 }

@@ -5,8 +5,11 @@ Two caches, both under clib.cache_dir() (`$IMPLGEN_CACHE`, else `$XDG_CACHE_HOME
   gen/<key>/      generated .c/.h of one shape; the key hashes the spec's content (equation, params, bounds,
                   folded values, name) and implgen's own generator + template sources, so editing a spec or
                   upgrading implgen regenerates, and nothing else does;
-  scene-<hash>.so the compiled library (clib.build_shared hashes every source and header).
-An unchanged scene therefore neither runs SymPy nor the C compiler the second time.
+  obj/<name>-<hash>.o  one object per C source (clib.compile_object hashes the source and the headers it
+                  can see): the runtime's objects are compiled once and shared by every scene;
+  scene-<hash>.so the linked library (clib.link_shared, keyed by its objects).
+An unchanged scene therefore neither runs SymPy nor the C compiler the second time, and a new shape costs
+one generation, one small compilation (its .c and the glue) and a link.
 """
 
 from __future__ import annotations
@@ -141,12 +144,11 @@ def build_scene(scene: Scene, fold: bool = False) -> BuildResult:
         data = glue_text.encode()
         atomic_write(glue, lambda fh: fh.write(data))
     rt = runtime_dir()
-    sources = (
-        runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES, TRACER_SOURCES)
-        + [d / f"{e.c_name}.c" for d, e in zip(dirs, entries)]
-        + [glue]
-    )
-    lib = clib.build_shared(
-        sources, include_dirs=[rt, *dirs], extra_flags=["-pthread"], libs=["-lm", "-pthread"], tag="scene"
-    )
+    # Each runtime source sees only the runtime's headers, so its object is shared by every scene; each shape
+    # sees its own folder too, and only the glue sees all of them.
+    jobs = [(src, [rt]) for src in runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES, TRACER_SOURCES)]
+    jobs += [(d / f"{e.c_name}.c", [rt, d]) for d, e in zip(dirs, entries)]
+    jobs.append((glue, [rt, *dirs]))
+    objects = clib.compile_objects(jobs, extra_flags=["-pthread"])
+    lib = clib.link_shared(objects, libs=["-lm", "-pthread"], tag="scene")
     return BuildResult(library=lib, entries=entries, leaf_index=leaf_index, generated=generated)

@@ -1,20 +1,29 @@
-"""`implgen render SCENE.yaml -o OUT.png [--width W --height H --spp N --threads T --max-depth N]`.
+"""`implgen render SCENE.yaml -o OUT [options]`: a still to a PNG, or an animation's frames to a PNG
+sequence, a video or a GIF; here, on a LocalCluster, or on a running Dask cluster.
 
-The output is checked before anything else, then the scene is loaded, rendered (scene/render.py) and the
-PNG written atomically.
+The output is checked before anything else, then the scene is loaded and every frame validated, and only
+then does anything render. A still scene without Dask options takes the path it always took (render.py).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
 
+from implgen import validate
 from implgen.cli import ArgumentParser
 from implgen.errors import UserError
-from implgen.outputs import check_output_file
-from implgen.scene.load import load_scene
-from implgen.scene.render import DEFAULT_FOLD, RenderInfo, render, write_png
+from implgen.scene import cluster
+from implgen.scene.batch import Runner, render_frames
+from implgen.scene.frameout import FrameOutput, plan_output
+from implgen.scene.frames import FrameOptions, Frames, load_frames, parse_range
+from implgen.scene.keys import MAX_FRAMES
+from implgen.scene.load import MAX_DEPTH, MAX_SIZE, MAX_SPP
+from implgen.scene.render import DEFAULT_FOLD, MAX_THREADS, RenderInfo, render, write_png
+
+MAX_RETRIES = 100
 
 
 def _positive(text: str) -> int:
@@ -27,39 +36,124 @@ def _positive(text: str) -> int:
     return v
 
 
-def main(argv: Sequence[str]) -> int:
-    ap = ArgumentParser(label="render", prog="implgen render", description="Render a scene file to a PNG.")
+def _parser() -> ArgumentParser:
+    ap = ArgumentParser(
+        label="render", prog="implgen render", description="Render a scene file: a still or an animation's frames."
+    )
     ap.add_argument("scene", type=Path)
-    ap.add_argument("-o", "--output", type=Path, required=True, help="PNG to write")
+    ap.add_argument(
+        "-o", "--output", type=Path, required=True, help="OUT.png, a pattern like frames/f_%%04d.png, .mp4, .webm, .gif"
+    )
     ap.add_argument("--width", type=_positive)
     ap.add_argument("--height", type=_positive)
     ap.add_argument("--spp", type=_positive, help="samples per pixel (stratified)")
-    ap.add_argument("--threads", type=_positive, help="default: all cores")
+    ap.add_argument("--threads", type=_positive, help="render threads per frame (default: all cores)")
     ap.add_argument("--max-depth", type=int, dest="max_depth", metavar="N")
     ap.add_argument("--fold", action="store_true", help="fold constant shape params into the generated code")
+    ap.add_argument("--frames", metavar="A:B", help="render frames A to B of an animation (both included)")
+    where = ap.add_mutually_exclusive_group()
+    where.add_argument("--local-workers", type=_positive, metavar="N", help="a Dask LocalCluster of N processes")
+    where.add_argument("--cluster", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://host:8786")
+    ap.add_argument("--tiles", type=_positive, metavar="K", help="render each frame as K bands of rows (K tasks)")
+    ap.add_argument("--retries", type=int, default=3, help="reruns of a failed task (default 3)")
+    ap.add_argument("--keep-frames", action="store_true", help="keep a video's or GIF's frame PNGs")
     ap.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
-    args = ap.parse_args(list(argv))
-    check_output_file(args.output, "-o", (".png",))
-    scene = load_scene(args.scene)
+    return ap
+
+
+def main(argv: Sequence[str]) -> int:
+    args = _parser().parse_args(list(argv))
+    validate.whole("--retries", "", args.retries, 0, MAX_RETRIES)
+    address = cluster.check_address(args.cluster) if args.cluster is not None else None
+    if args.local_workers is not None:
+        validate.whole("--local-workers", "", args.local_workers, 1, cluster.MAX_LOCAL_WORKERS)
+    plan_output(args.output, 1, MAX_FRAMES - 1, 2, 2)  # the path alone, before reading the scene
+    frames = load_frames(args.scene)
+    todo = parse_range(args.frames, frames.count) if args.frames is not None else range(frames.count)
+    opts = _options(args, frames)
+    out = plan_output(args.output, len(todo), todo[-1], opts.width, opts.height)
+    if args.fold and frames.params_vary:
+        raise UserError("--fold", "the scene's shape params change from frame to frame; they cannot be folded")
+    if args.tiles is not None:
+        validate.whole("--tiles", "", args.tiles, 1, opts.height)
+    distributed = args.local_workers is not None or address is not None
+    if out.kind == "still" and args.tiles is None and not distributed:
+        return _still(args, frames, todo[0], opts, out)
+    if args.local_workers is not None and args.threads is None:
+        opts = dataclasses.replace(opts, threads=cluster.local_threads(args.local_workers))
+    if not distributed:
+        return _run(args, frames, todo, opts, out, Runner(retries=args.retries))
+    with cluster.connect(args.local_workers, address) as client:
+        return _run(args, frames, todo, opts, out, Runner(client=client, retries=args.retries))
+
+
+def _options(args: argparse.Namespace, frames: Frames) -> FrameOptions:
+    sc = frames.first
+    opts = FrameOptions(
+        width=args.width or sc.width,
+        height=args.height or sc.height,
+        spp=args.spp or sc.spp,
+        max_depth=sc.max_depth if args.max_depth is None else args.max_depth,
+        threads=args.threads,
+    )
+    for option, v, lo, hi in (
+        ("--width", opts.width, 1, MAX_SIZE),
+        ("--height", opts.height, 1, MAX_SIZE),
+        ("--spp", opts.spp, 1, MAX_SPP),
+        ("--threads", opts.threads or 1, 1, MAX_THREADS),
+        ("--max-depth", opts.max_depth, 0, MAX_DEPTH),
+    ):
+        validate.whole(option, "", v, lo, hi)
+    return opts
+
+
+def _still(args: argparse.Namespace, frames: Frames, frame: int, opts: FrameOptions, out: FrameOutput) -> int:
+    """One image in this process, with a progress bar over rows (what `implgen render` always did)."""
     info = RenderInfo()
     img = render(
-        scene,
-        width=args.width,
-        height=args.height,
-        spp=args.spp,
-        threads=args.threads,
-        max_depth=args.max_depth,
+        frames.scene(frame),
+        width=opts.width,
+        height=opts.height,
+        spp=opts.spp,
+        threads=opts.threads,
+        max_depth=opts.max_depth,
         progress=not args.quiet,
         fold=args.fold or DEFAULT_FOLD,
         info=info,
     )
     try:
-        write_png(img, args.output)
+        write_png(img, out.target)
     except OSError as err:  # what the early check could not foresee: a full disk, a folder removed meanwhile
         raise UserError(f"-o {args.output}", f"cannot write: {err.strerror or err}") from None
     total = sum(info.rays.values())
     print(
-        f"implgen: wrote {args.output} ({img.shape[1]}x{img.shape[0]}, {info.seconds:.3f} s on "
+        f"implgen: wrote {out.target} ({img.shape[1]}x{img.shape[0]}, {info.seconds:.3f} s on "
         f"{info.threads} threads, {total / max(info.seconds, 1e-9) / 1e6:.2f} Mrays/s)"
+    )
+    return 0
+
+
+def _run(
+    args: argparse.Namespace, frames: Frames, todo: range, opts: FrameOptions, out: FrameOutput, runner: Runner
+) -> int:
+    where = "this process" if runner.client is None else f"{runner.workers()} Dask workers"
+    tiles = args.tiles or 1
+    report = render_frames(
+        frames,
+        todo,
+        opts,
+        out,
+        runner,
+        tiles=tiles,
+        fold=args.fold,
+        progress=not args.quiet,
+        keep_frames=args.keep_frames,
+    )
+    n = len(report.written)
+    skipped = f", {len(report.skipped)} already there" if report.skipped else ""
+    cut = f" in {tiles} tiles each" if tiles > 1 else ""
+    print(
+        f"implgen: wrote {n} frame{'' if n == 1 else 's'}{skipped} of {opts.width}x{opts.height}{cut} "
+        f"to {out.target} in {report.seconds:.1f} s ({where})"
     )
     return 0

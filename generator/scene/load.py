@@ -17,6 +17,7 @@ import numpy as np
 from implgen import abi, validate
 from implgen.codegen.spec import Spec, load_spec, parse_spec
 from implgen.errors import UserError
+from implgen.scene import keys
 from implgen.scene import transform as tf
 from implgen.scene.model import Camera, Csg, Leaf, Light, Material, Node, Scene, depth
 from implgen.yamlfile import read_yaml
@@ -49,9 +50,9 @@ ABSORPTION_MAX = 1e6
 
 # ----------------------------------------------------------------------------------------------- helpers
 
-TOP_KEYS = ("image", "camera", "background", "lights", "materials", "objects")
+TOP_KEYS = ("image", "camera", "background", "lights", "materials", "objects", "animation")
 IMAGE_KEYS = ("width", "height", "spp", "max_depth")
-CAMERA_KEYS = ("position", "look_at", "up", "fov")
+CAMERA_KEYS = ("position", "look_at", "up", "fov", "orbit")
 LIGHT_KEYS = ("position", "color", "intensity")
 MATERIAL_KEYS = (
     "color",
@@ -64,18 +65,30 @@ MATERIAL_KEYS = (
     "transparency",
     "ior",
     "absorption",
+    "inside",
 )
 LEAF_KEYS = ("shape", "equation", "name", "params", "bounds", "transform", "material")
 
 
 class _Ctx:
-    def __init__(self, path: Path):
+    def __init__(self, path: Path, frame: int, memo: dict | None):
         self.path = path
         self.source = str(path)
-        self.spec_cache: dict[Path, Spec] = {}
-        self.resolved: dict[str, Path] = {}  # `shape:` text -> spec file, looked up once per scene
+        memo = {} if memo is None else memo  # shared by the frames of one animation: specs are read once
+        self.spec_cache: dict[Path, Spec] = memo.setdefault("specs", {})
+        self.resolved: dict[str, Path] = memo.setdefault("paths", {})  # `shape:` text -> spec file
+        self.inline_specs: dict[str, Spec] = memo.setdefault("inline", {})
         self.inline_count = 0
         self.leaves = 0
+        self.frame = frame
+        self.frames: int | None = None  # the animation's frame count; None without an `animation` block
+        self.keyed: list[str] = []  # key paths of the values that change with the frame
+        self.static: dict[int, tuple] = memo.setdefault("static", {})  # objects the same on every frame
+        self.reused: set[int] = set()  # objects[i] taken from `static` on this frame
+
+    def resolve(self, key: str, raw: Any) -> Any:
+        """A part of the scene made only of numbers (a transform), with keyed values at this frame."""
+        return keys.resolve(self.source, key, raw, self.frame, self.frames, self.keyed)
 
     def fail(self, key: str, msg: str) -> UserError:
         return UserError(self.source, f"{key}: {msg}")
@@ -110,16 +123,25 @@ def _num(
     hi: float = validate.MAX_COORDINATE,
     lo_open: bool = False,
 ) -> float:
-    return validate.number(ctx.source, key, value, lo, hi, lo_open=lo_open)
+    def check(k: str, v: Any) -> float:
+        return validate.number(ctx.source, k, v, lo, hi, lo_open=lo_open)
+
+    return keys.number_at(ctx.source, key, value, ctx.frame, ctx.frames, check, ctx.keyed)
 
 
 def _int(ctx: _Ctx, key: str, value: Any, lo: int, hi: int) -> int:
+    if keys.is_keyed(value):
+        raise ctx.fail(key, "cannot be keyed (it is the same on every frame)")
     return validate.whole(ctx.source, key, value, lo, hi)
 
 
 def _vec(
     ctx: _Ctx, key: str, value: Any, lo: float = -validate.MAX_COORDINATE, hi: float = validate.MAX_COORDINATE
 ) -> tuple[float, float, float]:
+    if keys.is_keyed(value):
+        raise ctx.fail(key, "key each of the three numbers on its own: [x, {keys: ...}, z]")
+    if isinstance(value, (list, tuple)) and len(value) == 3:
+        value = [_num(ctx, f"{key}[{i}]", v, lo, hi) for i, v in enumerate(value)]
     return validate.vector(ctx.source, key, value, lo, hi)
 
 
@@ -147,6 +169,8 @@ def _material(ctx: _Ctx, key: str, raw: Any) -> Material:
         m.ior = _num(ctx, f"{key}.ior", raw["ior"], 0.0, IOR_MAX, lo_open=True)
     if "absorption" in raw:
         m.absorption = _vec(ctx, f"{key}.absorption", raw["absorption"], 0.0, ABSORPTION_MAX)
+    if "inside" in raw:  # two-sided: the colour of the back (f < 0) side of a surface
+        m.inside = _color(ctx, f"{key}.inside", raw["inside"])
     return m
 
 
@@ -211,10 +235,13 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
         mapping = {"name": raw.get("name", f"inline{ctx.inline_count}"), "equation": raw["equation"]}
         if "bounds" in raw:
             mapping["bounds"] = raw["bounds"]
+        overrides: Any = {}
         if "params" in raw:
-            mapping["params"] = raw["params"]
-        spec = parse_spec(mapping, f"{ctx.source}: {key}")
-        overrides = {}
+            mapping["params"], overrides = keys.inline_params(ctx.source, f"{key}.params", raw["params"], ctx.frames)
+        memo_key = f"{ctx.inline_count}:{mapping!r}"  # the same inline shape on every frame
+        if memo_key not in ctx.inline_specs:
+            ctx.inline_specs[memo_key] = parse_spec(mapping, f"{ctx.source}: {key}")
+        spec = ctx.inline_specs[memo_key]
     if not isinstance(overrides, dict):
         raise ctx.fail(f"{key}.params", "expected a mapping name -> number")
     params = dict(spec.params)
@@ -226,7 +253,7 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
         params[name] = _num(ctx, f"{key}.params.{name}", v)
     if overrides:
         spec.check_values(params, ctx.source, f"{key}.params")
-    m = tf.parse_transform(ctx.source, f"{key}.transform", raw.get("transform"))
+    m = tf.parse_transform(ctx.source, f"{key}.transform", ctx.resolve(f"{key}.transform", raw.get("transform")))
     mat = _material_ref(ctx, f"{key}.material", raw["material"], named) if "material" in raw else None
     return Leaf(spec=spec, params=params, matrix=m, material=mat, where=key)
 
@@ -256,8 +283,24 @@ def _node(ctx: _Ctx, key: str, raw: Any, named: dict[str, Material], depth: int)
         node = _balanced(op, children, key)
     node.material = mat
     if "transform" in raw:
-        m = tf.parse_transform(ctx.source, f"{key}.transform", raw["transform"])
+        m = tf.parse_transform(ctx.source, f"{key}.transform", ctx.resolve(f"{key}.transform", raw["transform"]))
         _apply_transform(node, m)
+    return node
+
+
+def _object(ctx: _Ctx, i: int, raw: Any, named: dict[str, Material], fixed: dict | None) -> Node:
+    """objects[i]; one with no keyed value is parsed on the first frame only and shared by later frames."""
+    if fixed is not None and i not in fixed and not keys.contains_keyed(raw):
+        leaves, inline = ctx.leaves, ctx.inline_count
+        node = _node(ctx, f"objects[{i}]", raw, named, 0)
+        fixed[i] = (node, ctx.leaves - leaves, ctx.inline_count - inline)
+        return node
+    if fixed is None or i not in fixed:
+        return _node(ctx, f"objects[{i}]", raw, named, 0)
+    node, leaves, inline = fixed[i]  # the same counts as on the first frame, which passed the limits
+    ctx.reused.add(i)
+    ctx.leaves += leaves
+    ctx.inline_count += inline
     return node
 
 
@@ -288,13 +331,19 @@ def _apply_transform(node: Node, m: np.ndarray) -> None:
         _apply_transform(node.right, m)
 
 
-def parse_scene(data: Any, source: str | Path = "<scene>") -> Scene:
+def parse_scene(data: Any, source: str | Path = "<scene>", *, frame: int = 0, memo: dict | None = None) -> Scene:
+    """The scene at `frame` (0 for a still). `memo` carries the specs read for one frame to the next."""
     path = Path(source)
-    ctx = _Ctx(path)
+    ctx = _Ctx(path, frame, memo)
     if not isinstance(data, dict):
         raise UserError(ctx.source, "a scene must be a mapping with at least 'objects'")
     _mapping(ctx, "", data, TOP_KEYS)
     sc = Scene(source=ctx.source)
+    if "animation" in data:
+        sc.animation = keys.parse_animation(ctx.source, data["animation"])
+        ctx.frames = sc.animation.frames
+    if not 0 <= frame < sc.animation.frames:
+        raise UserError(ctx.source, f"frame {frame} is outside [0, {sc.animation.frames - 1}]")
     img = _mapping(ctx, "image", _given(data, "image", {}), IMAGE_KEYS)
     sc.width = _int(ctx, "image.width", img.get("width", sc.width), 1, MAX_SIZE)
     sc.height = _int(ctx, "image.height", img.get("height", sc.height), 1, MAX_SIZE)
@@ -302,6 +351,8 @@ def parse_scene(data: Any, source: str | Path = "<scene>") -> Scene:
     sc.max_depth = _int(ctx, "image.max_depth", img.get("max_depth", sc.max_depth), 0, MAX_DEPTH)
     cam = _mapping(ctx, "camera", _given(data, "camera", {}), CAMERA_KEYS)
     c = Camera()
+    if "orbit" in cam:
+        c.position, c.look_at = keys.orbit_camera(ctx.source, cam, ctx.frame, ctx.frames, ctx.keyed)
     if "position" in cam:
         c.position = _vec(ctx, "camera.position", cam["position"])
     if "look_at" in cam:
@@ -341,12 +392,16 @@ def parse_scene(data: Any, source: str | Path = "<scene>") -> Scene:
     objs = data.get("objects")
     if not isinstance(objs, list) or not objs:
         raise ctx.fail("objects", "expected a non-empty list")
-    sc.objects = [_node(ctx, f"objects[{i}]", raw, named, 0) for i, raw in enumerate(objs)]
-    for obj in sc.objects:
+    fixed = ctx.static if not keys.contains_keyed(mats) else None  # no object can change with the frame
+    sc.objects = [_object(ctx, i, raw, named, fixed) for i, raw in enumerate(objs)]
+    sc.keyed = tuple(ctx.keyed)
+    for i, obj in enumerate(sc.objects):
+        if i in ctx.reused:  # checked on the first frame
+            continue
         if depth(obj) > MAX_CSG_DEPTH:  # cannot happen within the documented limits; the tracer's own
             raise ctx.fail(getattr(obj, "where", "objects"), f"CSG tree deeper than {MAX_CSG_DEPTH}")
-    for leaf in sc.leaves():
-        tf.check_matrix(ctx.source, f"{leaf.where}.transform", leaf.matrix)
+        for leaf in Scene(source="", objects=[obj]).leaves():
+            tf.check_matrix(ctx.source, f"{leaf.where}.transform", leaf.matrix)
     return sc
 
 

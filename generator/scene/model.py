@@ -12,6 +12,7 @@ import numpy as np
 
 from implgen import abi
 from implgen.codegen.spec import Spec
+from implgen.scene.keys import Animation
 
 
 @dataclass
@@ -27,12 +28,20 @@ class Material:
     transparency: float = 0.0
     ior: float = 1.5
     absorption: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    inside: tuple[float, float, float] | None = None  # colour of a surface's back (f < 0) side; None: color
+
+    @property
+    def two_sided(self) -> float:
+        """rt_material.two_sided: 1 when the back of the surface has its own colour."""
+        return 0.0 if self.inside is None else 1.0
 
     def packed(self) -> list[float]:
         """RT_MATERIAL_DOUBLES values in the order of rt_material's fields (read from tracer.h)."""
         values: list[float] = []
         for name, count in abi.material_fields():
             v = getattr(self, name)
+            if name == "inside" and v is None:
+                v = (0.0, 0.0, 0.0)  # unused: two_sided is 0
             values += [float(x) for x in v] if count > 1 else [float(v)]
         return values + [0.0] * (abi.value("RT_MATERIAL_DOUBLES") - len(values))
 
@@ -92,6 +101,8 @@ class Scene:
     background: tuple[float, float, float] = (0.0, 0.0, 0.0)
     lights: list[Light] = field(default_factory=list)
     objects: list[Node] = field(default_factory=list)
+    animation: Animation = field(default_factory=Animation)  # frames and fps; one frame for a still
+    keyed: tuple[str, ...] = ()  # key paths of the values that change from frame to frame
 
     def leaves(self) -> list[Leaf]:
         out: list[Leaf] = []

@@ -18,7 +18,7 @@ import numpy as np
 
 from implgen import validate
 from implgen.outputs import atomic_write
-from implgen.scene.build import build_scene
+from implgen.scene.build import BuildResult, build_scene
 from implgen.scene.load import MAX_DEPTH, MAX_SIZE, MAX_SPP, load_scene, parse_scene
 from implgen.scene.model import Scene
 from implgen.scene.tracer import CScene
@@ -61,9 +61,13 @@ def render(
     progress: bool = False,
     fold: bool = DEFAULT_FOLD,
     info: RenderInfo | None = None,
+    built: BuildResult | None = None,
+    rows: tuple[int, int] | None = None,
 ) -> np.ndarray:
     """Render a scene (a Scene, a scene file path, or a scene mapping) to a float32 array (height, width, 3),
-    row 0 at the top, colours linear and not clamped. Options override the scene's `image` settings."""
+    row 0 at the top, colours linear and not clamped. Options override the scene's `image` settings. `built`:
+    the scene library when the caller has it already (the frames of one animation share one). `rows`: only
+    the band of rows [y0, y1) of the image (a tile), exactly as those rows of the whole image."""
     sc = _as_scene(scene)
     w = width or sc.width
     h = height or sc.height
@@ -78,13 +82,20 @@ def render(
         ("--max-depth", depth, 0, MAX_DEPTH),
     ):
         validate.whole(option, "", v, lo, hi)
-    built = build_scene(sc, fold=fold)
+    y0, y1 = (0, h) if rows is None else rows
+    if not 0 <= y0 < y1 <= h:
+        raise ValueError(f"rows {rows} outside the image's {h} rows")
+    if built is None:
+        built = build_scene(sc, fold=fold)
     cs = CScene(sc, built)
     try:
         ctx = cs.lib.rt_render_new(cs.ptr, w, h, n, depth, nthreads, seed)
         if not ctx:
             raise RuntimeError("rt_render_new failed")
-        out = np.zeros((h, w, 3), dtype=np.float32)
+        if rows is not None and cs.lib.rt_render_set_rows(ctx, y0, y1) != 0:
+            cs.lib.rt_render_free(ctx)
+            raise RuntimeError("rt_render_set_rows failed")
+        out = np.zeros((y1 - y0, w, 3), dtype=np.float32)
         result: dict[str, int] = {}
         ptr = out.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
 
@@ -101,7 +112,7 @@ def render(
         if progress:
             from tqdm import tqdm
 
-            bar = tqdm(total=h, unit="row", desc=Path(sc.source).name, leave=True)
+            bar = tqdm(total=y1 - y0, unit="row", desc=Path(sc.source).name, leave=True)
         try:
             done = 0
             while True:

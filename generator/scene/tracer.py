@@ -52,6 +52,7 @@ def bind(lib: ctypes.CDLL) -> ctypes.CDLL:
             [vp, ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_ulong],
         ),
         "rt_render_free": (None, [vp]),
+        "rt_render_set_rows": (ctypes.c_int, [vp, ctypes.c_int, ctypes.c_int]),
         "rt_render_run": (ctypes.c_int, [vp, ctypes.POINTER(ctypes.c_float)]),
         "rt_render_progress": (ctypes.c_int, [vp]),
         "rt_render_cancel": (None, [vp]),

@@ -94,7 +94,7 @@ def parse_transform(source: str, key: str, raw: Any) -> np.ndarray:
     if "axes" in raw or "position" in raw:
         extra = set(raw) - {"position", "axes"}
         if extra:
-            raise UserError(source, f"{key}.{sorted(extra)[0]}: not allowed with position/axes")
+            raise UserError(source, f"{key}.{min(extra, key=str)}: not allowed with position/axes")
         if "axes" not in raw:
             raise UserError(source, f"{key}: 'position' needs 'axes' (three vectors u, v, w)")
         axes = raw["axes"]
@@ -107,7 +107,8 @@ def parse_transform(source: str, key: str, raw: Any) -> np.ndarray:
         extra = set(raw) - {"scale", "rotate", "translate"}
         if extra:
             raise UserError(
-                source, f"{key}.{sorted(extra)[0]}: unknown key (allowed: scale, rotate, translate, or position + axes)"
+                source,
+                f"{key}.{min(extra, key=str)}: unknown key (allowed: scale, rotate, translate, or position + axes)",
             )
         lin = np.eye(3)
         if "scale" in raw:

@@ -34,8 +34,8 @@ static double backward(const double *c, int degree, double t, double *scale)
 }
 
 /* first_hit against intersect on one ray: 0 when consistent; counts differences in *differ */
-static int check_first_hit(const gen_shape_entry *e, const double o[3], const double d[3],
-                           const double *roots, int n, int *differ, double *max_rel)
+static int check_first_hit(const gen_shape_entry *e, const double o[3], const double d[3], const double *roots, int n,
+                           int *differ, double *max_rel)
 {
     double t = -12345.0;
     int got = e->first_hit(o, d, 0.0, 1e3, e->params, &t);
@@ -82,8 +82,10 @@ static int check_shape(const gen_shape_entry *e, int rays, int *failures)
             double t = NAN;
             int got = e->first_hit(o, d, 0.0, 1e3, params, &t);
             if (*failures < 10)
-                fprintf(stderr, "%s ray %d: intersect %d roots (ig_shape_roots %d), first %.17g; first_hit %d: "
-                        "%.17g\n", shape->name, r, ng, n, n > 0 ? roots[0] : NAN, got, t);
+                fprintf(stderr,
+                        "%s ray %d: intersect %d roots (ig_shape_roots %d), first %.17g; first_hit %d: "
+                        "%.17g\n",
+                        shape->name, r, ng, n, n > 0 ? roots[0] : NAN, got, t);
             ++*failures;
         }
         for (int k = 0; k < n; ++k) {
@@ -92,19 +94,17 @@ static int check_shape(const gen_shape_entry *e, int rays, int *failures)
             double p[3] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
             int ok_normal = ig_shape_normal(shape, params, p, n3);
             double len = sqrt(n3[0] * n3[0] + n3[1] * n3[1] + n3[2] * n3[2]);
-            int bad = !(t >= 0.0 && t <= 1e3) || (k > 0 && !(t > roots[k - 1])) || !isfinite(t)
-                      || value > 1e-9 * scale
-                      || (ok_normal ? fabs(len - 1.0) > 1e-12 : len != 0.0);
+            int bad = !(t >= 0.0 && t <= 1e3) || (k > 0 && !(t > roots[k - 1])) || !isfinite(t) ||
+                      value > 1e-9 * scale || (ok_normal ? fabs(len - 1.0) > 1e-12 : len != 0.0);
             if (bad) {
                 if (*failures < 10)
-                    fprintf(stderr, "%s ray %d root %d: t=%.17g |p(t)|=%.3g scale=%.3g |n|=%.17g\n", shape->name,
-                            r, k, t, value, scale, len);
+                    fprintf(stderr, "%s ray %d root %d: t=%.17g |p(t)|=%.3g scale=%.3g |n|=%.17g\n", shape->name, r, k,
+                            t, value, scale, len);
                 ++*failures;
             }
         }
     }
-    printf("%-10s first_hit != intersect()[0] on %d rays (max rel difference %.1e)\n", shape->name,
-           differ, max_rel);
+    printf("%-10s first_hit != intersect()[0] on %d rays (max rel difference %.1e)\n", shape->name, differ, max_rel);
     return hits;
 }
 

@@ -1,9 +1,9 @@
-/* The refinement of bracketed roots (runtime_c/roots.c): ig_refine_many against ig_refine one bracket at a
- * time (bitwise: the batched lanes must give the very same doubles, which is what makes ig_first_root equal to
+/* The refinement of bracketed roots (runtime_c/roots_refine.c): ig_refine_many against ig_refine one bracket
+ * at a time (bitwise: the batched lanes must give the very same doubles, which is what makes ig_first_root equal to
  * the first root of the full list), and both against known roots, through the fast path (simple roots, from
  * good and from useless start guesses) and through the safeguarded fallback (a triple root, a root near 0 in
  * a bracket reaching 1e27). Run under AddressSanitizer + UBSan by
- * tests/test_roots_c.py. One line per failure; exit status = number of failures. */
+ * tests/test_c_drivers_roots.py. One line per failure; exit status = number of failures. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -13,22 +13,14 @@
 
 static int failures = 0;
 
-static double eval(const double *c, int n, double x)
-{
-    double v = c[n];
-    for (int k = n - 1; k >= 0; --k)
-        v = v * x + c[k];
-    return v;
-}
-
 /* Refine k brackets of c both ways; each root must be bitwise the same and within rtol of want[i]. */
-static void check(const char *name, const double *c, int n, int k, const double *l, const double *r,
-                  const double *x0, const double *want, double rtol)
+static void check(const char *name, const double *c, int n, int k, const double *l, const double *r, const double *x0,
+                  const double *want, double rtol)
 {
     double vl[IG_MAX_DEGREE + 1] = {0.0}, vr[IG_MAX_DEGREE + 1] = {0.0}, many[IG_MAX_DEGREE + 1];
     for (int i = 0; i < k; ++i) {
-        vl[i] = eval(c, n, l[i]);
-        vr[i] = eval(c, n, r[i]);
+        vl[i] = ig_horner(c, n, l[i]);
+        vr[i] = ig_horner(c, n, r[i]);
     }
     ig_refine_many(c, n, k, l, r, vl, vr, 2.0 * IG_U, x0, many);
     for (int i = 0; i < k; ++i) {
@@ -37,8 +29,9 @@ static void check(const char *name, const double *c, int n, int k, const double 
                  fabs(one - want[i]) <= rtol * fmax(fabs(want[i]), 1e-300);
         if (!ok) {
             ++failures;
-            fprintf(stderr, "FAIL %s, bracket %d of %d [%.17g, %.17g]: one at a time %.17g, batched %.17g, want %.17g\n",
-                    name, i, k, l[i], r[i], one, many[i], want[i]);
+            fprintf(stderr,
+                    "FAIL %s, bracket %d of %d [%.17g, %.17g]: one at a time %.17g, batched %.17g, want %.17g\n", name,
+                    i, k, l[i], r[i], one, many[i], want[i]);
         }
     }
 }

@@ -44,10 +44,11 @@ static void check_first(const char *name, const double *c, int n, double lo, dou
         ok = 0;
     if (!ok) {
         ++failures;
-        fprintf(stderr, "FAIL first root of %s [%s]: got %d (%.17g, writes beyond: %d), want %d (%.17g); "
-                "ig_real_roots listed %d first %.17g\n", name, method_names[m], got, f[0],
-                f[1] != -12345.0 || f[2] != -12345.0 || f[3] != -12345.0, nw > 0, nw > 0 ? want[0] : NAN,
-                k, k > 0 ? r[0] : NAN);
+        fprintf(stderr,
+                "FAIL first root of %s [%s]: got %d (%.17g, writes beyond: %d), want %d (%.17g); "
+                "ig_real_roots listed %d first %.17g\n",
+                name, method_names[m], got, f[0], f[1] != -12345.0 || f[2] != -12345.0 || f[3] != -12345.0, nw > 0,
+                nw > 0 ? want[0] : NAN, k, k > 0 ? r[0] : NAN);
     }
 }
 
@@ -184,7 +185,8 @@ int main(void)
         expect("root 1e100 (reversed-polynomial range)", c, n, -inf, inf, wh, 4, 1e-14, GENERAL);
     }
     { /* high degree products of known factors */
-        double r[] = {-2.5, -1.25, -0.5, 0.375, 1.5, 2.75}, q[][2] = {{0, 1}, {-1, 2}, {2, 5}, {0.5, 0.5}, {-3, 3}, {1, 1}};
+        double r[] = {-2.5, -1.25, -0.5, 0.375, 1.5, 2.75},
+               q[][2] = {{0, 1}, {-1, 2}, {2, 5}, {0.5, 0.5}, {-3, 3}, {1, 1}};
         n = from_roots(r, 6, q, 6, 1.0, c); /* degree 18 */
         expect("degree 18: 6 real, 6 complex pairs", c, n, -inf, inf, r, 6, 1e-10, ALL);
         double q9[][2] = {{0, 1}, {-1, 2}, {2, 5}, {0.5, 0.5}, {-3, 3}, {1, 1}, {0, 2}, {1.5, 1}, {-0.5, 1}};

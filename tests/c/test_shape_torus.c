@@ -92,7 +92,8 @@ int main(void)
     }
     double q[3] = {1e200, 1e200, 1e200}; /* gradient overflows to inf: still no NaN */
     int ok = ig_shape_normal(sh, params, q, nrm);
-    if (isnan(nrm[0]) || isnan(nrm[1]) || isnan(nrm[2]) || (ok && fabs(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2] - 1.0) > 1e-12)) {
+    if (isnan(nrm[0]) || isnan(nrm[1]) || isnan(nrm[2]) ||
+        (ok && fabs(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2] - 1.0) > 1e-12)) {
         ++failures;
         fprintf(stderr, "FAIL normal at 1e200\n");
     }

@@ -59,9 +59,11 @@ static void random_rotation(unsigned long long *s, double R[9])
     unit_vector(s, a);
     unit_vector(s, b);
     k = rt_dot(a, b);
-    for (i = 0; i < 3; ++i) b[i] -= k * a[i];
+    for (i = 0; i < 3; ++i)
+        b[i] -= k * a[i];
     k = sqrt(rt_dot(b, b));
-    for (i = 0; i < 3; ++i) b[i] /= k;
+    for (i = 0; i < 3; ++i)
+        b[i] /= k;
     c[0] = a[1] * b[2] - a[2] * b[1];
     c[1] = a[2] * b[0] - a[0] * b[2];
     c[2] = a[0] * b[1] - a[1] * b[0];
@@ -93,16 +95,20 @@ static void run_scale(const ig_shape *shape, const double *params, double scale,
         }
     }
     for (i = 0; i < 3; ++i) {
-        if (!isfinite(box[i])) box[i] = -1.5;
-        if (!isfinite(box[i + 3])) box[i + 3] = 1.5;
+        if (!isfinite(box[i]))
+            box[i] = -1.5;
+        if (!isfinite(box[i + 3]))
+            box[i + 3] = 1.5;
         centre[i] = 0.5 * (box[i] + box[i + 3]);
         rad += 0.25 * (box[i + 3] - box[i]) * (box[i + 3] - box[i]);
     }
     rad = sqrt(rad);
     random_rotation(seed, R);
-    for (i = 0; i < 3; ++i) T[i] = scale * (6 * urand(seed) - 3);
+    for (i = 0; i < 3; ++i)
+        T[i] = scale * (6 * urand(seed) - 3);
     for (i = 0; i < 3; ++i) {
-        for (j = 0; j < 3; ++j) M[4 * i + j] = scale * R[3 * i + j];
+        for (j = 0; j < 3; ++j)
+            M[4 * i + j] = scale * R[3 * i + j];
         M[4 * i + 3] = T[i];
         eye[i] = T[i] + scale * (i == 2 ? 5.0 : 0.0);
     }
@@ -127,10 +133,12 @@ static void run_scale(const ig_shape *shape, const double *params, double scale,
         }
         rt_xform_point(s->nodes[leaf].m, oo, o);
         rt_xform_vector(s->nodes[leaf].m, dob, d);
-        if (!rt_scene_intersect(s, o, d, 0.0, INFINITY, &h)) continue;
+        if (!rt_scene_intersect(s, o, d, 0.0, INFINITY, &h))
+            continue;
         ++got;
         ++c->hits;
-        if (h.err / scale > c->err_max) c->err_max = h.err / scale;
+        if (h.err / scale > c->err_max)
+            c->err_max = h.err / scale;
         c->err_sum += h.err / scale;
         for (side = 0; side < 2; ++side) {
             double d2[3], q[3], od2[3], roots[IG_MAX_DEGREE], cosn, dl, D2 = -1.0, dist_tr = -1.0;
@@ -138,7 +146,8 @@ static void run_scale(const ig_shape *shape, const double *params, double scale,
             rt_hit h2;
             unit_vector(seed, d2);
             if ((rt_dot(d2, h.n) < 0.0) != (side == 1))
-                for (i = 0; i < 3; ++i) d2[i] = -d2[i];
+                for (i = 0; i < 3; ++i)
+                    d2[i] = -d2[i];
             cosn = fabs(rt_dot(d2, h.n));
             dl = sqrt(rt_dot(d2, d2));
             ++c->rays;
@@ -147,22 +156,27 @@ static void run_scale(const ig_shape *shape, const double *params, double scale,
             {
                 /* solved on the unit object-space direction, then back to the world parameter */
                 double L = sqrt(rt_dot(od2, od2));
-                for (i = 0; i < 3; ++i) od2[i] /= L;
+                for (i = 0; i < 3; ++i)
+                    od2[i] /= L;
                 nr = ig_shape_roots(shape, params, h.po, od2, -4.0 * rad, far / dl * L, IG_ROOTS_AUTO, roots);
-                for (k = 0; k < nr; ++k) roots[k] /= L;
+                for (k = 0; k < nr; ++k)
+                    roots[k] /= L;
             }
             for (k = 0; k < nr; ++k)
-                if (self < 0 || fabs(roots[k]) < fabs(roots[self])) self = k;
+                if (self < 0 || fabs(roots[k]) < fabs(roots[self]))
+                    self = k;
             if (self < 0 || fabs(roots[self]) * dl > 1e-6 * scale) {
                 ++c->lost; /* the reference cannot find the hit's own root: nothing to compare */
                 continue;
             }
-            if (self + 1 < nr) D2 = roots[self + 1] * dl;
+            if (self + 1 < nr)
+                D2 = roots[self + 1] * dl;
             rt_spawn_origin(&h, d2, q);
             got2 = rt_scene_intersect(s, q, d2, 0.0, INFINITY, &h2);
             if (got2) {
                 double v[3];
-                for (i = 0; i < 3; ++i) v[i] = h2.p[i] - h.p[i];
+                for (i = 0; i < 3; ++i)
+                    v[i] = h2.p[i] - h.p[i];
                 dist_tr = sqrt(rt_dot(v, v));
             }
             if (D2 >= 0.0 && D2 * cosn < 2.0 * h.err) {
@@ -178,7 +192,8 @@ static void run_scale(const ig_shape *shape, const double *params, double scale,
             } else if (got2 && D2 >= 0.0 && fabs(dist_tr - D2) <= 1e-3 * fmax(D2, scale)) {
                 /* the same crossing, located less precisely (near a singular point both solves lose digits) */
                 ++c->near;
-                if (fabs(dist_tr - D2) / fmax(D2, scale) > c->near_max) c->near_max = fabs(dist_tr - D2) / fmax(D2, scale);
+                if (fabs(dist_tr - D2) / fmax(D2, scale) > c->near_max)
+                    c->near_max = fabs(dist_tr - D2) / fmax(D2, scale);
             } else if (got2 && dist_tr < 1000.0 * h.err) {
                 ++c->self;
                 if (c->self <= 3) {
@@ -189,11 +204,14 @@ static void run_scale(const ig_shape *shape, const double *params, double scale,
                         double g[3], g2[3];
                         shape->gradient(h.po, params, g);
                         shape->gradient(h2.po, params, g2);
-                        printf("    hit po (%.17g %.17g %.17g) f %.3g |g| %.3g; h2 t %.3g po (%.17g %.17g %.17g) f %.3g |g| %.3g"
+                        printf("    hit po (%.17g %.17g %.17g) f %.3g |g| %.3g; h2 t %.3g po (%.17g %.17g %.17g) f "
+                               "%.3g |g| %.3g"
                                " leaf %d; roots:",
-                               h.po[0], h.po[1], h.po[2], shape->value(h.po, params), sqrt(rt_dot(g, g)), h2.t, h2.po[0],
-                               h2.po[1], h2.po[2], shape->value(h2.po, params), sqrt(rt_dot(g2, g2)), h2.leaf);
-                        for (k = 0; k < nr; ++k) printf(" %.6g", roots[k] * dl);
+                               h.po[0], h.po[1], h.po[2], shape->value(h.po, params), sqrt(rt_dot(g, g)), h2.t,
+                               h2.po[0], h2.po[1], h2.po[2], shape->value(h2.po, params), sqrt(rt_dot(g2, g2)),
+                               h2.leaf);
+                        for (k = 0; k < nr; ++k)
+                            printf(" %.6g", roots[k] * dl);
                         printf("\n");
                     }
 #endif
@@ -205,7 +223,8 @@ static void run_scale(const ig_shape *shape, const double *params, double scale,
                            side, D2, got2 ? dist_tr : -1.0, h.err, cosn);
 #ifdef RT_DEBUG_OFFSETS
                     printf("    reference roots:");
-                    for (k = 0; k < nr; ++k) printf(" %.9g", roots[k] * dl);
+                    for (k = 0; k < nr; ++k)
+                        printf(" %.9g", roots[k] * dl);
                     printf("\n");
 #endif
                 }
@@ -220,7 +239,8 @@ static void run_scale(const ig_shape *shape, const double *params, double scale,
                         shape->gradient(h2.po, params, g);
                         printf("    f(tracer hit) %.3g |grad| %.3g; reference roots:", shape->value(h2.po, params),
                                sqrt(rt_dot(g, g)));
-                        for (k = 0; k < nr; ++k) printf(" %.6g", roots[k] * dl);
+                        for (k = 0; k < nr; ++k)
+                            printf(" %.6g", roots[k] * dl);
                         printf("\n");
                     }
 #endif
@@ -241,11 +261,12 @@ int main(int argc, char **argv)
     for (k = 0; k < rt_test_nshapes; ++k) {
         counts c;
         memset(&c, 0, sizeof c);
-        for (j = 0; j < 5; ++j) run_scale(rt_test_shapes[k], rt_test_params[k], scales[j], per_shape / 5, &seed, &c);
+        for (j = 0; j < 5; ++j)
+            run_scale(rt_test_shapes[k], rt_test_params[k], scales[j], per_shape / 5, &seed, &c);
         printf("%-10s hits %7ld rays %7ld match %7ld self-hits %ld misses %ld other %ld ambiguous %ld lost %ld "
                "near %ld (worst %.1e) err/scale max %.2e mean %.2e\n",
-               rt_test_shapes[k]->name, c.hits, c.rays, c.match, c.self, c.miss, c.extra, c.ambiguous, c.lost,
-               c.near, c.near_max, c.err_max, c.hits ? c.err_sum / c.hits : 0.0);
+               rt_test_shapes[k]->name, c.hits, c.rays, c.match, c.self, c.miss, c.extra, c.ambiguous, c.lost, c.near,
+               c.near_max, c.err_max, c.hits ? c.err_sum / c.hits : 0.0);
         fails += c.self + c.miss;
     }
     printf("%ld failures\n", fails);

@@ -1,0 +1,135 @@
+"""Many frames, or the tiles of one still: rendered here or on Dask, written in order, resumable.
+
+`render_frames` renders the frames of an animation that are not complete yet (a rerun skips them), one task
+per frame, and writes each as soon as it and every frame before it are done. With tiles, each frame is K
+bands of rows, one task each, stacked when all are back: each pixel's samples depend only on the pixel and
+the seed (runtime_c/tracer_render.c), so the result is bit for bit the image rendered in one piece. A still
+is an animation of one frame.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from implgen.scene import cluster
+from implgen.scene.build import build_scene
+from implgen.scene.frameout import FrameOutput
+from implgen.scene.frames import FrameOptions, Frames, decode_png, encode_png, rebind, render_frame_png
+
+WINDOW_PER_WORKER = 3  # tasks in flight per worker: enough to hide the round trip, little memory
+
+
+@dataclass
+class Runner:
+    """Where tasks run: `client` None is this process."""
+
+    client: Any = None
+    retries: int = 3
+    task: Callable[..., bytes] = render_frame_png  # the unit of work; tests wrap it to inject faults
+
+    def workers(self) -> int:
+        """Workers the cluster has now (1 for this process)."""
+        if self.client is None:
+            return 1
+        return len(self.client.scheduler_info(n_workers=-1).get("workers", {})) or 1
+
+    def window(self) -> int:
+        return 1 if self.client is None else WINDOW_PER_WORKER * self.workers()
+
+    def results(self, jobs: Iterator[tuple[Any, tuple]], name: str) -> Iterator[tuple[Any, bytes]]:
+        if self.client is None:
+            return cluster.serial(self.task, jobs)
+        return cluster.ordered(self.client, self.task, jobs, window=self.window(), retries=self.retries, name=name)
+
+
+@dataclass
+class BatchReport:
+    written: list[int]
+    skipped: list[int]
+    seconds: float
+    bytes_moved: int  # PNG bytes that came back from the tasks
+
+
+def render_frames(
+    frames: Frames,
+    todo: range,
+    opts: FrameOptions,
+    out: FrameOutput,
+    runner: Runner,
+    *,
+    tiles: int = 1,
+    fold: bool = False,
+    progress: bool = False,
+    keep_frames: bool = False,
+    on_written: Callable[[int], None] | None = None,
+) -> BatchReport:
+    """Render the frames of `todo` whose output is missing, each as one task or as `tiles` bands of rows,
+    write them in order, then finish the output (encode a video or GIF from all frames of `todo`)."""
+    t0 = time.perf_counter()
+    skipped = [f for f in todo if out.done(f)]
+    missing = [f for f in todo if not out.done(f)]
+    out.prepare()
+    written: list[int] = []
+    moved = 0
+    if missing:
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=len(missing), unit="frame", desc=out.target.name, leave=True)
+        try:
+            rows = [None] if tiles == 1 else bands(opts.height, tiles)
+            results = runner.results(_jobs(frames, missing, rows, opts, runner, fold), name="frame")
+            for f, png, nbytes in _assembled(results, len(rows)):
+                out.write(f, png)
+                written.append(f)
+                moved += nbytes
+                if bar is not None:
+                    bar.update(1)
+                if on_written is not None:
+                    on_written(f)
+        finally:
+            if bar is not None:
+                bar.close()
+    out.finish(list(todo), frames.fps, keep_frames=keep_frames)
+    return BatchReport(written=written, skipped=skipped, seconds=time.perf_counter() - t0, bytes_moved=moved)
+
+
+def _jobs(
+    frames: Frames, missing: list[int], rows: list, opts: FrameOptions, runner: Runner, fold: bool
+) -> Iterator[tuple[tuple[int, int], tuple]]:
+    """((frame, band), task arguments) for each band of each missing frame, made as they are needed. In this
+    process the library is built once and shared by every frame; a Dask worker builds it through its cache."""
+    built = build_scene(frames.first, fold=fold) if runner.client is None else None
+    for f in missing:
+        scene = frames.scene(f)
+        frame_built = None if built is None else rebind(built, scene, fold)
+        for k, band in enumerate(rows):
+            yield (f, k), (scene, opts, band, frame_built)
+
+
+def _assembled(results: Iterator[tuple[tuple[int, int], bytes]], nbands: int) -> Iterator[tuple[int, bytes, int]]:
+    """(frame, PNG, bytes moved) from the tasks' results in order: one PNG per frame, or its bands stacked.
+    Each pixel's samples depend only on the pixel, so the stacked bands are the one-piece image bit for bit."""
+    parts: list[np.ndarray] = []
+    nbytes = 0
+    for (f, k), png in results:
+        if nbands == 1:
+            yield f, png, len(png)
+            continue
+        parts.append(decode_png(png))
+        nbytes += len(png)
+        if k == nbands - 1:
+            yield f, encode_png(np.concatenate(parts, axis=0)), nbytes
+            parts, nbytes = [], 0
+
+
+def bands(height: int, k: int) -> list[tuple[int, int]]:
+    """K bands of rows [y0, y1) covering the image, sizes differing by at most one row (K <= height)."""
+    edges = [i * height // k for i in range(k + 1)]
+    return [(edges[i], edges[i + 1]) for i in range(k)]

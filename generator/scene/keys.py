@@ -1,0 +1,223 @@
+"""Keyed values: a number in a scene that changes from frame to frame, and the `animation` block.
+
+    fov: {keys: {0: 30, 47: 55}, ease: smooth}    # frame -> value; ease: linear (default) or smooth
+    animation: {frames: 48, fps: 24}
+
+Between two keys the value moves from one to the other by the ease: `linear` is a + (b - a) s, `smooth` the
+cubic a + (b - a) s^2 (3 - 2 s), where s = (frame - f0) / (f1 - f0). Before the first key and after the last
+the value holds. At a key frame the value is the key's number itself (not recomputed), so a keyed value is
+exact at its keys. Both eases stay between their two keys, so a value whose keys are inside a range stays
+inside it on every frame.
+
+The range of each number is checked where it is used (scene/load.py), on every frame; this module only
+checks the shape of a keyed mapping. The format is documented in docs/formats.md#keyed-values.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from implgen import validate
+from implgen.errors import UserError
+
+MAX_FRAMES = 10_000  # frames in one animation (every frame is validated before anything renders)
+MAX_FPS = 1000.0
+DEFAULT_FPS = 24.0
+EASES = ("linear", "smooth")
+KEYED_KEYS = ("keys", "ease")
+ANIMATION_KEYS = ("frames", "fps")
+ORBIT_KEYS = ("center", "radius", "height", "turns")
+MAX_TURNS = 1000
+
+
+@dataclass(frozen=True)
+class Animation:
+    frames: int = 1
+    fps: float = DEFAULT_FPS
+
+
+@dataclass(frozen=True)
+class Keyed:
+    """A keyed number: frames in increasing order, their values, and the ease between them."""
+
+    frames: tuple[int, ...]
+    values: tuple[Any, ...]  # as written (checked as numbers where used, against that key's range)
+    ease: str = "linear"
+
+    def at(self, frame: int) -> Any:
+        """The value at `frame`: exactly a key's value at its frame, held outside the keys."""
+        fs, vs = self.frames, self.values
+        if frame <= fs[0]:
+            return vs[0]
+        if frame >= fs[-1]:
+            return vs[-1]
+        i = 1
+        while fs[i] < frame:
+            i += 1
+        if fs[i] == frame:
+            return vs[i]
+        a, b = float(vs[i - 1]), float(vs[i])
+        s = (frame - fs[i - 1]) / (fs[i] - fs[i - 1])
+        if self.ease == "smooth":
+            s = s * s * (3.0 - 2.0 * s)
+        return a + (b - a) * s
+
+
+def is_keyed(value: Any) -> bool:
+    """Whether a raw YAML value is written as a keyed value (a mapping with `keys`)."""
+    return isinstance(value, dict) and "keys" in value
+
+
+def parse_animation(source: str, raw: Any) -> Animation:
+    if raw is None:
+        return Animation()
+    if not isinstance(raw, dict):
+        raise UserError(source, "animation: expected a mapping with 'frames' (and optionally 'fps')")
+    for k in raw:
+        if k not in ANIMATION_KEYS:
+            raise UserError(source, f"animation.{_name(k)}: unknown key (allowed: {', '.join(ANIMATION_KEYS)})")
+    if "frames" not in raw:
+        raise UserError(source, "animation: missing key 'frames'")
+    frames = validate.whole(source, "animation.frames", raw["frames"], 1, MAX_FRAMES)
+    fps = validate.number(source, "animation.fps", raw.get("fps", DEFAULT_FPS), 0.0, MAX_FPS, lo_open=True)
+    return Animation(frames=frames, fps=fps)
+
+
+def parse_keyed(source: str, key: str, raw: dict, frames: int | None) -> Keyed:
+    """Check a keyed mapping's form. `frames` is the animation's frame count (None: the scene has no
+    `animation` block, where a keyed value has no meaning)."""
+    if frames is None:
+        raise UserError(source, f"{key}: a keyed value needs an 'animation' block at the top level")
+    for k in raw:
+        if k not in KEYED_KEYS:
+            raise UserError(source, f"{key}.{_name(k)}: unknown key (allowed: {', '.join(KEYED_KEYS)})")
+    ease = raw.get("ease", "linear")
+    if ease not in EASES:
+        raise UserError(source, f"{key}.ease: {validate.describe(ease)} is not one of {', '.join(EASES)}")
+    keys = raw["keys"]
+    if not isinstance(keys, dict) or not keys:
+        raise UserError(source, f"{key}.keys: expected a mapping frame -> number, with at least one key")
+    items = []
+    for f, v in keys.items():
+        if isinstance(f, bool) or not isinstance(f, int):
+            raise UserError(source, f"{key}.keys: a key is a frame number, not {validate.describe(f)}")
+        if not 0 <= f < frames:
+            raise UserError(
+                source, f"{key}.keys: frame {validate.describe(f)} is outside the animation's frames [0, {frames - 1}]"
+            )
+        if is_keyed(v):
+            raise UserError(source, f"{key}.keys.{f}: a key's value is a number, not another keyed value")
+        validate.number(source, f"{key}.keys.{f}", v)  # finite; its own range is checked where it is used
+        items.append((f, v))
+    items.sort()
+    return Keyed(frames=tuple(f for f, _ in items), values=tuple(v for _, v in items), ease=ease)
+
+
+def _name(k: Any) -> str:
+    return k if isinstance(k, str) and k.isidentifier() else validate.describe(k)
+
+
+def resolve(source: str, key: str, raw: Any, frame: int, frames: int | None, seen: list[str]) -> Any:
+    """`raw` with every keyed value inside it replaced by its value at `frame` (for parts of a scene where
+    every leaf is a number, such as a transform). The key paths of the keyed values found go to `seen`."""
+    if is_keyed(raw):
+        seen.append(key)
+        return parse_keyed(source, key, raw, frames).at(frame)
+    if isinstance(raw, dict):
+        return {k: resolve(source, f"{key}.{_name(k)}", v, frame, frames, seen) for k, v in raw.items()}
+    if isinstance(raw, list):
+        return [resolve(source, f"{key}[{i}]", v, frame, frames, seen) for i, v in enumerate(raw)]
+    return raw
+
+
+def number_at(
+    source: str,
+    key: str,
+    raw: Any,
+    frame: int,
+    frames: int | None,
+    check: Callable[[str, Any], float],
+    seen: list[str],
+) -> float:
+    """A number that may be keyed, at `frame`, through `check(key, value)` (its range): each key's value is
+    checked under its own name (`camera.fov.keys.47`), then the value at this frame."""
+    if not is_keyed(raw):
+        return check(key, raw)
+    seen.append(key)
+    keyed = parse_keyed(source, key, raw, frames)
+    for f, v in zip(keyed.frames, keyed.values):
+        check(f"{key}.keys.{f}", v)
+    return check(key, keyed.at(frame))
+
+
+def inline_params(source: str, key: str, raw: Any, frames: int | None) -> tuple[Any, dict]:
+    """An inline equation's `params` as (the shape's defaults, the keyed ones to pass per frame): a keyed
+    param's default is its first key, so the shape is the same on every frame and only the value moves."""
+    if not isinstance(raw, dict):
+        return raw, {}  # the spec parser says what is wrong with it
+    keyed = {k: v for k, v in raw.items() if is_keyed(v)}
+    first = {k: parse_keyed(source, f"{key}.{_name(k)}", v, frames).values[0] for k, v in keyed.items()}
+    return {**raw, **first}, keyed
+
+
+def contains_keyed(raw: Any) -> bool:
+    """Whether a keyed value appears anywhere in a raw YAML value."""
+    if is_keyed(raw):
+        return True
+    if isinstance(raw, dict):
+        return any(contains_keyed(v) for v in raw.values())
+    if isinstance(raw, list):
+        return any(contains_keyed(v) for v in raw)
+    return False
+
+
+def orbit_camera(
+    source: str, cam: dict, frame: int, frames: int | None, seen: list[str]
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """`camera.orbit` at `frame`: (position, look_at). Its numbers may be keyed too."""
+    for k in ("position", "look_at"):
+        if k in cam:
+            raise UserError(source, f"camera.{k}: not with camera.orbit (the orbit sets it)")
+    raw = cam["orbit"]
+    if not isinstance(raw, dict):
+        raise UserError(source, "camera.orbit: expected a mapping with 'radius' (and center, height, turns)")
+    for k in raw:
+        if k not in ORBIT_KEYS:
+            raise UserError(source, f"camera.orbit.{_name(k)}: unknown key (allowed: {', '.join(ORBIT_KEYS)})")
+    if "radius" not in raw:
+        raise UserError(source, "camera.orbit: missing key 'radius'")
+
+    def num(key: str, value: Any, lo: float, hi: float, lo_open: bool = False) -> float:
+        def check(k: str, v: Any) -> float:
+            return validate.number(source, k, v, lo, hi, lo_open=lo_open)
+
+        return number_at(source, f"camera.orbit.{key}", value, frame, frames, check, seen)
+
+    big = validate.MAX_COORDINATE
+    center = raw.get("center", [0, 0, 0])
+    if isinstance(center, list) and len(center) == 3:
+        center = [num(f"center[{i}]", v, -big, big) for i, v in enumerate(center)]
+    c = validate.vector(source, "camera.orbit.center", center)
+    radius = num("radius", raw["radius"], 0.0, big, lo_open=True)
+    height = num("height", raw.get("height", 0.0), -big, big)
+    turns = num("turns", raw.get("turns", 1.0), -MAX_TURNS, MAX_TURNS)
+    if turns and frames is not None and frames > 1:
+        seen.append("camera.orbit")
+    return orbit(c, radius, height, turns, frame, frames or 1), c
+
+
+def orbit(
+    center: tuple[float, float, float], radius: float, height: float, turns: float, frame: int, frames: int
+) -> tuple[float, float, float]:
+    """The camera position on an orbit at `frame`: `radius` from the vertical axis through `center`,
+    `height` above it, `turns` full turns over the animation (counter-clockwise seen from above for
+    turns > 0), starting on the +z side. Frame `frames` would be frame 0 again, so a one-turn loop is seamless."""
+    angle = 2.0 * math.pi * turns * frame / frames
+    return (
+        center[0] + radius * math.sin(angle),
+        center[1] + height,
+        center[2] + radius * math.cos(angle),
+    )

@@ -1,0 +1,91 @@
+"""`implgen view [SPEC.yaml | SCENE.yaml] [--port P] [--host H] [--no-browser]`: the interactive viewer.
+
+The file is read and checked like every input (a mapping with `objects` is a scene, anything else a spec);
+with no file the page starts from a torus. The socket is bound before anything starts, so a port in use is
+one line and exit status 2. The server runs until Ctrl-C.
+"""
+
+from __future__ import annotations
+
+import socket
+import threading
+import webbrowser
+from collections.abc import Sequence
+from pathlib import Path
+
+from implgen.cli import ArgumentParser
+from implgen.codegen.spec import parse_spec
+from implgen.errors import UserError
+from implgen.view.document import STARTER, Document
+from implgen.yamlfile import read_yaml
+
+
+def document_factory(path: Path | None):
+    """A function giving each page a fresh Document for the file (parsed once, here)."""
+    from implgen.scene.load import parse_scene
+
+    if path is None:
+        spec = parse_spec(STARTER, "starter")
+        return lambda: Document.for_spec(spec)
+    data = read_yaml(path, what="spec or scene")
+    if isinstance(data, dict) and "objects" in data:
+        scene_path = path
+        return lambda: Document.for_scene(parse_scene(read_yaml(scene_path, what="scene"), scene_path))
+    spec = parse_spec(data, str(path))
+    return lambda: Document.for_spec(spec)
+
+
+def bind(host: str, port: int) -> socket.socket:
+    try:
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+    except OSError as err:
+        raise UserError("--host", f"cannot resolve {host!r} ({err.strerror or err})") from None
+    family, _, _, _, addr = infos[0]
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        sock.bind(addr)
+    except OSError as err:
+        sock.close()
+        raise UserError("--port", f"cannot listen on {host}:{port} ({err.strerror or err})") from None
+    sock.listen(64)
+    return sock
+
+
+def serve(sock: socket.socket, make_document, threads: int | None = None, on_ready=None) -> None:
+    """Run the server on a bound socket until it is stopped (Ctrl-C, or server.should_exit)."""
+    import uvicorn
+
+    from implgen.view.protocol import MAX_MESSAGE
+    from implgen.view.server import create_app
+
+    config = uvicorn.Config(
+        create_app(make_document, threads=threads), log_level="warning", ws_max_size=MAX_MESSAGE, lifespan="off"
+    )
+    server = uvicorn.Server(config)
+    if on_ready is not None:
+        on_ready(server)
+    server.run(sockets=[sock])
+
+
+def main(argv: Sequence[str]) -> int:
+    ap = ArgumentParser(
+        label="view", prog="implgen view", description="Type an equation, turn it, drag its params: in the browser."
+    )
+    ap.add_argument("file", type=Path, nargs="?", help="a spec or a scene (default: a torus)")
+    ap.add_argument("--port", type=int, default=8765, help="0 picks a free port (default 8765)")
+    ap.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine)")
+    ap.add_argument("--no-browser", action="store_true", dest="no_browser", help="do not open a browser")
+    args = ap.parse_args(list(argv))
+    if not 0 <= args.port <= 65535:
+        raise UserError("--port", f"{args.port} is outside [0, 65535]")
+    make_document = document_factory(args.file)
+    make_document()  # a scene's shapes are checked now, not when the first page connects
+    sock = bind(args.host, args.port)
+    host, port = sock.getsockname()[:2]
+    url = f"http://{'[' + host + ']' if ':' in host else host}:{port}/"
+    print(f"implgen view: {url}  (Ctrl-C stops)", flush=True)
+    if not args.no_browser:
+        threading.Timer(0.5, webbrowser.open, args=(url,)).start()
+    serve(sock, make_document)
+    return 0

@@ -1,0 +1,186 @@
+"""What the viewer shows, as validated values: the shape, its param values, the orbit camera and the options;
+and the scene model built from them for the tracer.
+
+Everything here comes from a parsed message (view/protocol.py) or a parsed file: the equation is a `Spec` from
+the spec parser, numbers went through implgen.validate. Nothing typed by a user is kept as text.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from implgen.codegen.spec import Spec, parse_spec
+from implgen.scene.model import Camera, Csg, Leaf, Light, Material, Node, Scene
+
+CLIPS = ("none", "sphere", "box")
+LIGHTS = ("studio", "headlight", "top", "scene")
+
+# The starter shape: Suffern's torus about the y-axis.
+STARTER = {
+    "name": "torus",
+    "equation": "(x^2 + y^2 + z^2)^2 - 2*(a^2 + b^2)*(x^2 + y^2 + z^2) + 4*a^2*y^2 + (a^2 - b^2)^2",
+    "params": {"a": 1.0, "b": 0.35},
+    "bounds": {"x": ["-a - b", "a + b"], "y": ["-b", "b"], "z": ["-a - b", "a + b"]},
+}
+
+
+def _clip_spec(kind: str) -> Spec:
+    """The clip solid, its size `r` a run-time param: a ball of radius r, or the cube [-r, r]^3 (a ball that
+    holds the cube, cut by its bounds box: inside CSG a leaf is its solid cut by its bounds)."""
+    eq = "x^2 + y^2 + z^2 - r^2" if kind == "sphere" else "x^2 + y^2 + z^2 - 4*r^2"
+    box = {a: ["-r", "r"] for a in "xyz"}
+    return parse_spec({"name": f"clip_{kind}", "equation": eq, "params": {"r": 1.0}, "bounds": box}, "clip")
+
+
+CLIP_SPECS = {kind: _clip_spec(kind) for kind in CLIPS[1:]}
+
+
+@dataclass
+class Orbit:
+    """The camera turns about `target` at `distance`: yaw about +y, pitch above the x-z plane (degrees)."""
+
+    yaw: float = 30.0
+    pitch: float = 25.0
+    distance: float = 6.0
+    target: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    fov: float = 40.0
+
+    def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(position, right, up) of the camera."""
+        y, p = math.radians(self.yaw), math.radians(self.pitch)
+        back = np.array([math.cos(p) * math.sin(y), math.sin(p), math.cos(p) * math.cos(y)])
+        right = np.array([math.cos(y), 0.0, -math.sin(y)])
+        up = np.cross(back, right)
+        return np.add(self.target, self.distance * back), right, up
+
+    def camera(self) -> Camera:
+        pos, _, up = self.basis()
+        return Camera(position=tuple(pos), look_at=tuple(self.target), up=tuple(up), fov=self.fov)
+
+    @staticmethod
+    def looking(cam: Camera) -> Orbit:
+        """The orbit that reproduces a scene file's camera position and target (up becomes +y)."""
+        v = np.subtract(cam.position, cam.look_at)
+        dist = float(np.linalg.norm(v))
+        pitch = math.degrees(math.asin(max(-1.0, min(1.0, v[1] / dist))))
+        yaw = math.degrees(math.atan2(v[0], v[2]))
+        return Orbit(yaw=yaw, pitch=max(-89.0, min(89.0, pitch)), distance=dist, target=cam.look_at, fov=cam.fov)
+
+
+@dataclass
+class Options:
+    clip: str = "sphere"
+    clip_size: float = 3.0
+    color: tuple[float, float, float] = (0.95, 0.75, 0.3)
+    inside: tuple[float, float, float] = (0.35, 0.55, 0.95)
+    lights: str = "studio"
+    background: tuple[float, float, float] = (0.12, 0.12, 0.14)
+
+
+@dataclass
+class Document:
+    """The viewer's state. `base` is the scene a SCENE.yaml gave (None for a spec: the shape alone);
+    `leaf` is the leaf whose equation and params the page edits."""
+
+    spec: Spec
+    values: dict[str, float]
+    orbit: Orbit = field(default_factory=Orbit)
+    options: Options = field(default_factory=Options)
+    base: Scene | None = None
+    leaf: Leaf | None = None
+
+    @staticmethod
+    def for_spec(spec: Spec) -> Document:
+        doc = Document(spec=spec, values=dict(spec.params))
+        box = spec.box()
+        if box is not None and all(math.isfinite(v) for v in box):
+            # frame the spec's box: the camera sees its bounding sphere
+            radius = 0.5 * math.dist(box[:3], box[3:])
+            center = tuple(0.5 * (lo + hi) for lo, hi in zip(box[:3], box[3:]))
+            doc.orbit.target = center
+            doc.orbit.distance = max(1e-3, radius / math.sin(math.radians(doc.orbit.fov / 2)) * 1.1)
+            doc.options.clip_size = max(1e-3, round(radius * 1.2, 3))
+        return doc
+
+    @staticmethod
+    def for_scene(scene: Scene) -> Document:
+        leaves = scene.leaves()
+        leaf = leaves[0]
+        doc = Document(spec=leaf.spec, values=dict(leaf.params), base=scene, leaf=leaf)
+        doc.orbit = Orbit.looking(scene.camera)
+        doc.options = Options(clip="none", lights="scene", background=scene.background)
+        return doc
+
+    def set_spec(self, spec: Spec) -> None:
+        """A new shape: a param keeps its slider value while its name and default stay, else takes the default."""
+        old = self.spec.params
+        self.values = {k: self.values.get(k, v) if old.get(k) == v else v for k, v in spec.params.items()}
+        self.spec = spec
+
+    def lights(self) -> list[Light]:
+        """Light presets move with the camera (the lit side stays in view while orbiting), except `top`."""
+        pos, right, up = self.orbit.basis()
+        back = (pos - np.asarray(self.orbit.target)) / self.orbit.distance
+        d = self.orbit.distance
+        t = np.asarray(self.orbit.target)
+
+        def at(r: float, u: float, b: float) -> tuple[float, float, float]:
+            return tuple(t + 2.0 * d * (r * right + u * up + b * back))
+
+        preset = self.options.lights
+        if preset == "scene" and self.base is not None:
+            return list(self.base.lights)
+        if preset == "headlight":
+            return [Light(tuple(pos), (1.0, 1.0, 1.0))]
+        if preset == "top":
+            return [Light(tuple(t + (0.0, 3.0 * d, 0.3 * d)), (1.0, 1.0, 1.0))]
+        return [Light(at(-0.6, 0.8, 1.0), (0.8, 0.8, 0.8)), Light(at(0.9, 0.1, 0.5), (0.35, 0.35, 0.4))]
+
+    def material(self) -> Material:
+        o = self.options
+        return Material(color=o.color, inside=o.inside, ambient=0.12, diffuse=0.75, specular=0.45, shininess=40.0)
+
+    def _shape_node(self) -> Node:
+        leaf = Leaf(spec=self.spec, params=dict(self.values), matrix=np.eye(3, 4), material=None, where="shape")
+        if self.options.clip == "none":
+            return leaf
+        clip = Leaf(
+            spec=CLIP_SPECS[self.options.clip],
+            params={"r": self.options.clip_size},
+            matrix=np.eye(3, 4),
+            material=replace(self.material(), color=self.options.inside),  # cut faces show the inside colour
+            where="clip",
+        )
+        return Csg(op="intersection", left=leaf, right=clip, material=None, where="shape")
+
+    def scene(self, width: int = 640, height: int = 480, spp: int = 1) -> Scene:
+        """The scene the tracer renders (a fresh model each time; the specs are shared)."""
+        if self.base is None:
+            sc = Scene(source="view", width=width, height=height, spp=spp, max_depth=4)
+            node = self._shape_node()
+            if isinstance(node, Csg):
+                node.material = self.material()
+            else:
+                node.material = self.material()
+            sc.objects = [node]
+        else:
+            sc = replace(self.base, width=width, height=height, spp=spp)
+            sc.objects = [_with_leaf(obj, self.leaf, self.spec, self.values) for obj in self.base.objects]
+        sc.camera = self.orbit.camera()
+        sc.lights = self.lights()
+        sc.background = self.options.background
+        return sc
+
+
+def _with_leaf(node: Node, target: Leaf | None, spec: Spec, values: dict[str, float]) -> Node:
+    """A copy of the tree with the edited leaf given the current spec and params."""
+    if isinstance(node, Leaf):
+        if node is target:
+            return replace(node, spec=spec, params=dict(values))
+        return node
+    left = _with_leaf(node.left, target, spec, values)
+    right = _with_leaf(node.right, target, spec, values)
+    return Csg(op=node.op, left=left, right=right, material=node.material, where=node.where)

@@ -1,0 +1,84 @@
+"""The viewer's state as YAML a user can keep: a spec file, or a whole scene file that `implgen render` takes.
+
+Written from the parsed state (equations printed from their expression trees, numbers as parsed), never from
+what was typed. Shapes are written inline, so a saved scene stands on its own.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import yaml
+
+from implgen.codegen.grammar import format_expression
+from implgen.codegen.spec import Spec, param_symbol
+from implgen.scene.model import Leaf, Material, Node, Scene
+
+
+def _num(v: float) -> float | int:
+    v = float(v)
+    return int(v) if v.is_integer() and abs(v) < 2**53 else v
+
+
+def _vec(v) -> list[float | int]:
+    return [_num(x) for x in v]
+
+
+def spec_mapping(spec: Spec, values: dict[str, float] | None = None) -> dict:
+    """A spec file's mapping; `values` become the params' defaults."""
+    out: dict = {"name": spec.name, "equation": spec.equation}
+    if spec.params:
+        out["params"] = {k: _num((values or {}).get(k, v)) for k, v in spec.params.items()}
+    if spec.bounds is not None:
+        names = {param_symbol(p): p for p in spec.params}
+        out["bounds"] = {
+            a: [format_expression(lo, names), format_expression(hi, names)] for a, (lo, hi) in spec.bounds.items()
+        }
+    if spec.description:
+        out["description"] = spec.description
+    return out
+
+
+def material_mapping(m: Material) -> dict:
+    out: dict = {"color": _vec(m.color)}
+    if m.checker_scale > 0:
+        out = {"checker": {"colors": [_vec(m.color), _vec(m.color2)], "scale": _num(m.checker_scale)}}
+    for k in ("ambient", "diffuse", "specular", "shininess", "reflectivity", "transparency", "ior"):
+        out[k] = _num(getattr(m, k))
+    out["absorption"] = _vec(m.absorption)
+    if getattr(m, "inside", None) is not None:
+        out["inside"] = _vec(m.inside)
+    return out
+
+
+def _node(n: Node) -> dict:
+    if isinstance(n, Leaf):
+        out = {k: v for k, v in spec_mapping(n.spec, n.params).items() if k != "description"}
+        if not np.array_equal(n.matrix, np.eye(3, 4)):
+            m = n.matrix
+            out["transform"] = {"position": _vec(m[:, 3]), "axes": [_vec(m[:, i]) for i in range(3)]}
+    else:
+        out = {n.op: [_node(n.left), _node(n.right)]}
+    if n.material is not None:
+        out["material"] = material_mapping(n.material)
+    return out
+
+
+def scene_mapping(sc: Scene) -> dict:
+    """A scene file's mapping for this scene model (lights at intensity 1 with colour x intensity)."""
+    cam = sc.camera
+    return {
+        "image": {"width": sc.width, "height": sc.height, "spp": sc.spp, "max_depth": sc.max_depth},
+        "camera": {
+            "position": _vec(cam.position),
+            "look_at": _vec(cam.look_at),
+            "up": _vec(cam.up),
+            "fov": _num(cam.fov),
+        },
+        "background": _vec(sc.background),
+        "lights": [{"position": _vec(li.position), "color": _vec(li.color)} for li in sc.lights],
+        "objects": [_node(o) for o in sc.objects],
+    }
+
+
+def to_yaml(mapping: dict) -> str:
+    return yaml.safe_dump(mapping, sort_keys=False, default_flow_style=None, width=110)

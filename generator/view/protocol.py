@@ -1,0 +1,147 @@
+"""The page's messages, parsed and checked: every number against a range, every equation through the spec parser.
+
+A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
+
+    {"type": "shape", "equation": "...", "params": {"a": 1.0}}        a new equation and its param defaults
+                                                                      (optional "bounds" as in a spec)
+    {"type": "render", "seq": 7, "refine": true, "width": 640, "height": 480,
+     "values": {"a": 1.2}, "orbit": {...}, "options": {...}}          the view to show (the newest wins)
+    {"type": "save_png", "width": 1920, "height": 1080, "spp": 16}    the current view through render()
+    {"type": "save_yaml"} / {"type": "show_c"}                        the spec or scene / the generated C
+
+Bad values raise UserError naming the message field; the session sends the line back to the page.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from typing import Any
+
+from implgen import validate
+from implgen.codegen.grammar import format_expression
+from implgen.codegen.spec import Spec, param_symbol, parse_spec
+from implgen.errors import UserError
+from implgen.view.document import CLIPS, LIGHTS, Options, Orbit
+
+MAX_MESSAGE = 64 * 1024  # bytes of one message from the page
+MAX_FRAME = (2048, 2048)  # the largest interactive frame
+MAX_SAVE = (8192, 8192)  # the largest saved picture
+MAX_SAVE_PIXELS = 8192 * 4608  # 8K at 16:9
+MAX_SAVE_SPP = 64
+TYPES = ("shape", "render", "save_png", "save_yaml", "show_c")
+
+
+@dataclass
+class RenderRequest:
+    seq: int
+    refine: bool
+    width: int
+    height: int
+    values: dict[str, float]
+    orbit: Orbit
+    options: Options
+
+
+def decode(text: str | bytes) -> dict[str, Any]:
+    """One message: a JSON object with a known `type`."""
+    if len(text) > MAX_MESSAGE:
+        raise UserError("message", f"longer than {MAX_MESSAGE} bytes")
+    try:
+        data = json.loads(text)
+    except (ValueError, RecursionError):
+        raise UserError("message", "not JSON") from None
+    if not isinstance(data, dict) or data.get("type") not in TYPES:
+        raise UserError("message", f"expected an object with type one of: {', '.join(TYPES)}")
+    return data
+
+
+def _mapping(key: str, value: Any) -> dict:
+    if not isinstance(value, dict):
+        raise UserError(key, "expected a mapping")
+    return value
+
+
+def _bounds_text(spec: Spec) -> dict[str, list[str]] | None:
+    """The spec's bounds printed back in the equation grammar (so they can be parsed again with new params)."""
+    if spec.bounds is None:
+        return None
+    names = {param_symbol(p): p for p in spec.params}
+    return {a: [format_expression(lo, names), format_expression(hi, names)] for a, (lo, hi) in spec.bounds.items()}
+
+
+def parse_shape(data: dict, current: Spec) -> Spec:
+    """A new equation and param defaults, through the spec parser. The current shape's name is kept, and its
+    bounds while the equation stays the same (new defaults only): a box made for one surface would cut
+    another one anywhere."""
+    mapping: dict[str, Any] = {"name": current.name, "equation": data.get("equation")}
+    if data.get("params"):
+        mapping["params"] = _mapping("params", data["params"])
+    if data.get("bounds") is not None:  # given: checked like a spec file's
+        return parse_spec({**mapping, "bounds": data["bounds"]}, "equation")
+    spec = parse_spec(mapping, "equation")
+    bounds = _bounds_text(current)
+    if bounds is not None and spec.equation == current.equation:
+        try:
+            return parse_spec({**mapping, "bounds": bounds}, "equation")
+        except UserError:
+            pass  # a param the bounds need was removed: unbounded
+    return spec
+
+
+def parse_values(raw: Any, spec: Spec) -> dict[str, float]:
+    values = dict(spec.params)
+    for name, v in _mapping("values", raw if raw is not None else {}).items():
+        if name in spec.params:  # a stale slider of a param that is gone is ignored
+            values[name] = validate.number("values", str(name), v)
+    return values
+
+
+def parse_orbit(raw: Any) -> Orbit:
+    raw = _mapping("orbit", raw)
+    o = Orbit()
+    o.yaw = validate.number("orbit", "yaw", raw.get("yaw", o.yaw), -1e6, 1e6) % 360.0
+    o.pitch = validate.number("orbit", "pitch", raw.get("pitch", o.pitch), -89.0, 89.0)
+    o.distance = validate.number("orbit", "distance", raw.get("distance", o.distance), 1e-3, 1e6)
+    o.target = validate.vector("orbit", "target", raw.get("target", list(o.target)), -1e6, 1e6)
+    o.fov = validate.number("orbit", "fov", raw.get("fov", o.fov), 1.0, 150.0)
+    return o
+
+
+def _choice(key: str, value: Any, allowed: tuple[str, ...]) -> str:
+    if value not in allowed:
+        raise UserError("options", f"{key}: expected one of {', '.join(allowed)}")
+    return value
+
+
+def parse_options(raw: Any) -> Options:
+    raw = _mapping("options", raw)
+    o = Options()
+    o.clip = _choice("clip", raw.get("clip", o.clip), CLIPS)
+    o.clip_size = validate.number("options", "clip_size", raw.get("clip_size", o.clip_size), 1e-3, 1e6)
+    o.color = validate.vector("options", "color", raw.get("color", list(o.color)), 0.0, 1.0)
+    o.inside = validate.vector("options", "inside", raw.get("inside", list(o.inside)), 0.0, 1.0)
+    o.lights = _choice("lights", raw.get("lights", o.lights), LIGHTS)
+    o.background = validate.vector("options", "background", raw.get("background", list(o.background)), 0.0, 1.0)
+    return o
+
+
+def parse_render(data: dict, spec: Spec) -> RenderRequest:
+    return RenderRequest(
+        seq=validate.whole("render", "seq", data.get("seq", 0), 0, 2**31 - 1),
+        refine=bool(data.get("refine", True)),
+        width=validate.whole("render", "width", data.get("width", 640), 16, MAX_FRAME[0]),
+        height=validate.whole("render", "height", data.get("height", 480), 16, MAX_FRAME[1]),
+        values=parse_values(data.get("values"), spec),
+        orbit=parse_orbit(data.get("orbit", {})),
+        options=parse_options(data.get("options", {})),
+    )
+
+
+def parse_save(data: dict) -> tuple[int, int, int]:
+    w = validate.whole("save_png", "width", data.get("width", 1920), 1, MAX_SAVE[0])
+    h = validate.whole("save_png", "height", data.get("height", 1080), 1, MAX_SAVE[1])
+    if w * h > MAX_SAVE_PIXELS:
+        raise UserError("save_png", f"more than {MAX_SAVE_PIXELS} pixels")
+    spp = validate.whole("save_png", "spp", data.get("spp", 16), 1, MAX_SAVE_SPP)
+    return w, h, spp

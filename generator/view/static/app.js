@@ -1,0 +1,296 @@
+// implgen view: the page. Sends the view it wants over one WebSocket and draws the frames that come back.
+// The server checks everything; this file only collects what the user set. Plain JS, no build step.
+"use strict";
+
+(() => {
+  const $ = (id) => document.getElementById(id);
+  const canvas = $("view");
+  const ctx2d = canvas.getContext("2d");
+  const HEADER = 12; // seq (u32), kind (u8), 3 spare bytes, width (u16), height (u16)
+  const KIND_COARSE = 0, KIND_FULL = 1, KIND_SAVE = 2;
+
+  const state = {
+    params: {}, // name -> default (as the server parsed it)
+    values: {}, // name -> slider value
+    ranges: {}, // name -> [min, max], editable
+    orbit: { yaw: 30, pitch: 25, distance: 6, target: [0, 0, 0], fov: 40 },
+    options: {},
+    home: null, // the orbit to go back to
+  };
+  let ws = null;
+  let seq = 0;
+  let drawnSeq = -1;
+  let drawnKind = -1;
+  let frames = 0;
+  let queued = null; // {refine} of a render waiting for the next animation frame
+  let restTimer = 0;
+  let typing = 0; // the pause after typing that applies the equation
+  const sentAt = new Map();
+
+  // ---------------------------------------------------------------- colours
+  const toHex = (rgb) => "#" + rgb.map((c) => Math.round(Math.max(0, Math.min(1, c)) * 255)
+    .toString(16).padStart(2, "0")).join("");
+  const fromHex = (hex) => [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16) / 255);
+
+  // ---------------------------------------------------------------- messages out
+  function send(msg) {
+    if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify(msg));
+  }
+
+  function readOptions() {
+    const size = parseFloat($("clip-size").value);
+    return {
+      clip: $("clip").value,
+      clip_size: Number.isFinite(size) ? size : state.options.clip_size,
+      color: fromHex($("color").value),
+      inside: fromHex($("inside").value),
+      lights: $("lights").value,
+      background: fromHex($("background").value),
+    };
+  }
+
+  // A render request goes out at most once per animation frame; the newest view is what is sent.
+  function requestRender(refine) {
+    if (queued) { queued.refine = queued.refine || refine; return; }
+    queued = { refine };
+    requestAnimationFrame(() => {
+      const q = queued;
+      queued = null;
+      seq += 1;
+      sentAt.set(seq, performance.now());
+      state.options = readOptions();
+      send({
+        type: "render", seq, refine: q.refine, width: canvas.width, height: canvas.height,
+        values: state.values, orbit: state.orbit, options: state.options,
+      });
+    });
+  }
+
+  // Coarse frames while something moves; refined once it has rested.
+  function moved() {
+    requestRender(false);
+    clearTimeout(restTimer);
+    restTimer = setTimeout(() => requestRender(true), 180);
+  }
+
+  function parseParamsText(text) {
+    const out = {};
+    for (const part of text.split(",")) {
+      if (!part.trim()) continue;
+      const [name, value] = part.split("=").map((s) => s.trim());
+      out[name] = value === undefined ? "" : value; // the server checks names and numbers
+    }
+    return out;
+  }
+
+  function applyShape() {
+    clearTimeout(typing);
+    send({ type: "shape", equation: $("equation").value, params: parseParamsText($("params-text").value) });
+  }
+
+  // ---------------------------------------------------------------- messages in
+  function showShape(msg) {
+    $("equation").classList.remove("bad");
+    $("equation-error").textContent = "";
+    state.params = msg.params;
+    state.values = Object.assign({}, msg.values);
+    for (const [k, v] of Object.entries(msg.params)) {
+      if (!state.ranges[k]) {
+        const span = Math.max(1, Math.abs(v));
+        state.ranges[k] = [v - span, v + span];
+      }
+    }
+    $("params-text").value = Object.entries(msg.params).map(([k, v]) => `${k} = ${v}`).join(", ");
+    $("degree").textContent = `degree ${msg.degree}`;
+    buildSliders();
+  }
+
+  function buildSliders() {
+    const box = $("sliders");
+    box.replaceChildren();
+    for (const name of Object.keys(state.params)) {
+      const [lo, hi] = state.ranges[name];
+      const row = document.createElement("div");
+      row.className = "slider";
+      const label = document.createElement("span");
+      label.textContent = name;
+      const value = document.createElement("span");
+      value.className = "value";
+      const range = document.createElement("div");
+      range.className = "range";
+      const min = Object.assign(document.createElement("input"), { type: "number", value: lo, step: "any" });
+      const max = Object.assign(document.createElement("input"), { type: "number", value: hi, step: "any" });
+      const slider = Object.assign(document.createElement("input"), {
+        type: "range", min: lo, max: hi, step: (hi - lo) / 1000, value: state.values[name],
+      });
+      slider.dataset.name = name;
+      slider.setAttribute("aria-label", name);
+      min.setAttribute("aria-label", `${name} min`);
+      max.setAttribute("aria-label", `${name} max`);
+      const show = () => { value.textContent = Number(state.values[name]).toPrecision(4); };
+      show();
+      slider.addEventListener("input", () => { state.values[name] = parseFloat(slider.value); show(); requestRender(false); });
+      slider.addEventListener("change", () => requestRender(true));
+      const setRange = () => {
+        const a = parseFloat(min.value), b = parseFloat(max.value);
+        if (Number.isFinite(a) && Number.isFinite(b) && a < b) {
+          state.ranges[name] = [a, b];
+          slider.min = a; slider.max = b; slider.step = (b - a) / 1000;
+          slider.value = state.values[name];
+        }
+      };
+      min.addEventListener("change", setRange);
+      max.addEventListener("change", setRange);
+      range.append(min, slider, max);
+      row.append(label, value, range);
+      box.append(row);
+    }
+  }
+
+  function setOptions(o) {
+    state.options = o;
+    $("clip").value = o.clip;
+    $("clip-size").value = o.clip_size;
+    $("color").value = toHex(o.color);
+    $("inside").value = toHex(o.inside);
+    $("background").value = toHex(o.background);
+    $("lights").value = o.lights;
+  }
+
+  async function drawFrame(buf) {
+    const view = new DataView(buf);
+    const fseq = view.getUint32(0), kind = view.getUint8(4);
+    const w = view.getUint16(8), h = view.getUint16(10);
+    const bytes = new Uint8Array(buf, HEADER);
+    if (kind === KIND_SAVE) {
+      download(new Blob([bytes], { type: "image/png" }), "implgen-view.png");
+      $("message").textContent = `saved ${w} x ${h} PNG`;
+      return;
+    }
+    if (fseq < drawnSeq || (fseq === drawnSeq && kind <= drawnKind)) return; // stale
+    const type = kind === KIND_FULL ? "image/png" : "image/jpeg";
+    const bitmap = await createImageBitmap(new Blob([bytes], { type }));
+    if (fseq < drawnSeq || (fseq === drawnSeq && kind <= drawnKind)) return;
+    ctx2d.imageSmoothingEnabled = true;
+    ctx2d.drawImage(bitmap, 0, 0, canvas.width, canvas.height);
+    drawnSeq = fseq; drawnKind = kind; frames += 1;
+    canvas.dataset.seq = fseq; canvas.dataset.kind = kind === KIND_FULL ? "full" : "coarse";
+    canvas.dataset.frames = frames;
+    const t0 = sentAt.get(fseq);
+    const ms = t0 === undefined ? "" : ` ${Math.round(performance.now() - t0)} ms`;
+    $("status").textContent = `${kind === KIND_FULL ? "full" : "coarse"} ${w} x ${h}${ms}`;
+    for (const k of sentAt.keys()) if (k < fseq) sentAt.delete(k);
+  }
+
+  function download(blob, name) {
+    const a = Object.assign(document.createElement("a"), { href: URL.createObjectURL(blob), download: name });
+    document.body.append(a);
+    a.click();
+    a.remove();
+    setTimeout(() => URL.revokeObjectURL(a.href), 10000);
+  }
+
+  function onMessage(ev) {
+    if (ev.data instanceof ArrayBuffer) { drawFrame(ev.data); return; }
+    const msg = JSON.parse(ev.data);
+    if (msg.type === "hello") {
+      $("equation").value = msg.equation;
+      state.orbit = msg.orbit;
+      state.home = JSON.parse(JSON.stringify(msg.orbit));
+      setOptions(msg.options);
+      if (msg.mode !== "scene") $("lights").querySelector("option[value=scene]").disabled = true;
+      else for (const id of ["clip", "clip-size", "color", "inside"]) $(id).disabled = true; // the file's own
+      showShape(msg);
+      requestRender(true);
+    } else if (msg.type === "shape") {
+      showShape(msg);
+      requestRender(true);
+    } else if (msg.type === "error") {
+      if (msg.field === "equation") {
+        $("equation").classList.add("bad");
+        $("equation-error").textContent = msg.message;
+      } else {
+        $("message").textContent = msg.message;
+      }
+    } else if (msg.type === "yaml") {
+      download(new Blob([msg.text], { type: "application/yaml" }), msg.mode === "scene" ? "scene.yaml" : "shape.yaml");
+    } else if (msg.type === "c") {
+      $("code").textContent = msg.text;
+      $("code-dialog").showModal();
+    }
+  }
+
+  function connect() {
+    const proto = location.protocol === "https:" ? "wss" : "ws";
+    ws = new WebSocket(`${proto}://${location.host}/ws`);
+    ws.binaryType = "arraybuffer";
+    ws.addEventListener("message", onMessage);
+    ws.addEventListener("close", () => { $("message").textContent = "disconnected from the server (reload to reconnect)"; });
+  }
+
+  // ---------------------------------------------------------------- the picture: orbit, pan, zoom
+  let drag = null;
+  canvas.addEventListener("pointerdown", (e) => {
+    drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey };
+    canvas.setPointerCapture(e.pointerId);
+    canvas.classList.add("dragging");
+  });
+  canvas.addEventListener("pointermove", (e) => {
+    if (!drag) return;
+    const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+    drag.x = e.clientX; drag.y = e.clientY;
+    const o = state.orbit;
+    if (drag.pan || e.shiftKey) {
+      const y = o.yaw * Math.PI / 180, p = o.pitch * Math.PI / 180;
+      const right = [Math.cos(y), 0, -Math.sin(y)];
+      const back = [Math.cos(p) * Math.sin(y), Math.sin(p), Math.cos(p) * Math.cos(y)];
+      const up = [back[1] * right[2] - back[2] * right[1], back[2] * right[0] - back[0] * right[2],
+        back[0] * right[1] - back[1] * right[0]];
+      const k = o.distance * Math.tan(o.fov * Math.PI / 360) * 2 / canvas.clientHeight;
+      o.target = o.target.map((t, i) => t - k * dx * right[i] + k * dy * up[i]);
+    } else {
+      o.yaw = (o.yaw - dx * 0.4) % 360;
+      o.pitch = Math.max(-89, Math.min(89, o.pitch + dy * 0.4));
+    }
+    requestRender(false);
+  });
+  const endDrag = () => {
+    if (!drag) return;
+    drag = null;
+    canvas.classList.remove("dragging");
+    requestRender(true);
+  };
+  canvas.addEventListener("pointerup", endDrag);
+  canvas.addEventListener("pointercancel", endDrag);
+  canvas.addEventListener("wheel", (e) => {
+    e.preventDefault();
+    state.orbit.distance = Math.max(1e-3, Math.min(1e6, state.orbit.distance * Math.exp(e.deltaY * 0.001)));
+    moved();
+  }, { passive: false });
+
+  // ---------------------------------------------------------------- controls
+  $("equation").addEventListener("keydown", (e) => {
+    if (e.key === "Enter" && !e.shiftKey) { e.preventDefault(); applyShape(); }
+  });
+  $("equation").addEventListener("input", () => { clearTimeout(typing); typing = setTimeout(applyShape, 600); });
+  $("params-text").addEventListener("keydown", (e) => { if (e.key === "Enter") applyShape(); });
+  $("apply").addEventListener("click", applyShape);
+  for (const id of ["clip", "clip-size", "color", "inside", "background", "lights"]) {
+    $(id).addEventListener("input", () => requestRender(false));
+    $(id).addEventListener("change", () => requestRender(true));
+  }
+  $("reset-view").addEventListener("click", () => {
+    state.orbit = JSON.parse(JSON.stringify(state.home));
+    requestRender(true);
+  });
+  $("save-png").addEventListener("click", () => {
+    $("message").textContent = "rendering...";
+    send({ type: "save_png", width: parseInt($("save-width").value, 10), height: parseInt($("save-height").value, 10),
+      spp: parseInt($("save-spp").value, 10) });
+  });
+  $("save-yaml").addEventListener("click", () => send({ type: "save_yaml" }));
+  $("show-c").addEventListener("click", () => send({ type: "show_c" }));
+  $("close-code").addEventListener("click", () => $("code-dialog").close());
+
+  connect();
+})();

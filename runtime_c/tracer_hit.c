@@ -1,0 +1,367 @@
+/* Rays against a committed scene: the slab clip of a ray to a box, the closest-hit query (unbounded objects,
+ * then the BVH), and finishing a hit (normal, orientation, the error bound of the hit point).
+ */
+#include "tracer_internal.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ------------------------------------------------------------------ rays and boxes */
+
+void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far)
+{
+    int a;
+    memcpy(r->o, o, sizeof r->o);
+    memcpy(r->d, d, sizeof r->d);
+    r->len = sqrt(rt_dot(d, d));
+    for (a = 0; a < 3; ++a)
+        r->inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
+    if (r->len > 0.0) {
+        for (a = 0; a < 3; ++a)
+            r->u[a] = d[a] / r->len;
+        r->far_t = far / r->len;
+    } else {
+        r->u[0] = r->u[1] = r->u[2] = 0.0;
+        r->far_t = INFINITY;
+    }
+}
+
+/* Slab clipping of [*t0, *t1] against an axis-aligned box (sides may be infinite), given the ray's inverse
+ * direction inv (any value on an axis where d is 0), or NULL to divide only on the axes reached. An empty or
+ * NaN box, or a ray parallel to an axis and outside the box on it, gives 0. f0/f1 (may be NULL) receive the
+ * outward face code +-(axis + 1) of the face that moved the bound, or keep their value when the bound did not
+ * move. Returns 1 when the clipped interval is non-empty. */
+static inline int clip_slabs(const double box[6], const double o[3], const double d[3], const double inv[3], double *t0,
+                             double *t1, int *f0, int *f1)
+{
+    double lo = *t0, hi = *t1;
+    int a;
+    for (a = 0; a < 3; ++a) {
+        double bmin = box[a], bmax = box[a + 3], ta, tb;
+        int fa;
+        if (!(bmin <= bmax))
+            return 0; /* empty or NaN box */
+        if (d[a] == 0.0) {
+            if (!(o[a] >= bmin && o[a] <= bmax))
+                return 0;
+            continue;
+        }
+        /* outward normal of the face the ray enters through: the min face, or the max one when d < 0 */
+        fa = ig_slab(bmin, bmax, o[a], inv ? inv[a] : 1.0 / d[a], &ta, &tb) ? a + 1 : -(a + 1);
+        if (ta > lo) {
+            lo = ta;
+            if (f0)
+                *f0 = fa;
+        }
+        if (tb < hi) {
+            hi = tb;
+            if (f1)
+                *f1 = -fa;
+        }
+        if (!(lo <= hi))
+            return 0;
+    }
+    *t0 = lo;
+    *t1 = hi;
+    return 1;
+}
+
+int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0, int *f1)
+{
+    return clip_slabs(box, o, d, NULL, t0, t1, f0, f1);
+}
+
+/* The BVH's box test: rt_clip_box with the ray's precomputed inverse direction and no face codes. */
+static int ray_box(const double box[6], const rt_ray *r, double *t0, double *t1)
+{
+    return clip_slabs(box, r->o, r->d, r->inv, t0, t1, NULL, NULL);
+}
+
+/* ------------------------------------------------------------------ hits */
+
+/* Safety factors of the hit-point error bound (see rt_finish_hit); chosen by the measurement in
+ * tests/c/tracer_offsets.c, which reports how many self-hits each choice leaves. */
+#ifndef RT_ERR_OBJECT
+#define RT_ERR_OBJECT 32.0 /* x eps x (degree + 1) x magnitude of the object-space computation */
+#endif
+#ifndef RT_ERR_WORLD
+#define RT_ERR_WORLD 32.0 /* x eps x magnitude of the world-space computation */
+#endif
+
+/* Rounding noise of f near the hit as the root solver sees it. The solver expands f(o + t d) around a point
+ * of the ray next to the object (shape.c's shift point: nearest the centre of the box's finite axes, else the
+ * coordinate origin). Two estimates, the larger wins: Horner's running error bound eps * sum |c_k| |tau|^k
+ * at the root's offset tau from that point, and the disagreement between that expansion and the generated
+ * value(p) -- two roundings of the same number, which catches cancellation inside the coefficients (a
+ * cubed factor expanded into monomials) that the first estimate cannot see. Measured by
+ * tests/c/tracer_offsets.c. */
+static double solver_noise(const rt_node *n, const double oo[3], const double od[3], const double po[3], double fp,
+                           double t)
+{
+    double c[IG_MAX_DEGREE + 1], os[3], num = 0.0, den = 0.0, ts, tau, pw = 1.0, sum = 0.0, horner;
+    int a, k, deg = n->shape->degree;
+    for (k = 0; k < n->prep.nfinite; ++k) { /* the box's finite axes (none for an unbounded shape) */
+        a = n->prep.finite[k];
+        num += od[a] * (n->prep.centre[a] - oo[a]);
+        den += od[a] * od[a];
+    }
+    if (!(den > 0.0)) {
+        num = -rt_dot(oo, od);
+        den = rt_dot(od, od);
+    }
+    ts = den > 0.0 ? num / den : 0.0;
+    if (!isfinite(ts))
+        ts = 0.0;
+    for (a = 0; a < 3; ++a)
+        os[a] = oo[a] + ts * od[a];
+    n->shape->coeffs(os, od, n->params, c);
+    tau = t - ts;
+    for (k = 0; k <= deg; ++k) {
+        sum += fabs(c[k]) * pw;
+        pw *= fabs(tau);
+    }
+    horner = ig_horner(c, deg, tau);
+    /* The secondary ray will be solved from its own shift point, not this one; when this ray's shift point
+     * happens to sit at the hit, the sum above sees only |f(po)| ~ 0. So also expand along the segment from
+     * the box centre (the coordinate origin on open axes) to po: the noise any ray solved inside the box
+     * meets near po. */
+    {
+        double seg[3], c2[IG_MAX_DEGREE + 1], sum2 = 0.0;
+        for (a = 0; a < 3; ++a)
+            seg[a] = po[a] - n->prep.centre[a];
+        n->shape->coeffs(n->prep.centre, seg, n->params, c2);
+        for (k = 0; k <= deg; ++k)
+            sum2 += fabs(c2[k]);
+        if (sum2 > sum)
+            sum = sum2;
+    }
+    sum = RT_ERR_OBJECT * DBL_EPSILON * (double)(deg + 1) * sum;
+    horner = RT_ERR_OBJECT * fabs(horner - fp);
+    if (!isfinite(sum) || !isfinite(horner))
+        return 0.0;
+    return sum > horner ? sum : horner;
+}
+
+/* How far from po the surface can be, given |f(po)| plus its noise: along the direction u (the normal, or
+ * the ray at a singular point) f(po + s u) = c_0 + c_1 s + c_2 s^2 + ...; the smallest s at which one term
+ * c_k s^k reaches |c_0| + noise. With k = 1 this is the familiar (|f| + noise) / |grad f|; the higher terms
+ * keep the estimate finite where grad f vanishes (a cusp, or the heart's singular equator). */
+static double distance_bound(const rt_node *n, const double po[3], const double u[3], double level)
+{
+    double c[IG_MAX_DEGREE + 1], best = INFINITY, best_pow = INFINITY;
+    int k, deg = n->shape->degree;
+    n->shape->coeffs(po, u, n->params, c);
+    for (k = 1; k <= deg; ++k) {
+        double q;
+        if (k > 1 && isfinite(best))
+            best_pow *= best; /* best^k */
+        if (!(c[k] != 0.0) || !isfinite(c[k]))
+            continue;
+        q = level / fabs(c[k]);
+        if (k == 1) {
+            best = q;
+            best_pow = q;
+        } else if (q < best_pow) { /* only then is q^(1/k) below the best so far */
+            best = pow(q, 1.0 / k);
+            best_pow = q;
+        }
+    }
+    return isfinite(best) ? best : 0.0;
+}
+
+void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], const double d[3], rt_hit *hit,
+                   rt_hit_lazy *lazy)
+{
+    const rt_node *n = &s->nodes[pd->leaf];
+    rt_hit_lazy own, *lz = lazy ? lazy : &own;
+    double g[3], nw[3], len, t = pd->t;
+    int a, singular = 0, face = pd->face, entering = pd->entering, entering_known = pd->entering_known;
+
+    rt_to_object(n, o, d, lz->oo, lz->od);
+    memcpy(lz->o, o, sizeof lz->o);
+    memcpy(lz->d, d, sizeof lz->d);
+    for (a = 0; a < 3; ++a) {
+        hit->p[a] = o[a] + t * d[a];
+        hit->po[a] = lz->oo[a] + t * lz->od[a];
+        lz->u[a] = 0.0;
+    }
+    lz->f = 0.0;
+    if (face == 0) {
+        double f = n->shape->value(hit->po, n->params), gl;
+        n->shape->gradient(hit->po, n->params, g);
+        gl = sqrt(rt_dot(g, g));
+        if (!(gl > 0.0) || !isfinite(gl) || !isfinite(f))
+            singular = 1;
+        /* the direction rt_hit_error measures the distance to f = 0 along */
+        if (!singular) {
+            for (a = 0; a < 3; ++a)
+                lz->u[a] = g[a] / gl;
+        } else {
+            double l = sqrt(rt_dot(lz->od, lz->od));
+            for (a = 0; a < 3; ++a)
+                lz->u[a] = lz->od[a] / l;
+        }
+        lz->f = f;
+    } else {
+        g[0] = g[1] = g[2] = 0.0;
+        g[abs(face) - 1] = face > 0 ? 1.0 : -1.0;
+    }
+    /* World normal by the inverse transpose: n_w = Minv^T g. */
+    if (!singular) {
+        for (a = 0; a < 3; ++a)
+            nw[a] = n->minv[a] * g[0] + n->minv[4 + a] * g[1] + n->minv[8 + a] * g[2];
+        len = sqrt(rt_dot(nw, nw));
+        if (!(len > 0.0) || !isfinite(len))
+            singular = 1;
+        else
+            for (a = 0; a < 3; ++a)
+                nw[a] /= len;
+    }
+    if (singular) {
+        /* grad f = 0 (a cusp, an apex): no normal exists; face the ray so shading stays finite. */
+        len = sqrt(rt_dot(d, d));
+        for (a = 0; a < 3; ++a)
+            nw[a] = -d[a] / len;
+        g[0] = g[1] = g[2] = 0.0;
+        if (!entering_known)
+            entering = 1;
+    } else if (!entering_known) {
+        entering = rt_dot(nw, d) < 0.0;
+    } else if ((rt_dot(nw, d) < 0.0) != (entering != 0)) {
+        /* CSG: orient by the interval end (this also flips a subtracted part's normal). */
+        for (a = 0; a < 3; ++a) {
+            nw[a] = -nw[a];
+            g[a] = -g[a];
+        }
+    }
+    memcpy(hit->n, nw, sizeof nw);
+    len = sqrt(rt_dot(g, g));
+    for (a = 0; a < 3; ++a)
+        hit->no[a] = len > 0.0 ? g[a] / len : nw[a];
+    hit->err = 0.0;
+    hit->t = t;
+    hit->object = pd->object;
+    hit->leaf = pd->leaf;
+    hit->face = face;
+    hit->material = n->material;
+    hit->entering = entering != 0;
+    hit->singular = singular;
+    lz->pending = 1;
+    if (!lazy)
+        rt_hit_error(s, hit, lz);
+}
+
+void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lz)
+{
+    const rt_node *n = &s->nodes[hit->leaf];
+    double dist = 0.0, mag_o, mag_w, td[3], tod[3], tr[3], t = hit->t;
+    int a;
+    if (!lz->pending)
+        return;
+    lz->pending = 0;
+    if (hit->face == 0) {
+        double f = lz->f, level;
+        level = isfinite(f) ? fabs(f) + solver_noise(n, lz->oo, lz->od, hit->po, f, t) : 0.0;
+        /* distance of the computed point from f = 0, including how far the solver's noise can move a root */
+        dist = level > 0.0 ? distance_bound(n, hit->po, lz->u, level) : 0.0;
+    }
+    /* Error bound of the hit point, in world units. The object-space part: the measured distance |f|/|grad f|
+     * of the computed point, plus the rounding noise of evaluating f and of forming o' + t d' (relative to
+     * the magnitudes involved); M stretches it by at most its norm. The world part: rounding of o + t d and
+     * of the transforms. */
+    for (a = 0; a < 3; ++a) {
+        td[a] = t * lz->d[a];
+        tod[a] = t * lz->od[a];
+    }
+    mag_o = rt_maxabs3(lz->oo) + rt_maxabs3(tod) + rt_maxabs3(hit->po);
+    tr[0] = n->m[3];
+    tr[1] = n->m[7];
+    tr[2] = n->m[11];
+    mag_w = rt_maxabs3(lz->o) + rt_maxabs3(td) + rt_maxabs3(hit->p) + rt_maxabs3(tr);
+    hit->err = n->mnorm * (dist + RT_ERR_OBJECT * DBL_EPSILON * (double)(n->shape->degree + 1) * mag_o) +
+               RT_ERR_WORLD * DBL_EPSILON * mag_w;
+}
+
+int rt_spawn_skip(const rt_scene *s, const rt_hit *h) { return s->flat[h->object] ? h->object : -1; }
+
+int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
+                     int skip, rt_pending *out)
+{
+    double best = tmax;
+    int found = 0, i, sp = 0;
+    int stack[128];
+    double entry[128];
+    rt_ray ray;
+    rt_pending h;
+    if (!s->committed)
+        return 0;
+    if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]) || !isfinite(o[0]) || !isfinite(o[1]) || !isfinite(o[2]))
+        return 0;
+    rt_ray_init(&ray, o, d, s->far);
+    /* A hit is kept when it is closer than the best so far (rt_object_hit only reports t < best). In
+     * RT_ANY_OPAQUE mode a hit on an opaque material ends the search. */
+#define RT_TAKE(obj)                                                                                                   \
+    if ((obj) != skip && rt_object_hit(s, (obj), &ray, tmin, best, &h)) {                                              \
+        *out = h;                                                                                                      \
+        best = h.t;                                                                                                    \
+        found = 1;                                                                                                     \
+        if (mode == RT_ANY_OPAQUE && s->materials[s->nodes[h.leaf].material].transparency <= 0.0)                      \
+            return 1;                                                                                                  \
+    }
+    for (i = 0; i < s->nunbounded; ++i)
+        RT_TAKE(s->unbounded[i])
+    /* Each stack entry carries the t where the ray enters its box, so a node is clipped once and skipped
+     * when a closer hit has been found since it was pushed. */
+    if (s->nbvh > 0) {
+        double t0 = tmin, t1 = best;
+        if (ray_box(s->bvh[0].box, &ray, &t0, &t1)) {
+            stack[sp] = 0;
+            entry[sp++] = t0;
+        }
+    }
+    while (sp > 0) {
+        const rt_bvh_node *b;
+        --sp;
+        if (entry[sp] > best)
+            continue;
+        b = &s->bvh[stack[sp]];
+        if (b->left < 0) {
+            for (i = b->first; i < b->first + b->count; ++i)
+                RT_TAKE(s->order[i])
+        } else if (sp + 2 <= (int)(sizeof stack / sizeof stack[0])) {
+            /* visit the nearer child first: push it last */
+            const rt_bvh_node *l = &s->bvh[b->left], *r = &s->bvh[b->right];
+            double la = tmin, lb = best, ra = tmin, rb = best;
+            int lhit = ray_box(l->box, &ray, &la, &lb);
+            int rhit = ray_box(r->box, &ray, &ra, &rb);
+            if (lhit && rhit && la > ra) {
+                stack[sp] = b->left;
+                entry[sp++] = la;
+                stack[sp] = b->right;
+                entry[sp++] = ra;
+            } else {
+                if (rhit) {
+                    stack[sp] = b->right;
+                    entry[sp++] = ra;
+                }
+                if (lhit) {
+                    stack[sp] = b->left;
+                    entry[sp++] = la;
+                }
+            }
+        }
+    }
+#undef RT_TAKE
+    return found;
+}
+
+int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, rt_hit *hit)
+{
+    rt_pending h;
+    if (!rt_scene_closest(s, o, d, tmin, tmax, RT_CLOSEST, -1, &h))
+        return 0;
+    rt_finish_hit(s, &h, o, d, hit, NULL);
+    return 1;
+}

@@ -1,0 +1,189 @@
+"""`implgen view` in a real browser: headless Debian Chromium driven by Selenium against the real server (uvicorn
+on 127.0.0.1, a free port). `make test` installs chromium and chromium-driver when they are missing.
+
+The page is used as a person would: type an equation, wait for the picture, drag a slider, type a bad
+equation, orbit with the mouse. The picture on the canvas is compared with render() of the same view.
+With IMPLGEN_SCREENSHOT=path set, a screenshot of the page is saved there (the README's picture).
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import os
+import shutil
+import threading
+import time
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from implgen.codegen.spec import parse_spec
+from implgen.scene.render import render, to_uint8
+from implgen.view import protocol
+from implgen.view.command import bind, document_factory, serve
+
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+CHROMEDRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
+EQUATION = "x^4 - 5*x^2 + y^4 - 5*y^2 + z^4 - 5*z^2 + c"  # a tanglecube; c = 11.8 is the classic one
+PARAMS = "c = 11.8"
+WAIT = 120  # seconds: generous, the machine may be busy; nothing here is a timing
+
+
+@pytest.fixture(scope="module")
+def server():
+    make = document_factory(None)
+    sock = bind("127.0.0.1", 0)
+    holder: dict = {}
+    thread = threading.Thread(target=serve, args=(sock, make, 2, lambda s: holder.setdefault("server", s)), daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 30
+    while not getattr(holder.get("server"), "started", False):
+        assert time.monotonic() < deadline and thread.is_alive(), "the server did not start"
+        time.sleep(0.05)
+    yield f"http://127.0.0.1:{sock.getsockname()[1]}/"
+    holder["server"].should_exit = True
+    thread.join(30)
+
+
+@pytest.fixture(scope="module")
+def driver():
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    assert os.path.exists(CHROMIUM) and os.path.exists(CHROMEDRIVER), "run `make browser` (chromium, chromium-driver)"
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = CHROMIUM
+    for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1100,640"):
+        opts.add_argument(arg)
+    opts.add_argument("--force-device-scale-factor=1")
+    d = webdriver.Chrome(service=Service(CHROMEDRIVER), options=opts)
+    yield d
+    d.quit()
+
+
+def wait(driver, what, message: str):
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    return WebDriverWait(driver, WAIT, poll_frequency=0.05).until(lambda d: what(d), message)
+
+
+def frame_state(driver) -> tuple[int, str]:
+    script = "const c = document.getElementById('view'); return [c.dataset.seq, c.dataset.kind];"
+    seq, kind = driver.execute_script(script)
+    return (int(seq) if seq is not None else -1, kind or "")
+
+
+def wait_full_after(driver, seq: int) -> int:
+    """Wait for a refined frame newer than `seq`, then until no newer request is on its way."""
+
+    def done(d):
+        s, kind = frame_state(d)
+        return s if s > seq and kind == "full" else False
+
+    return wait(driver, done, f"no refined frame after {seq}")
+
+
+def canvas_pixels(driver) -> np.ndarray:
+    url = driver.execute_script("return document.getElementById('view').toDataURL('image/png');")
+    data = base64.b64decode(url.split(",", 1)[1])
+    return np.asarray(Image.open(io.BytesIO(data)).convert("RGB")).astype(int)
+
+
+def page_colour(driver, element_id: str) -> list[float]:
+    hexa = driver.find_element("id", element_id).get_attribute("value")
+    return [int(hexa[i : i + 2], 16) / 255 for i in (1, 3, 5)]
+
+
+def reference(driver, values: dict) -> np.ndarray:
+    """render() of the view the page shows: the starter's camera, the page's colours, the typed shape."""
+    doc = document_factory(None)()
+    spec = protocol.parse_shape({"equation": EQUATION, "params": {"c": 11.8}}, doc.spec)
+    doc.set_spec(spec)
+    doc.values = dict(values)
+    doc.options.color = tuple(page_colour(driver, "color"))
+    doc.options.inside = tuple(page_colour(driver, "inside"))
+    doc.options.background = tuple(page_colour(driver, "background"))
+    return to_uint8(render(doc.scene(640, 480, 4), threads=2)).astype(int)
+
+
+def test_the_page_in_a_real_browser(server, driver) -> None:
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.keys import Keys
+
+    driver.get(server)
+    first = wait_full_after(driver, -1)  # the starter torus, refined
+    assert canvas_pixels(driver).std() > 10
+
+    # type an equation with a param; Enter applies it
+    params = driver.find_element("id", "params-text")
+    params.clear()
+    params.send_keys(PARAMS)
+    eq = driver.find_element("id", "equation")
+    eq.clear()
+    eq.send_keys(EQUATION)
+    eq.send_keys(Keys.ENTER)
+    wait(driver, lambda d: d.find_element("id", "degree").text == "degree 4", "the shape was not accepted")
+    typed = wait_full_after(driver, first)
+    time.sleep(0.5)
+    typed = max(typed, frame_state(driver)[0])
+    shown = canvas_pixels(driver)
+    ref = reference(driver, {"c": 11.8})
+    diff = np.abs(shown - ref)
+    assert diff.mean() < 1.0 and np.mean(diff > 8) < 0.002, (diff.mean(), np.mean(diff > 8))
+    assert driver.find_element("id", "equation-error").text == ""
+
+    # drag the slider of c: the picture changes, and matches render() with the new value
+    slider = driver.find_element("css selector", "input[type=range][data-name=c]")
+    ActionChains(driver).click_and_hold(slider).move_by_offset(-60, 0).release().perform()
+    moved = wait_full_after(driver, typed)
+    time.sleep(0.5)
+    moved = max(moved, frame_state(driver)[0])
+    after = canvas_pixels(driver)
+    assert np.abs(after - shown).mean() > 2
+    c_now = float(slider.get_attribute("value"))
+    assert c_now < 11.8
+    assert np.abs(after - reference(driver, {"c": c_now})).mean() < 1.0
+
+    # a bad equation: one line beside the field, the last good picture stays
+    eq.clear()
+    eq.send_keys("x^2 + * y")
+    eq.send_keys(Keys.ENTER)
+    wait(driver, lambda d: d.find_element("id", "equation-error").text, "no message for a bad equation")
+    message = driver.find_element("id", "equation-error").text
+    assert "syntax error" in message and "\n" not in message
+    time.sleep(0.3)
+    assert frame_state(driver)[0] == moved and np.array_equal(canvas_pixels(driver), after)
+    params.clear()
+    params.send_keys(PARAMS)  # back to c = 11.8 when the equation is next applied
+
+    # orbit with the mouse: the server is still up and the view turns
+    canvas = driver.find_element("id", "view")
+    ActionChains(driver).move_to_element(canvas).click_and_hold().move_by_offset(40, 10).move_by_offset(
+        40, 10
+    ).release().perform()
+    turned = wait_full_after(driver, moved)
+    assert turned > moved and np.abs(canvas_pixels(driver) - after).mean() > 2
+
+    shot = os.environ.get("IMPLGEN_SCREENSHOT")
+    if shot:  # the classic tanglecube, a little further away, for the README
+        from selenium.webdriver.common.actions.wheel_input import ScrollOrigin
+
+        driver.set_window_size(1100, 700)
+        from selenium.webdriver.support.ui import Select
+
+        Select(driver.find_element("id", "clip")).select_by_value("none")  # the whole surface
+        eq.clear()
+        eq.send_keys(EQUATION)
+        eq.send_keys(Keys.ENTER)
+        wait(driver, lambda d: not d.find_element("id", "equation-error").text, "the message stayed")
+        shown = wait_full_after(driver, turned)
+        slider = driver.find_element("css selector", "input[type=range][data-name=c]")  # rebuilt with the shape
+        ActionChains(driver).click_and_hold(slider).release().perform()  # the middle of the range: c = 11.8
+        shown = wait_full_after(driver, shown)
+        ActionChains(driver).scroll_from_origin(ScrollOrigin.from_element(canvas), 0, 600).perform()
+        wait_full_after(driver, shown)
+        time.sleep(1.0)
+        driver.save_screenshot(shot)
+    assert parse_spec({"name": "t", "equation": EQUATION, "params": {"c": 11.8}}).degree == 4
