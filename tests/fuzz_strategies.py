@@ -311,7 +311,7 @@ def _container(doc: Any, path: tuple) -> Any:
     return doc
 
 
-BREAKS = ["replace", "replace", "replace", "equation", "delete", "add_key", "rename", "repeat", "share", "wrap"]
+BREAKS = ["keep", "replace", "replace", "replace", "equation", "delete", "add_key", "rename", "repeat", "share", "wrap"]
 
 
 @st.composite
@@ -319,6 +319,8 @@ def broken(draw: st.DrawFn, documents: st.SearchStrategy[Any]) -> tuple[str, Any
     """(what was broken, the document) from a valid document with exactly one thing broken."""
     doc = copy.deepcopy(draw(documents))
     how = draw(st.sampled_from(BREAKS))
+    if how == "keep":  # valid as built: the loaders must take it
+        return how, doc
     paths = _paths(doc)[::-1]  # Hypothesis favours the first: let that be a leaf deep down
     if how == "wrap" or not paths:
         return how, draw(st.sampled_from([[doc], {"spec": doc}, _deep_list(50), "text", 12, None]))
@@ -462,7 +464,28 @@ def scenes(draw: st.DrawFn) -> dict:
     )
     doc["materials"] = {n: draw(materials) for n in names}
     doc["objects"] = draw(st.lists(nodes(names), min_size=1, max_size=3))
+    if draw(st.booleans()):
+        frames = draw(st.integers(1, 6))
+        doc = {"animation": {"frames": frames}, **copy.deepcopy(doc)}  # st.just values are shared: copy first
+        _animate(draw, doc, frames)
     return doc
+
+
+_NOT_KEYABLE = ("image", "animation", "bounds")
+
+
+def _animate(draw: st.DrawFn, doc: Any, frames: int, top: bool = True) -> None:
+    """Some of the scene's numbers keyed to frames: the key at frame 0 the number itself, the last key a
+    number between half and all of it (in range wherever the number was)."""
+    items = list(doc.items()) if isinstance(doc, dict) else list(enumerate(doc)) if isinstance(doc, list) else []
+    for k, v in items:
+        if top and k in _NOT_KEYABLE:
+            continue
+        if isinstance(v, float) and draw(st.integers(0, 3)) == 0:
+            last = v * draw(st.floats(0.5, 1.0))
+            doc[k] = {"keys": {0: v, frames - 1: last}, "ease": draw(st.sampled_from(["linear", "smooth"]))}
+        elif isinstance(v, (dict, list)) and k != "bounds":
+            _animate(draw, v, frames, top=False)
 
 
 # --------------------------------------------------------------------------------------- raw mutations

@@ -148,6 +148,8 @@ CASES += [
     equation("degree-bomb-sum", "(x+y+z)^10000", "degree would exceed 24"),
     equation("degree-bomb-nested", "((((x^2)^2)^2)^2)^2", "degree would exceed 24"),
     equation("degree-bomb-tower", "x^(2^64)", "degree would exceed 24"),
+    equation("degree-bomb-power-of-product", "(2*x)^99999999999", "degree would exceed 24"),
+    equation("degree-bomb-param-product", "x + (3*a)^(10^12)", "parameters raised", "params: {a: 1}\n"),
     equation("degree-bomb-huge-exponent", "(x+1)^99999999999999999999", "degree would exceed 24"),
     equation("degree-product-chain", "*".join(["(x+y+1)"] * 30), "degree would exceed 24"),
     equation(

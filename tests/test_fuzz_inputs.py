@@ -43,7 +43,7 @@ from implgen.cli import main
 from implgen.codegen.grammar import ParseError, format_expression, parse_expression, split_equation
 from implgen.codegen.spec import VARIABLES, exact_polynomial, load_spec, param_symbol
 from implgen.errors import UserError
-from implgen.scene.load import load_scene
+from implgen.scene.frames import load_frames
 
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS = Path(__file__).resolve().parent / "fuzz_corpus"
@@ -217,7 +217,7 @@ def test_scene_loader_broken_scenes(work, case):
     how, doc = case
     path = work / "scenes" / "scene.yaml"
     path.write_text(dump(doc), encoding="utf-8")
-    scene, message = outcome(load_scene, path)
+    scene, message = outcome(load_frames, path)
     if scene is None:
         assert message.startswith(f"{path}: "), message
         _refusal_through_cli(work, path)
@@ -229,7 +229,7 @@ def test_scene_with_a_value_no_key_accepts_is_refused(work, case):
     where, doc = case
     path = work / "scenes" / "poisoned.yaml"
     path.write_text(dump(doc), encoding="utf-8")
-    scene, message = outcome(load_scene, path)
+    scene, message = outcome(load_frames, path)
     assert scene is None, f"accepted with {where} poisoned"
     assert message.startswith(f"{path}: "), message
 
@@ -260,7 +260,7 @@ def test_mutated_example_scenes(work, case):
     path = work / "scenes" / name
     path.write_bytes(data)
     try:
-        scene, message = outcome(load_scene, path)
+        scene, message = outcome(load_frames, path)
         if scene is None:
             assert message.startswith(f"{path}: "), message
             _refusal_through_cli(work, path)

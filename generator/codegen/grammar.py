@@ -210,13 +210,18 @@ class _Builder:
             if k > 1 and bits * k > 2 * MAX_CONST_BITS:
                 raise ParseError(f"constant power too large: exponent {k}")
             return Parsed(_bounded(base.expr**k), 0, 0)
-        return self._checked(base.expr**k, base.degree_bound * k, base.param_degree_bound * k)
+        degree, param_degree = base.degree_bound * k, base.param_degree_bound * k
+        self._check_degrees(degree, param_degree)  # before the power: SymPy computes 2^k of (2*x)^k at once
+        return self._checked(base.expr**k, degree, param_degree)
 
-    def _checked(self, expr: sympy.Expr, degree: int, param_degree: int) -> Parsed:
+    def _check_degrees(self, degree: int, param_degree: int) -> None:
         if degree > self.max_degree:
             raise ParseError(f"degree would exceed {self.max_degree} (the highest supported)")
         if param_degree > self.max_param_degree:
             raise ParseError(f"parameters raised to a degree above {self.max_param_degree}")
+
+    def _checked(self, expr: sympy.Expr, degree: int, param_degree: int) -> Parsed:
+        self._check_degrees(degree, param_degree)
         return self._constant_checked(Parsed(expr, degree, param_degree))
 
     @staticmethod
