@@ -150,6 +150,18 @@ CASES += [
     equation("degree-bomb-tower", "x^(2^64)", "degree would exceed 24"),
     equation("degree-bomb-power-of-product", "(2*x)^99999999999", "degree would exceed 24"),
     equation("degree-bomb-param-product", "x + (3*a)^(10^12)", "parameters raised", "params: {a: 1}\n"),
+    equation(
+        "expansion-bomb-params",
+        "x + (a+b+c+d+e+f+g+h)^20",
+        "would expand to up to 888,031 terms (at most 20,000)",
+        "params: {a: 1, b: 1, c: 1, d: 1, e: 1, f: 1, g: 1, h: 1}\n",
+    ),
+    equation(
+        "expansion-bomb-product",
+        "x + (a+b+c+d)^30 * (e+f+g+h)^30",
+        "would expand to up to",
+        "params: {a: 1, b: 1, c: 1, d: 1, e: 1, f: 1, g: 1, h: 1}\n",
+    ),
     equation("degree-bomb-huge-exponent", "(x+1)^99999999999999999999", "degree would exceed 24"),
     equation("degree-product-chain", "*".join(["(x+y+1)"] * 30), "degree would exceed 24"),
     equation(

@@ -133,6 +133,7 @@ def test_parsed_equations_print_back_to_the_same_polynomial(text):
     poly = exact_polynomial(parsed.expr, list(SYMBOLS.values()))
     degree = max((sum(m[:3]) for m in poly.monoms()), default=0) if poly != 0 else 0
     assert degree <= parsed.degree_bound
+    assert len(poly.terms()) <= parsed.terms  # the bound that refuses expansion bombs is a bound
 
 
 @fuzz_settings(300)

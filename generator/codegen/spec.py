@@ -24,7 +24,7 @@ from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
 from implgen import abi, validate
-from implgen.codegen.grammar import ParseError, format_expression, parse_expression, split_equation
+from implgen.codegen.grammar import ParseError, check_terms, format_expression, parse_expression, split_equation
 from implgen.codegen.names import check_identifier, check_shape_name
 from implgen.errors import UserError
 from implgen.yamlfile import read_yaml
@@ -204,6 +204,7 @@ def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[s
         lhs_text, rhs_text = split_equation(str(text))
         lhs = parse_expression(lhs_text, VARIABLES, symbols, MAX_DEGREE)
         rhs = parse_expression(rhs_text, VARIABLES, symbols, MAX_DEGREE)
+        check_terms(lhs.terms + rhs.terms)
     except ParseError as err:
         raise UserError(source, f"equation: {err}") from None
     f = lhs.expr - rhs.expr
