@@ -214,6 +214,33 @@ CASES += [
     scene("huge-file", OBJ + "# " + "x" * (1 << 20) + "\n", "larger than 1048576 bytes"),
 ]
 
+# Keyed values: 1,000 keys shared by eight transforms, checked on each of 2,000 frames; the last frame takes the
+# composed translation past 1e9. Each key used to be parsed and checked again on every frame (minutes).
+_KEYS = ", ".join([f"{i}: 0" for i in range(0, 1999, 2)] + ["1999: 9.0e8"])
+_KEYED_LEAF = f"{{shape: {SPHERE}, transform: [{{translate: [*k, 0, 0]}}, {{translate: [*k, 0, 0]}}]}}"
+CASES += [
+    scene(
+        "animation-many-keys-many-frames",
+        "animation: {frames: 2000}\nobjects: ["
+        + ", ".join([_KEYED_LEAF.replace("*k", f"&k {{keys: {{{_KEYS}}}}}", 1)] + [_KEYED_LEAF] * 3)
+        + "]\n",
+        "objects[0].transform: the transform moves the object beyond 1e+09 (at frame 1999)",
+    ),
+    top("animation-keyed-without-block", "camera: {fov: {keys: {0: 30, 5: 40}}}", "needs an 'animation' block"),
+    top("animation-frames-zero", "animation: {frames: 0}", "animation.frames: 0 is outside [1, 10000]"),
+    top("animation-frames-huge", f"animation: {{frames: {BIG}}}", "animation.frames: a number of about 1e400"),
+    top("animation-key-outside", "animation: {frames: 4}\ncamera: {fov: {keys: {9: 30}}}", "frame 9 is outside"),
+    top("animation-key-range", "animation: {frames: 4}\ncamera: {fov: {keys: {0: 30, 3: 200}}}", "fov.keys.3: 200"),
+    top("animation-ease", "animation: {frames: 4}\ncamera: {fov: {keys: {0: 30}, ease: bounce}}", "is not one of"),
+    top("animation-nested-keys", "animation: {frames: 4}\ncamera: {fov: {keys: {0: {keys: {0: 1}}}}}", "not another"),
+    top("animation-keyed-width", "animation: {frames: 4}\nimage: {width: {keys: {0: 8}}}", "cannot be keyed"),
+    scene(
+        "animation-scale-through-zero",
+        f"animation: {{frames: 5}}\nobjects: [{{shape: {SPHERE}, transform: {{scale: {{keys: {{0: -1, 4: 1}}}}}}}}]\n",
+        "(at frame 2)",
+    ),
+]
+
 # ----------------------------------------------------------------------------------------------- CSG
 CASES += [
     objects("union-one-child", f"[{{union: [{LEAF}]}}]", "objects[0].union: expected a list of 2 to 1024 objects"),

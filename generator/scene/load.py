@@ -83,12 +83,13 @@ class _Ctx:
         self.frame = frame
         self.frames: int | None = None  # the animation's frame count; None without an `animation` block
         self.keyed: list[str] = []  # key paths of the values that change with the frame
+        self.keyed_cache: dict = memo.setdefault("keyed", {})  # keyed mappings parsed and checked once
         self.static: dict[int, tuple] = memo.setdefault("static", {})  # objects the same on every frame
         self.reused: set[int] = set()  # objects[i] taken from `static` on this frame
 
     def resolve(self, key: str, raw: Any) -> Any:
         """A part of the scene made only of numbers (a transform), with keyed values at this frame."""
-        return keys.resolve(self.source, key, raw, self.frame, self.frames, self.keyed)
+        return keys.resolve(self.source, key, raw, self.frame, self.frames, self.keyed, self.keyed_cache)
 
     def fail(self, key: str, msg: str) -> UserError:
         return UserError(self.source, f"{key}: {msg}")
@@ -126,7 +127,7 @@ def _num(
     def check(k: str, v: Any) -> float:
         return validate.number(ctx.source, k, v, lo, hi, lo_open=lo_open)
 
-    return keys.number_at(ctx.source, key, value, ctx.frame, ctx.frames, check, ctx.keyed)
+    return keys.number_at(ctx.source, key, value, ctx.frame, ctx.frames, check, ctx.keyed, ctx.keyed_cache)
 
 
 def _int(ctx: _Ctx, key: str, value: Any, lo: int, hi: int) -> int:
@@ -237,7 +238,9 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
             mapping["bounds"] = raw["bounds"]
         overrides: Any = {}
         if "params" in raw:
-            mapping["params"], overrides = keys.inline_params(ctx.source, f"{key}.params", raw["params"], ctx.frames)
+            mapping["params"], overrides = keys.inline_params(
+                ctx.source, f"{key}.params", raw["params"], ctx.frames, ctx.keyed_cache
+            )
         memo_key = f"{ctx.inline_count}:{mapping!r}"  # the same inline shape on every frame
         if memo_key not in ctx.inline_specs:
             ctx.inline_specs[memo_key] = parse_spec(mapping, f"{ctx.source}: {key}")
@@ -352,7 +355,7 @@ def parse_scene(data: Any, source: str | Path = "<scene>", *, frame: int = 0, me
     cam = _mapping(ctx, "camera", _given(data, "camera", {}), CAMERA_KEYS)
     c = Camera()
     if "orbit" in cam:
-        c.position, c.look_at = keys.orbit_camera(ctx.source, cam, ctx.frame, ctx.frames, ctx.keyed)
+        c.position, c.look_at = keys.orbit_camera(ctx.source, cam, ctx.frame, ctx.frames, ctx.keyed, ctx.keyed_cache)
     if "position" in cam:
         c.position = _vec(ctx, "camera.position", cam["position"])
     if "look_at" in cam:
