@@ -378,6 +378,23 @@ CASES += [
     render("threads-option", ["--threads", "-2"], "argument --threads", "--threads"),
     render("threads-above-option", ["--threads", "100000"], "--threads", "--threads"),
     render("unknown-option", ["--colour", "red"], "unrecognized arguments: --colour", "--colour"),
+    *(
+        Case(
+            f"out-pattern-{i}",
+            ["render", "a.yaml", "-o", pattern],
+            "a frame pattern needs exactly one %d field",
+            {"a.yaml": "animation: {frames: 3}\n" + OBJ},
+            names=f"-o {pattern}",
+        )
+        for i, pattern in enumerate(["f_%n.png", "f_%099999999d.png", "f_%d_%d.png", "f_%s.png", "f_%%d.png"])
+    ),
+    Case(
+        "out-video-odd-size",
+        ["render", "a.yaml", "-o", "v.mp4", "--width", "5"],
+        "a video needs an even width and height",
+        {"a.yaml": "animation: {frames: 3}\n" + OBJ},
+        names="-o v.mp4",
+    ),
     Case("no-output", ["render", "s.yaml"], "arguments are required: -o/--output", {"s.yaml": OBJ}, names="render"),
 ]
 
