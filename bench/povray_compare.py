@@ -1,9 +1,10 @@
 """implgen against POV-Ray 3.7 on the same scenes, and how intersection cost grows with degree.
 
-    .venv/bin/python bench/povray_compare.py [--quick] [-o bench/results/povray] [--runs N]
+    .venv/bin/python bench/povray_compare.py [--quick] [-o bench/results/povray] [--runs N] [--scenes a,b]
 
-For each scene in bench/scenes/ (torus, piriform, heart sextic, Chmutov octic, and the torus again seen from
-10^4 units through a telephoto lens; ground plane, one light, shadows, 800x600, 1 sample) it
+For each scene in bench/scenes/ (torus, piriform, heart sextic, Chmutov octic, the torus again seen from 10^4
+units through a telephoto lens, Chmutov surfaces of degree 12 and 16, a spiky superellipsoid of degree 20;
+ground plane, one light, shadows, 800x600, 1 sample) it
   1. exports the same scene to POV-Ray (`polynomial { ... sturm }`, expanded exactly from our spec; matched
      camera: POV-Ray is left-handed, so `right -x*aspect`; our fov is vertical, POV-Ray's angle horizontal);
   2. times both programs as subprocesses (wall clock, median of --runs runs, interleaved) on 1 thread and on
@@ -11,8 +12,9 @@ For each scene in bench/scenes/ (torus, piriform, heart sextic, Chmutov octic, a
   3. renders coverage masks (ours: the tracer with a flat white unlit material, black background, no
      plane; POV-Ray: `finish { ambient 1 diffuse 0 }`, black background, no plane, no light), counts the
      pixels where they disagree and decides each disputed pixel exactly: its primary ray is mapped to object
-     space in rational arithmetic, f(o + t d) is expanded over Q and Sturm's theorem counts its real roots
-     t >= 0;
+     space in rational arithmetic, f(o + t d) is expanded over Q, t is clipped to the object's box, and
+     Descartes' rule of signs with bisection on integers (implgen.roots.descartes) decides whether a real root
+     lies there;
   4. times the generated C intersectors of a dense degree-n family (n = 2..20): coefficients, solve, total;
   5. writes report.md, results.json and the images into the output folder.
 Every number in the report comes from this one run.
@@ -22,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import platform
 import re
@@ -37,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-SCENES = ("torus", "piriform", "heart", "chmutov", "torus_far")
+SCENES = ("torus", "piriform", "heart", "chmutov", "torus_far", "chmutov12", "chmutov16", "spiky20")
 IMPLGEN = Path(sys.executable).parent / "implgen"
 
 
@@ -54,6 +57,7 @@ _ensure_current_install()
 
 from implgen.codegen.spec import exact_polynomial, param_symbol  # noqa: E402
 from implgen.export import povray as pv  # noqa: E402
+from implgen.roots.descartes import has_root  # noqa: E402
 from implgen.scene.load import load_scene  # noqa: E402
 
 # --------------------------------------------------------------------------------------------- POV-Ray
@@ -163,12 +167,14 @@ def pov_mask(png: Path) -> np.ndarray:
 
 
 class ExactJudge:
-    """Does the primary ray of a pixel truly hit an object? Decided in exact rational arithmetic."""
+    """Does the primary ray of a pixel truly hit an object inside its box? Decided in exact rational arithmetic:
+    f(o + t d) expanded over Q, t clipped to the object's box (as exported with `clipped_by`), and the integer
+    Descartes/bisection test of implgen.roots.descartes on that interval."""
 
     def __init__(self, scene, w: int, h: int):
         import sympy as sp
 
-        self.scene, self.w, self.h, self.sp = scene, w, h, sp
+        self.scene, self.w, self.h = scene, w, h
         self.objects = []
         for leaf in scene.leaves():
             if leaf.spec.degree == 1 and leaf.spec.name == "ground":
@@ -180,39 +186,53 @@ class ExactJudge:
             ]
             m = sp.Matrix(3, 4, [sp.Rational(Fraction(float(v))) for v in np.asarray(leaf.matrix).ravel()])
             inv = m[:, :3].inv()
-            self.objects.append((terms, inv, m[:, 3], leaf.spec.degree))
+            frac = lambda v: Fraction(int(sp.numer(v)), int(sp.denom(v)))  # noqa: E731
+            inv_f = [[frac(inv[i, j]) for j in range(3)] for i in range(3)]
+            tr_f = [frac(m[i, 3]) for i in range(3)]
+            self.objects.append((terms, inv_f, tr_f, leaf.spec.degree, _padded_box(leaf.spec.box(leaf.params))))
 
     @staticmethod
-    def _mul(a: list[Fraction], b: list[Fraction]) -> list[Fraction]:
-        out = [Fraction(0)] * (len(a) + len(b) - 1)
+    def _mul(a: list[int], b: list[int]) -> list[int]:
+        out = [0] * (len(a) + len(b) - 1)
         for i, x in enumerate(a):
             if x:
                 for j, y in enumerate(b):
                     out[i + j] += x * y
         return out
 
-    def ray_poly(self, obj, o: np.ndarray, d: np.ndarray) -> list[Fraction]:
-        """Exact coefficients (lowest first) of f(o' + t d') with o', d' the object-space ray."""
-        sp = self.sp
-        terms, inv, tr, deg = obj
-        ow = sp.Matrix([sp.Rational(Fraction(float(v))) for v in o])
-        dw = sp.Matrix([sp.Rational(Fraction(float(v))) for v in d])
-        oo, dd = inv * (ow - tr), inv * dw
-        lin = [
-            [Fraction(int(sp.numer(oo[k])), int(sp.denom(oo[k]))), Fraction(int(sp.numer(dd[k])), int(sp.denom(dd[k])))]
-            for k in range(3)
-        ]
+    @staticmethod
+    def object_ray(obj, o: np.ndarray, d: np.ndarray) -> tuple[list[Fraction], list[Fraction]]:
+        """The world ray (doubles, taken exactly) in the object's space, exactly."""
+        _, inv, tr, _, _ = obj
+        ow = [Fraction(float(v)) - tr[k] for k, v in enumerate(o)]
+        dw = [Fraction(float(v)) for v in d]
+        oo = [sum(inv[i][j] * ow[j] for j in range(3)) for i in range(3)]
+        dd = [sum(inv[i][j] * dw[j] for j in range(3)) for i in range(3)]
+        return oo, dd
+
+    def ray_poly(self, obj, o: np.ndarray, d: np.ndarray) -> list[int]:
+        """Integer coefficients (lowest first) of a positive multiple of f(o' + t d'), o', d' the object-space
+        ray: with o' = A / D and d' = B / D over one denominator D, D^deg f(o' + t d') = sum c_m D^(deg - |m|)
+        prod_k (A_k + B_k t)^(m_k), and the c_m are scaled to integers: all in Python integers, no gcd."""
+        terms, _, _, deg, _ = obj
+        oo, dd = self.object_ray(obj, o, d)
+        den = 1
+        for v in (*oo, *dd, *(c for _, c in terms)):
+            den = den * v.denominator // math.gcd(den, v.denominator)
+        lin = [[int(oo[k] * den), int(dd[k] * den)] for k in range(3)]
         powers = []
         for k in range(3):
-            pw = [[Fraction(1)]]
+            pw = [[1]]
             for _ in range(deg):
                 pw.append(self._mul(pw[-1], lin[k]))
             powers.append(pw)
-        acc = [Fraction(0)] * (deg + 1)
+        acc = [0] * (deg + 1)
+        dpow = [den**e for e in range(deg + 2)]
         for (i, j, k), c in terms:
+            scale = int(c * den) * dpow[deg - (i + j + k)]
             p = self._mul(self._mul(powers[0][i], powers[1][j]), powers[2][k])
             for e, v in enumerate(p):
-                acc[e] += c * v
+                acc[e] += scale * v
         return acc
 
     def hits(self, px: int, py: int) -> bool:
@@ -220,15 +240,47 @@ class ExactJudge:
         return any(self.ray_hits(obj, o, d) for obj in self.objects)
 
     def ray_hits(self, obj, o, d) -> bool:
-        sp = self.sp
-        c = self.ray_poly(obj, o, d)
-        while len(c) > 1 and c[-1] == 0:
-            c.pop()
-        if len(c) == 1:
-            return c[0] == 0
-        t = sp.Symbol("t")
-        poly = sp.Poly([sp.Rational(v.numerator, v.denominator) for v in reversed(c)], t, domain="QQ")
-        return poly.count_roots(0, None) > 0  # Sturm: real roots with t >= 0 (a tangent root counts)
+        span = _box_span(obj[4], *self.object_ray(obj, o, d))
+        if span is None:
+            return False
+        return has_root(self.ray_poly(obj, o, d), *span)  # a tangent root counts
+
+
+def _padded_box(box):
+    """The spec box grown by 1e-9 of its extent, in doubles as runtime_c/shape.c does (and the exporter's
+    clipped_by), as exact rationals; None bounds for infinite ones."""
+    if box is None:
+        return None
+    box = np.asarray(box, dtype=float)
+    lo, hi = box[:3], box[3:]
+    scale = np.maximum(np.where(np.isfinite(lo), np.abs(lo), 0.0), np.where(np.isfinite(hi), np.abs(hi), 0.0))
+    lo, hi = lo - 1e-9 * scale, hi + 1e-9 * scale
+    return [
+        (Fraction(float(a)) if np.isfinite(a) else None, Fraction(float(b)) if np.isfinite(b) else None)
+        for a, b in zip(lo, hi)
+    ]
+
+
+def _box_span(box, oo, dd) -> tuple[Fraction, Fraction | None] | None:
+    """[t0, t1] (t1 None: unbounded) of t >= 0 where o + t d is inside the box, exactly; None when empty."""
+    t0, t1 = Fraction(0), None
+    for k, (lo, hi) in enumerate(box or []):
+        for bound, is_lo in ((lo, True), (hi, False)):
+            if bound is None:
+                continue
+            if dd[k] == 0:
+                if (oo[k] < bound) if is_lo else (oo[k] > bound):
+                    return None
+                continue
+            t = (bound - oo[k]) / dd[k]
+            entering = (dd[k] > 0) == is_lo
+            if entering:
+                t0 = max(t0, t)
+            else:
+                t1 = t if t1 is None else min(t1, t)
+    if t1 is not None and t1 < t0:
+        return None
+    return t0, t1
 
 
 # ------------------------------------------------------------------------------------- degree family
@@ -369,7 +421,12 @@ def main(argv=None) -> int:
         default=300,
         help="agreed silhouette pixels checked exactly per scene (random sample)",
     )
+    ap.add_argument("--scenes", default=",".join(SCENES), help="comma-separated subset of bench/scenes (default: all)")
     args = ap.parse_args(argv)
+    scenes = [s for s in args.scenes.split(",") if s]
+    unknown = sorted(set(scenes) - set(SCENES))
+    if unknown:
+        ap.error(f"--scenes: unknown scene(s) {', '.join(unknown)}; choose from {', '.join(SCENES)}")
     runs = args.runs or (1 if args.quick else 3)
     w, h = (400, 300) if args.quick else (800, 600)
     out = args.out.resolve()
@@ -391,7 +448,7 @@ def main(argv=None) -> int:
     print(f"POV-Ray {results['povray']}; {results['machine']['cpu']} x{ncpu}; {w}x{h}, {runs} run(s) each")
     rng = np.random.default_rng(2024)
 
-    for name in SCENES:
+    for name in scenes:
         path = ROOT / "bench" / "scenes" / f"{name}.yaml"
         scene = load_scene(path)
         pov, povc = povdir / f"{name}.pov", povdir / f"{name}_coverage.pov"
@@ -565,8 +622,9 @@ def write_report(r: dict, out: Path) -> None:
         "## Coverage (object hit or not, per pixel)",
         "",
         "Disputed = pixels where one program sees the object and the other does not. Each checked disputed "
-        "pixel is decided exactly (ray mapped to object space in rationals, f(o + t d) expanded over Q, "
-        "Sturm count of roots t >= 0).",
+        "pixel is decided exactly (ray mapped to object space in rationals, f(o + t d) expanded over Q, t "
+        "clipped to the object's box, a real root there decided by Descartes' rule of signs with bisection "
+        "on integers: implgen.roots.descartes).",
         "",
         "Silhouette pixels (a hit next to a miss) on which both agree are also sampled and checked the same "
         "way, to test the agreement itself.",

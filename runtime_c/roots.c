@@ -21,7 +21,21 @@
 
 /* ---------------------------------------------------------------- interval handling */
 
-typedef int (*interval_solver)(const double *p, int n, double a, double b, double *out);
+/* The chosen method on a finite [a, b] (method: sturm, bracket or bernstein; first: first-root mode where the
+ * method has one; fallbacks: NULL or the Bernstein statistics counter). */
+static int solve_interval(int method, int first, int *fallbacks, const double *p, int n, double a, double b,
+                          double *out)
+{
+    switch (method) {
+    case IG_ROOTS_STURM:
+        return ig_sturm_interval(p, n, a, b, out);
+    case IG_ROOTS_BERNSTEIN:
+        return first ? ig_bernstein_first(p, n, a, b, fallbacks, out)
+                     : ig_bernstein_interval(p, n, a, b, fallbacks, out);
+    default:
+        return ig_bracket_interval(p, n, a, b, out);
+    }
+}
 
 /* Fujiwara's bound 2 max_k |p[n-k] / p[n]|^(1/k) (with p[0] / 2), rounded up to a power of two using only
  * the binary exponents: cheap and never overflows (DBL_MAX when the bound is not representable). */
@@ -46,9 +60,9 @@ static double root_bound(const double *p, int n)
     return ldexp(1.0, best + 1);
 }
 
-/* first != 0 may swap in a first-root solver (first_solver) where the interval is solved in one piece. */
-static int solve_general(const double *p, int n, double lo, double hi, interval_solver solver,
-                         interval_solver first_solver, double *out)
+/* first != 0 uses the method's first-root mode where the interval is solved in one piece. */
+static int solve_general(const double *p, int n, double lo, double hi, int method, int first, int *fallbacks,
+                         double *out)
 {
     double a = lo, b = hi;
     if (isinf(a) || isinf(b)) {
@@ -64,7 +78,7 @@ static int solve_general(const double *p, int n, double lo, double hi, interval_
     /* coefficients are at most ~2^200 (see ig_real_roots_any); |x|^n below 2^524 keeps Horner and the
      * splitting of Dekker's product (another 2^27) far from overflow */
     if (big <= 0x1p20 || (double)n * ilogb(big) < 500.0) /* n <= 24: 2^20 is always safe */
-        return (first_solver ? first_solver : solver)(p, n, a, b, out);
+        return solve_interval(method, first, fallbacks, p, n, a, b, out);
 
     /* |x| > 1 on the reversed polynomial q(y) = y^n p(1/y), y = 1/x in [-1, 1] */
     double q[IG_MAX_DEGREE + 1], tmp[IG_ROOT_BUF];
@@ -72,22 +86,22 @@ static int solve_general(const double *p, int n, double lo, double hi, interval_
         q[k] = p[n - k];
     int cnt = 0;
     if (a <= 1.0 && b >= -1.0)
-        cnt = solver(p, n, fmax(a, -1.0), fmin(b, 1.0), out);
+        cnt = solve_interval(method, 0, fallbacks, p, n, fmax(a, -1.0), fmin(b, 1.0), out);
     if (b > 1.0) {
         double xa = fmax(a, 1.0);
-        int k = solver(q, n, 1.0 / b, 1.0 / xa, tmp);
+        int k = solve_interval(method, 0, fallbacks, q, n, 1.0 / b, 1.0 / xa, tmp);
         for (int i = 0; i < k; ++i) {
             double x = 1.0 / tmp[i];
-            if (x >= a && x <= b && !(x == 1.0 && a <= 1.0))
+            if (x >= a && x <= b) /* x = 1 from both parts: one is dropped as a duplicate */
                 out[cnt++] = x;
         }
     }
     if (a < -1.0) {
         double xb = fmin(b, -1.0);
-        int k = solver(q, n, 1.0 / xb, 1.0 / a, tmp);
+        int k = solve_interval(method, 0, fallbacks, q, n, 1.0 / xb, 1.0 / a, tmp);
         for (int i = 0; i < k; ++i) {
             double x = 1.0 / tmp[i];
-            if (x >= a && x <= b && !(x == -1.0 && b >= -1.0))
+            if (x >= a && x <= b)
                 out[cnt++] = x;
         }
     }
@@ -102,7 +116,8 @@ static int auto_method(int n)
     return IG_ROOTS_BERNSTEIN;
 }
 
-static int solve_reduced(const double *p, int n, double lo, double hi, int method, int first, double *out)
+static int solve_reduced(const double *p, int n, double lo, double hi, int method, int first, int *fallbacks,
+                         double *out)
 {
     if (n == 1) {
         double x = -p[0] / p[1];
@@ -123,20 +138,23 @@ static int solve_reduced(const double *p, int n, double lo, double hi, int metho
             return ig_closed_cubic(p, lo, hi, polish, out);
         if (n == 4)
             return ig_closed_quartic(p, lo, hi, polish, out);
-        return solve_general(p, n, lo, hi, ig_bracket_interval, NULL, out);
+        return solve_general(p, n, lo, hi, IG_ROOTS_BRACKET, 0, NULL, out);
     }
     case IG_ROOTS_STURM:
-        return solve_general(p, n, lo, hi, ig_sturm_interval, NULL, out);
     case IG_ROOTS_BRACKET:
-        return solve_general(p, n, lo, hi, ig_bracket_interval, NULL, out);
     case IG_ROOTS_BERNSTEIN:
-        return solve_general(p, n, lo, hi, ig_bernstein_interval, first ? ig_bernstein_first : NULL, out);
+        return solve_general(p, n, lo, hi, method, first, fallbacks, out);
     default:
         return 0;
     }
 }
 
 int ig_roots_core(const double *c, int n, double lo, double hi, int method, int first, double *roots)
+{
+    return ig_roots_stats(c, n, lo, hi, method, first, NULL, roots);
+}
+
+int ig_roots_stats(const double *c, int n, double lo, double hi, int method, int first, int *fallbacks, double *roots)
 {
     if (!c || !roots || n < 0 || n > IG_MAX_DEGREE)
         return 0;
@@ -179,7 +197,7 @@ int ig_roots_core(const double *c, int n, double lo, double hi, int method, int 
     double r[IG_ROOT_BUF];
     int k = 0;
     if (deg > 0)
-        k = solve_reduced(p + m, deg, lo, hi, method, first, r);
+        k = solve_reduced(p + m, deg, lo, hi, method, first, fallbacks, r);
     if (m > 0)
         r[k++] = 0.0;
     if (k > 1)

@@ -72,3 +72,18 @@ double ig_bench_first_batch(const double *c, int n, long count, const double *lo
 {
     return bench_batch(c, n, count, lo, hi, method, 1, roots, counts, ns);
 }
+
+/* Bernstein pieces handed to bracketing, per polynomial (untimed): fb[i] for polynomial i, in first-root mode
+ * when first != 0. */
+void ig_bench_fallbacks(const double *c, int n, long count, const double *lo, const double *hi, int method, int first,
+                        int *fb);
+
+void ig_bench_fallbacks(const double *c, int n, long count, const double *lo, const double *hi, int method, int first,
+                        int *fb)
+{
+    double r[IG_MAX_DEGREE];
+    for (long i = 0; i < count; ++i) {
+        fb[i] = 0;
+        ig_roots_stats(c + i * (n + 1), n, lo[i], hi[i], method, first, &fb[i], r);
+    }
+}

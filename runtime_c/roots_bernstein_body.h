@@ -12,26 +12,38 @@
 #endif
 #define BZ_FN(name) BZ_CAT(name, BZ_TAG)
 
-/* Bernstein coefficients of p(a + s h) on s in [0, 1]. */
-static void BZ_FN(to_bernstein)(const double *p, int n, double a, double h, double *b)
+/* Bernstein coefficients of both halves of [m - rl, m + rr]: one Taylor shift to the midpoint m,
+ * q(y) = p(m + y), then for each half the scaling y = +-r s and Pascal's triangle. L is written for [m - rl, m]
+ * (left end first), R for [m, m + rr]. Shifting to the midpoint, not to an end, keeps the rounding at the scale
+ * sum |p_k| max(|m - rl|, |m + rr|)^k (see bernstein()). */
+static void BZ_FN(to_bernstein_mid)(const double *p, int n, double m, double rl, double rr, double *L, double *R)
 {
     double t[IG_MAX_DEGREE + 1];
     (void)n;
     t[0] = p[0];
     for (int k = 1; k <= N; ++k)
         t[k] = p[k];
-    for (int i = 0; i < N; ++i) /* Taylor shift: t(y) = p(a + y), repeated synthetic division */
+    for (int i = 0; i < N; ++i) /* Taylor shift: t(y) = p(m + y), repeated synthetic division */
         for (int k = N - 1; k >= i; --k)
-            t[k] += a * t[k + 1];
-    double r = 1.0; /* h^j / C(n, j), C(n, j) = C(n, j - 1) (n - j + 1) / j */
-    b[0] = t[0];
+            t[k] += m * t[k + 1];
+    double fl = 1.0, fr = 1.0;   /* (-rl)^j / C(n, j), rr^j / C(n, j); C(n, j) = C(n, j - 1) (n - j + 1) / j */
+    double W[IG_MAX_DEGREE + 1]; /* the left half in the reflected variable (0 at m, 1 at m - rl) */
+    W[0] = t[0];
+    R[0] = t[0];
     for (int j = 1; j <= N; ++j) {
-        r *= h * (j * bz_inv[N - j + 1]);
-        b[j] = t[j] * r;
+        double f = j * bz_inv[N - j + 1];
+        fl *= -rl * f;
+        fr *= rr * f;
+        W[j] = t[j] * fl;
+        R[j] = t[j] * fr;
     }
     for (int k = 1; k <= N; ++k) /* b_i = sum_j C(i, j) w_j: Pascal's triangle, additions only */
-        for (int i = N; i >= k; --i)
-            b[i] += b[i - 1];
+        for (int i = N; i >= k; --i) {
+            W[i] += W[i - 1];
+            R[i] += R[i - 1];
+        }
+    for (int i = 0; i <= N; ++i)
+        L[i] = W[N - i];
 }
 
 /* de Casteljau at s = 1/2: the halves' coefficients (weights 1/2: the only rounding is in the sums). */
@@ -52,10 +64,11 @@ static void BZ_FN(split_half)(const double *b, int n, double *L, double *R)
     }
 }
 
-/* Sign changes of b[0..n] with end signs sl, sr (certain, nonzero); -1 when uncertain interior coefficients
+/* Sign changes of b[0..n] with end signs sl, sr (certain, nonzero), and in *unsure how many interior
+ * coefficients are within tol of zero; -1 when uncertain interior coefficients
  * could hide changes: a run of them between two equal signs (+ ? + may be + - +), or a run of two or more
  * between opposite signs (+ ? ? - may be + - + -). A single one between opposite signs changes nothing. */
-static int BZ_FN(variations)(const double *b, int n, double tol, int sl, int sr)
+static int BZ_FN(variations)(const double *b, int n, double tol, int sl, int sr, int *unsure)
 {
     int v = 0, last = sl, pending = 0;
     (void)n;
@@ -67,6 +80,7 @@ static int BZ_FN(variations)(const double *b, int n, double tol, int sl, int sr)
         changes += pos != prev;
         prev = pos;
     }
+    *unsure = N - 1 - certain;
     if (certain == N - 1)
         return changes + ((sr > 0) != prev);
     for (int i = 1; i < N; ++i) {
@@ -102,14 +116,16 @@ static double BZ_FN(polygon_crossing)(const double *b, int n, double tl, double 
     return NAN;
 }
 
-/* Piece [s0, s1] of [0, 1] with Bernstein coefficients b, end signs sl, sr and values vl, vr of p there. */
-static void BZ_FN(piece)(bz_ctx *c, const double *b, double s0, double s1, double tl, double tr, int sl, int sr,
-                         double vl, double vr, int depth)
+/* Piece [tl, tr] with Bernstein coefficients b, each within tol of the exact ones, end signs sl, sr and values
+ * vl, vr of p there. */
+static void BZ_FN(piece)(bz_ctx *c, const double *b, double tl, double tr, int sl, int sr, double vl, double vr,
+                         double tol, int depth)
 {
     const int n = c->n;
-    if (!isnan(c->fallback_from) || (c->first && c->cnt > 0))
+    if (c->first && c->cnt + c->nfb > 0)
         return;
-    int v = BZ_FN(variations)(b, n, c->tol, sl, sr);
+    int unsure;
+    int v = BZ_FN(variations)(b, n, tol, sl, sr, &unsure);
     if (v == 0)
         return;
     if (v == 1) { /* one simple root: refined now in first-root mode, else with the others at the end */
@@ -126,21 +142,34 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double s0, double s1, doubl
         c->bx0[k] = x0;
         return;
     }
-    double sm = 0.5 * (s0 + s1);
-    double tm = c->a + sm * c->h;
+    double tm = 0.5 * tl + 0.5 * tr;
     if (depth >= BZ_MAX_DEPTH || !(tm > tl && tm < tr)) {
-        c->fallback_from = tl;
+        bz_fallback(c, tl, tr);
         return;
     }
     double L[IG_MAX_DEGREE + 1], R[IG_MAX_DEGREE + 1], vm;
-    BZ_FN(split_half)(b, n, L, R);
-    int sm_sign = end_sign(c, L[N], tm, &vm);
+    /* Coefficients of uncertain sign: converted afresh on this piece, the rounding is at the scale of p here,
+     * sum |p_k| max(|tl|, |tr|)^k, which can be far below the inherited one (p small near the expansion point
+     * of the ray polynomial, or a piece far from the larger end of the interval). */
+    double tol_here = unsure > 0 ? 7.0 * N * IG_U * ig_horner_abs(c->p, n, fmax(fabs(tl), fabs(tr))) : tol;
+    if (tol_here < 0.25 * tol) {
+        BZ_FN(to_bernstein_mid)(c->p, n, tm, tm - tl, tr - tm, L, R);
+        tol = tol_here;
+    } else {
+        double big = 0.0;
+        for (int i = 0; i <= N; ++i)
+            big = fmax(big, fabs(b[i]));
+        BZ_FN(split_half)(b, n, L, R);
+        /* the halving's own rounding: one per level of averages, each below u times the largest coefficient */
+        tol += (N + 1) * IG_U * big;
+    }
+    int sm_sign = end_sign(c, L[N], tm, tol, &vm);
     if (sm_sign == 0) { /* p zero within rounding at the split point */
-        c->fallback_from = tl;
+        bz_fallback(c, tl, tr);
         return;
     }
-    BZ_FN(piece)(c, L, s0, sm, tl, tm, sl, sm_sign, vl, vm, depth + 1);
-    BZ_FN(piece)(c, R, sm, s1, tm, tr, sm_sign, sr, vm, vr, depth + 1);
+    BZ_FN(piece)(c, L, tl, tm, sl, sm_sign, vl, vm, tol, depth + 1);
+    BZ_FN(piece)(c, R, tm, tr, sm_sign, sr, vm, vr, tol, depth + 1);
 }
 
 #undef BZ_FN

@@ -58,10 +58,10 @@ int ig_closed_quartic(const double *c, double lo, double hi, int polish, double 
 /* Derivative bracketing on a finite [a, b] for exact degree n >= 3 (c[n] != 0, c[0] != 0). */
 int ig_bracket_interval(const double *c, int n, double a, double b, double *r);
 
-/* Bernstein subdivision on a finite [a, b], same preconditions; falls back to ig_bracket_interval whenever
- * it cannot conclude. _first: only the leftmost root is guaranteed to be among the output (which is sorted). */
-int ig_bernstein_interval(const double *c, int n, double a, double b, double *r);
-int ig_bernstein_first(const double *c, int n, double a, double b, double *r);
+/* Bernstein subdivision on a finite [a, b], same preconditions; hands a piece it cannot decide to
+ * ig_bracket_interval (and counts it in *fallbacks unless that is NULL). _first: the leftmost root only. */
+int ig_bernstein_interval(const double *c, int n, double a, double b, int *fallbacks, double *r);
+int ig_bernstein_first(const double *c, int n, double a, double b, int *fallbacks, double *r);
 
 /* Sturm isolation on a finite interval [a, b] for exact degree n >= 3 (c[n] != 0, c[0] != 0). */
 int ig_sturm_interval(const double *c, int n, double a, double b, double *r);
@@ -71,6 +71,10 @@ int ig_real_roots_any(const double *c, int n, double lo, double hi, int method, 
 
 /* The same with first != 0: only the smallest root (at most one), as ig_first_root. */
 int ig_roots_core(const double *c, int n, double lo, double hi, int method, int first, double *roots);
+
+/* ig_roots_core that also counts, into *fallbacks (NULL: not counted), the Bernstein pieces handed to
+ * bracketing: the solver report's statistics. */
+int ig_roots_stats(const double *c, int n, double lo, double hi, int method, int first, int *fallbacks, double *roots);
 
 /* Batch form of ig_first_root for the Python binding: root i (or NaN) to roots[i], 0/1 to counts[i]. */
 void ig_first_root_batch(const double *c, int n, long count, const double *lo, const double *hi, int method,

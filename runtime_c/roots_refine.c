@@ -175,8 +175,10 @@ static inline int lane_step(hh_lane *s, const double *e, double tol, double *roo
         s->r = x;
         s->vr = v;
     }
-    double d2 = d * d;
-    double step = (v * (d2 - v * hdd)) / (d2 * d - 2.0 * v * d * hdd + v * v * h3), xn = x - step;
+    /* v (d^2 - v hdd) / (d^3 - 2 v d hdd + v^2 h3), written with the Newton step nw = v / d so that nothing
+     * underflows where p and its derivatives are tiny (a root at 1e-152 of a polynomial scaled to 1) */
+    double nw = v / d, a = nw * (hdd / d);
+    double step = nw * (1.0 - a) / (1.0 - 2.0 * a + nw * (nw * (h3 / d))), xn = x - step;
     double as = fabs(step);
     int ok = xn >= s->l && xn <= s->r; /* false also for NaN: a zero denominator */
     if (ok && as <= 4.0 * IG_U * fabs(xn)) {

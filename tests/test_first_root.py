@@ -53,7 +53,7 @@ def sets() -> dict:
 def test_first_root_is_the_first_of_the_list(sets, method: str, name: str) -> None:
     """A first root exactly when real_roots finds one; inside [lo, hi]; batch = single; NaN where none; and bitwise
     the list's first entry for every method (Bernstein visits its pieces left to right in both modes, and a later
-    piece in doubt hands bracketing only the rest of the interval)."""
+    piece in doubt goes to bracketing alone, in both modes)."""
     c, lo, hi, _, _ = sets[name]
     roots, counts = real_roots_batch(c, lo, hi, method)
     first, fcounts = first_root_batch(c, lo, hi, method)

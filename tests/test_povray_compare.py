@@ -50,7 +50,8 @@ def test_pov_text_has_matched_camera_plane_and_polynomial():
     assert angle == pytest.approx(math.degrees(2 * math.atan(math.tan(math.radians(40) / 2) * 4 / 3)))
     assert "location <0, 2.2000000000000002, 5.5>" in text
     assert "plane { <0, 1, 0>, -0" in text or "plane { <0, 1, 0>, 0" in text
-    assert "polynomial { 4," in text and "sturm" in text and "bounded_by { box" in text
+    assert "polynomial { 4," in text and "sturm" in text
+    assert "clipped_by { box" in text and "bounded_by { clipped_by }" in text
     assert "assumed_gamma 1.0" in text and "light_source" in text
     cover = povray.scene_pov(scene, 800, 600, coverage=True)
     assert "plane" not in cover and "light_source" not in cover and "ambient 1 diffuse 0" in cover
@@ -97,3 +98,90 @@ def test_povray_renders_the_exported_ball(tmp_path):
     pc.run_povray(exe, pov, out, 80, 60, 1)
     mask = pc.pov_mask(out)
     assert mask[30, 40] and not mask[0, 0]
+
+
+def _cut_ball_scene(bounds: dict) -> object:
+    """A unit ball whose spec box cuts it: bounds in x only ([-inf, inf] elsewhere) or all three axes."""
+    return parse_scene(
+        {
+            "image": {"width": 64, "height": 48},
+            "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 40},
+            "objects": [{"equation": "x^2 + y^2 + z^2 - 1", "name": "ball", "bounds": bounds}],
+        },
+        "<test>",
+    )
+
+
+def test_box_that_cuts_the_surface_is_exported_as_clipped_by():
+    box = {"x": [-0.5, 0.5], "y": [-2, 2], "z": [-2, 2]}
+    text = povray.scene_pov(_cut_ball_scene(box), 64, 48)
+    clip = text.split("clipped_by { box { ")[1].split(" } }")[0]
+    lo, hi = (np.array([float(v) for v in part.strip("<>").split(",")]) for part in clip.split(">, <"))
+    assert lo[0] == pytest.approx(-0.5, abs=1e-8) and hi[0] == pytest.approx(0.5, abs=1e-8)
+    assert lo[0] < -0.5 and hi[0] > 0.5  # grown by 1e-9 of the extent, as the runtime clips
+    assert "bounded_by { clipped_by }" in text
+    # only x bounded: the planes of the finite bounds
+    text = povray.scene_pov(_cut_ball_scene({"x": [-0.5, 0.5]}), 64, 48)
+    assert "clipped_by { intersection { plane { x, 0.50000000" in text and "plane { -x, 0.50000000" in text
+    assert "bounded_by" not in text
+
+
+def test_exact_verdict_clips_to_the_box():
+    judge = pc.ExactJudge(_cut_ball_scene({"x": [-0.5, 0.5], "y": [-2, 2], "z": [-2, 2]}), 64, 48)
+    obj = judge.objects[0]
+    eye = np.array([0.0, 0.0, 5.0])
+    assert judge.ray_hits(obj, eye, np.array([0.0, 0.0, -1.0]))  # through the middle, inside the box
+    # towards x = 0.8 on the sphere's front: outside the box's x range, so no hit (the whole ball would say yes)
+    target = np.array([0.8, 0.0, 0.6])
+    assert not judge.ray_hits(obj, eye, target - eye)
+    full = pc.ExactJudge(_cut_ball_scene({"x": [-2, 2], "y": [-2, 2], "z": [-2, 2]}), 64, 48)
+    assert full.ray_hits(full.objects[0], eye, target - eye)
+
+
+@pytest.mark.skipif(
+    shutil.which("povray") is None, reason="POV-Ray is not installed (bench/povray_compare.py installs it)"
+)
+def test_povray_renders_the_clipped_ball_like_the_exact_verdict(tmp_path):
+    """POV-Ray itself, on the exported coverage scene: the ball cut to |x| <= 0.5 covers the pixels whose rays
+    the exact verdict says hit inside the box, and not the cut-away sides."""
+    scene = _cut_ball_scene({"x": [-0.5, 0.5], "y": [-2, 2], "z": [-2, 2]})
+    pov = tmp_path / "cut.pov"
+    pov.write_text(povray.scene_pov(scene, 64, 48, coverage=True))
+    png = tmp_path / "cut.png"
+    pc.run_povray(shutil.which("povray"), pov, png, 64, 48, 1)
+    mask = pc.pov_mask(png)
+    judge = pc.ExactJudge(scene, 64, 48)
+    hits = 0
+    for py in range(4, 48, 6):
+        for px in range(2, 64, 5):
+            assert mask[py, px] == judge.hits(px, py), (px, py)
+            hits += int(mask[py, px])
+    assert hits >= 5
+    # pixel 43 of row 24 looks at the ball's front at x ~ 0.7 (the whole ball spans ~14 pixels either side)
+    assert mask[24, 32] and not mask[24, 43] and not judge.hits(43, 24)
+    whole = pc.ExactJudge(_cut_ball_scene({"x": [-2, 2], "y": [-2, 2], "z": [-2, 2]}), 64, 48)
+    assert whole.hits(43, 24)
+
+
+def test_integer_ray_polynomial_is_a_positive_multiple_of_the_exact_one():
+    """ExactJudge.ray_poly works on integers; SymPy's expansion of f(o' + t d') over Q is the reference."""
+    from fractions import Fraction
+
+    import sympy as sp
+
+    scene = load_scene(TORUS)
+    judge = pc.ExactJudge(scene, 80, 60)
+    obj = judge.objects[0]
+    leaf = next(lf for lf in scene.leaves() if lf.spec.degree == 4)
+    o, d = pc.camera_ray(scene, 41.5, 33.5, 80, 60)
+    oo, dd = judge.object_ray(obj, o, d)
+    t = sp.Symbol("t")
+    subs = {pc.param_symbol(k): sp.Rational(Fraction(float(v))) for k, v in leaf.params.items()}
+    f = leaf.spec.f.xreplace(subs)
+    names = {s.name: s for s in f.free_symbols}
+    assert set(names) == {"x", "y", "z"}
+    line = {names[n]: sp.Rational(oo[k]) + sp.Rational(dd[k]) * t for k, n in enumerate("xyz")}
+    want = [Fraction(int(c.p), int(c.q)) for c in reversed(sp.Poly(sp.expand(f.xreplace(line)), t).all_coeffs())]
+    got = judge.ray_poly(obj, o, d)
+    ratio = Fraction(got[-1]) / want[-1]
+    assert ratio > 0 and all(Fraction(g) == ratio * w for g, w in zip(got, want))

@@ -23,13 +23,16 @@ from pathlib import Path
 
 import numpy as np
 
+from implgen.bench.solvers_high import degree_table, high_targets
 from implgen.cli import ArgumentParser
 from implgen.errors import UserError
-from implgen.roots.cases import CASE_SETS, HIGH_RAYS, CaseSet, find_shapes_dir
+from implgen.roots.cases import CASE_SETS, HIGH_CASE_SETS, HIGH_RAYS, CaseSet, find_shapes_dir
 from implgen.roots.reference import Score, reference, score_first, score_one
-from implgen.roots.solvers import bench_first_batch, bench_solve_batch
+from implgen.roots.solvers import bench_fallbacks, bench_first_batch, bench_solve_batch
 
 METHODS = ["closed_plain", "closed", "sturm", "bracket", "bernstein", "auto"]
+#: on the degree 12-24 sets the closed forms are bracketing (degree > 4), so they are left out
+HIGH_METHODS = ["sturm", "bracket", "bernstein", "auto"]
 
 
 def numpy_real_roots(c: np.ndarray, lo: float, hi: float) -> np.ndarray:
@@ -52,6 +55,7 @@ class Row:
     mean_ns: float
     score: Score
     timed: int
+    fallback: float = float("nan")  # share of polynomials with a Bernstein piece handed to bracketing
 
 
 #: methods also timed in first-root mode (ig_first_root: the nearest hit, what the tracer asks for)
@@ -119,11 +123,13 @@ def run(
         for m in methods:
             roots, counts, ns, total = timings[m]
             sc = _score(c, lo, hi, lambda i: roots[i, : counts[i]], ref)
-            rows.append(Row(cs.name, m, float(np.median(ns)), total / c.shape[0], sc, c.shape[0]))
+            fb = _fallback_share(c, lo, hi, m, False)
+            rows.append(Row(cs.name, m, float(np.median(ns)), total / c.shape[0], sc, c.shape[0], fb))
         for m in first_methods:
             r1, n1, ns, total = timings[m + FIRST]
             sc = _score(c, lo, hi, lambda i: r1[i : i + n1[i]], ref, score_first)
-            rows.append(Row(cs.name, m + FIRST, float(np.median(ns)), total / c.shape[0], sc, c.shape[0]))
+            fb = _fallback_share(c, lo, hi, m, True)
+            rows.append(Row(cs.name, m + FIRST, float(np.median(ns)), total / c.shape[0], sc, c.shape[0], fb))
         k = min(c.shape[0], max(nref, 2000))
         t0 = time.perf_counter_ns()
         npr = [numpy_real_roots(c[i], lo[i], hi[i]) for i in range(k)]
@@ -133,8 +139,19 @@ def run(
     return rows
 
 
+def _fallback_share(c, lo, hi, method: str, first: bool) -> float:
+    """Share of the polynomials where the Bernstein subdivision handed a piece to bracketing (an untimed pass)."""
+    if method not in ("bernstein", "auto"):
+        return float("nan")
+    return float(np.mean(bench_fallbacks(c, lo, hi, method, first) > 0))
+
+
 def _fmt_err(v: list) -> str:
     return f"{max(v):.1e}" if v else "-"
+
+
+def _fmt_share(v: float) -> str:
+    return "-" if np.isnan(v) else f"{100 * v:.2f} %"
 
 
 def _fmt_med(v: list) -> str:
@@ -240,8 +257,8 @@ def table(rows: list[Row], sets: list[CaseSet], timed: int, nref: int, seconds: 
         f"the first {nref}; run took {seconds:.0f} s.",
         "",
         "| case set | method | median ns/solve (C) | mean ns (C, untimed pass) | max rel err (well-cond.) | "
-        "median rel err | missed simple | phantom | near-tangent reports |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
+        "median rel err | missed simple | phantom | near-tangent reports | fallback |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
         s = r.score
@@ -249,7 +266,7 @@ def table(rows: list[Row], sets: list[CaseSet], timed: int, nref: int, seconds: 
         mean = f"{r.mean_ns:.0f}" + (" (Python)" if r.method == "numpy.roots" else "")
         lines.append(
             f"| {r.case} | {r.method} | {med} | {mean} | {_fmt_err(s.errors_well)} | {_fmt_med(s.errors_all)} | "
-            f"{s.missed}/{s.ref_simple} | {s.phantom} | {s.near_tangent} |"
+            f"{s.missed}/{s.ref_simple} | {s.phantom} | {s.near_tangent} | {_fmt_share(r.fallback)} |"
         )
     lines += [
         "",
@@ -258,9 +275,12 @@ def table(rows: list[Row], sets: list[CaseSet], timed: int, nref: int, seconds: 
         'condition <= 1e8, inside) was skipped or not returned, out of those that have one; "phantom" a '
         "returned root that is no root.",
     ]
+    high = [cs for cs in sets if cs in HIGH_CASE_SETS]
+    if high:
+        lines += ["", "Per degree (medians of the rows above):", ""] + degree_table(rows, high)
     lines += ["", "Case sets:", ""]
     lines += [f"- **{cs.name}**: {cs.describe}" for cs in sets]
-    lines += ["", "Targets:", ""] + targets(rows)
+    lines += ["", "Targets:", ""] + targets(rows) + high_targets(rows)
     return "\n".join(lines) + "\n"
 
 
@@ -333,12 +353,14 @@ def main(argv: list[str] | None = None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     t = time.time()
     print(
-        f"implgen bench solvers: {len(CASE_SETS)} case sets x {len(METHODS)} methods, "
+        f"implgen bench solvers: {len(CASE_SETS)} case sets x {len(METHODS)} methods and {len(HIGH_CASE_SETS)} "
+        f"of degree 12-24 x {len(HIGH_METHODS)}, "
         f"{len(FIRST_METHODS)} in first-root mode, + numpy.roots; ray sets from {shapes}/"
     )
     rows = run(args.timed, args.ref, args.seed, METHODS, CASE_SETS, shapes_dir=shapes)
+    rows += run(args.timed, args.ref, args.seed, HIGH_METHODS, HIGH_CASE_SETS, shapes_dir=shapes)
     seconds = time.time() - t
-    md = table(rows, CASE_SETS, args.timed, args.ref, seconds)
+    md = table(rows, CASE_SETS + HIGH_CASE_SETS, args.timed, args.ref, seconds)
     (out / "solvers.md").write_text(md)
     plot(rows, out / "solvers.png")
     print(md)

@@ -100,12 +100,35 @@ def _leaf_object(leaf, texture: str) -> str:
         length = float(np.linalg.norm(n))
         return f"plane {{ {_vec(n / length)}, {-d / length:.17g}\n  {texture}\n  {m}\n}}"
     body = polynomial_object(spec, leaf.params)[:-1].rstrip()  # drop the closing brace
-    box = spec.box(leaf.params)
-    bound = ""
-    if box is not None and np.all(np.isfinite(box)):
-        box = np.asarray(box, dtype=float)
-        bound = f"  bounded_by {{ box {{ {_vec(box[:3])}, {_vec(box[3:])} }} }}\n"
-    return f"{body}\n{bound}  {texture}\n  {m}\n}}"
+    return f"{body}\n{clip_text(spec.box(leaf.params))}  {texture}\n  {m}\n}}"
+
+
+def clip_text(box) -> str:
+    """What cuts the surface to its spec box, as implgen's runtime does (it solves only inside the box, grown
+    by 1e-9 of its extent). POV-Ray's `bounded_by` alone does not cut: it only skips rays that miss the box,
+    and a surface that leaves the box would render whole. So: `clipped_by` the box (or, with some bounds
+    infinite, the planes of the finite ones), and `bounded_by { clipped_by }` when the box is finite."""
+    import numpy as np
+
+    if box is None:
+        return ""
+    box = np.asarray(box, dtype=float)
+    lo, hi = box[:3], box[3:]
+    scale = np.maximum(np.where(np.isfinite(lo), np.abs(lo), 0.0), np.where(np.isfinite(hi), np.abs(hi), 0.0))
+    lo, hi = lo - 1e-9 * scale, hi + 1e-9 * scale
+    if np.all(np.isfinite(box)):
+        return f"  clipped_by {{ box {{ {_vec(lo)}, {_vec(hi)} }} }}\n  bounded_by {{ clipped_by }}\n"
+    planes = []
+    for axis, name in enumerate("xyz"):
+        if np.isfinite(hi[axis]):
+            planes.append(f"plane {{ {name}, {hi[axis]:.17g} }}")
+        if np.isfinite(lo[axis]):
+            planes.append(f"plane {{ -{name}, {-lo[axis]:.17g} }}")
+    if not planes:
+        return ""
+    if len(planes) == 1:
+        return f"  clipped_by {{ {planes[0]} }}\n"
+    return f"  clipped_by {{ intersection {{ {' '.join(planes)} }} }}\n"
 
 
 def scene_pov(scene, width: int, height: int, coverage: bool = False) -> str:

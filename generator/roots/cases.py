@@ -18,6 +18,7 @@ import numpy as np
 
 from implgen import raycast
 from implgen.errors import UserError
+from implgen.roots import raysets_high
 
 SHAPES_DIR = Path("examples/shapes")
 
@@ -351,3 +352,34 @@ CASE_SETS = [
 ]
 #: the set the solver report's "degree 6-12 ray polynomials" target is measured on (the example shapes reach 10)
 HIGH_RAYS = "rays deg 6-10"
+
+
+def _high(name: str, describe: str, make) -> CaseSet:
+    rays = "rays from far (1e4 units), near (3-6 box radii) and inside the box, a third each"
+    return CaseSet(
+        name,
+        f"{describe}; {rays}, box-clipped and shifted as runtime_c/shape.c does (implgen.roots.raysets_high)",
+        lambda k, r, s=None: make(k, r),
+    )
+
+
+#: degree 12-24 ray sets (implgen.roots.raysets_high): the report's cost and fallback rate per degree
+HIGH_CASE_SETS = [
+    *(
+        _high(
+            f"chmutov {n}",
+            f"Chmutov surface T{n}(x) + T{n}(y) + T{n}(z) = 0, degree {n}",
+            lambda k, r, n=n: raysets_high.chmutov_set(n, k, r),
+        )
+        for n in (12, 16, 20, 24)
+    ),
+    _high("linked tori 16", "four linked tori, the product of their quartics (degree 16)", raysets_high.tori_set),
+    *(
+        _high(
+            f"spiky {n}",
+            f"spiky superellipsoid x^{n} + y^{n} + z^{n} = c (x^2 + y^2 + z^2)^{n // 2 - 1} (degree {n})",
+            lambda k, r, n=n: raysets_high.spiky_set(n, k, r),
+        )
+        for n in (20, 24)
+    ),
+]

@@ -52,6 +52,8 @@ def library() -> ctypes.CDLL:
     lib.ig_bench_solve_batch.argtypes = [_DP, ctypes.c_int, ctypes.c_long, _DP, _DP, ctypes.c_int, _DP, _IP, _DP]
     lib.ig_bench_first_batch.restype = ctypes.c_double
     lib.ig_bench_first_batch.argtypes = [_DP, ctypes.c_int, ctypes.c_long, _DP, _DP, ctypes.c_int, _DP, _IP, _DP]
+    lib.ig_bench_fallbacks.restype = None
+    lib.ig_bench_fallbacks.argtypes = [_DP, ctypes.c_int, ctypes.c_long, _DP, _DP, ctypes.c_int, ctypes.c_int, _IP]
     return lib
 
 
@@ -160,3 +162,24 @@ def bench_first_batch(
     """First-root twin of bench_solve_batch (runtime_c/roots_bench.c: ig_bench_first_batch): (roots with NaN
     where none, counts 0/1, ns per solve, total ns of the untimed pass)."""
     return _batch("ig_bench_first_batch", coeffs, lo, hi, method, first=True, timed=True)
+
+
+def bench_fallbacks(coeffs: np.ndarray, lo: ArrayLike, hi: ArrayLike, method: str, first: bool = False) -> np.ndarray:
+    """Per polynomial, how many Bernstein pieces were handed to bracketing (runtime_c/roots_bench.c:
+    ig_bench_fallbacks; 0 for the methods without subdivision)."""
+    c = _coeff_matrix(coeffs)
+    count, n = c.shape[0], c.shape[1] - 1
+    lo_a, hi_a = _bounds(lo, count), _bounds(hi, count)
+    fb = np.zeros(count, dtype=np.intc)
+    if count:
+        library().ig_bench_fallbacks(
+            c.ctypes.data_as(_DP),
+            n,
+            count,
+            lo_a.ctypes.data_as(_DP),
+            hi_a.ctypes.data_as(_DP),
+            method_id(method, bench=True),
+            int(first),
+            fb.ctypes.data_as(_IP),
+        )
+    return fb.astype(np.int64)
