@@ -11,9 +11,11 @@ Bad input (UserError) becomes one line on stderr and exit status 2, never a trac
 
 from __future__ import annotations
 
+import argparse
 import importlib
 import sys
 from collections.abc import Callable, Sequence
+from typing import Any
 
 from implgen.errors import UserError
 
@@ -28,6 +30,18 @@ _BENCHES: dict[str, str] = {
     "gen": "implgen.bench.gen:main",
     "render": "implgen.bench.render:main",
 }
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse for every implgen command: a bad option is a UserError (one line naming `label`, or the
+    command, and exit status 2), never argparse's usage text and its own exit."""
+
+    def __init__(self, *args: Any, label: str | None = None, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.label = label or self.prog
+
+    def error(self, message: str) -> Any:
+        raise UserError(self.label, message)
 
 
 def _resolve(target: str) -> Callable[[Sequence[str]], int]:

@@ -3,7 +3,6 @@ cast a fan of rays at each through the generated Python, then render the showcas
 
 from __future__ import annotations
 
-import argparse
 import importlib.util
 import time
 from collections.abc import Sequence
@@ -11,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from implgen.cli import ArgumentParser
 from implgen.clib import build_shared
 from implgen.codegen.derive import derive
 from implgen.codegen.emit import derivation_ops, generate
@@ -42,7 +42,7 @@ def _ray_fan(module, box) -> tuple[int, int]:
 
 
 def main(argv: Sequence[str]) -> int:
-    parser = argparse.ArgumentParser(prog="implgen demo")
+    parser = ArgumentParser(prog="implgen demo")
     parser.add_argument("--shapes", type=Path, default=Path("examples/shapes"))
     parser.add_argument("-o", "--output", type=Path, default=Path("out"))
     args = parser.parse_args(list(argv))

@@ -55,10 +55,17 @@ def _check_names(option: str, folder: Path, names: list[str]) -> None:
         raise UserError(option, "the path is longer than 4095 bytes")
 
 
+def _check_not_dangling(option: str, path: Path) -> None:
+    """A name that does not exist but is a link: to a missing target, or in a loop. mkdir would fail there."""
+    if os.path.lexists(path) and not path.exists():
+        raise UserError(option, f"{path} is a link to nothing (a missing target or a loop of links)")
+
+
 def _check_writable_folder(option: str, folder: Path) -> None:
     """`folder` exists and a file can be created in it: tried for real (create and remove an empty file),
     since permission bits do not tell (root, read-only mounts, /proc)."""
     if not folder.exists():
+        _check_not_dangling(option, folder)
         raise UserError(option, f"the folder {folder} does not exist")
     if not folder.is_dir():
         raise UserError(option, f"{folder} is not a folder")
@@ -108,9 +115,11 @@ def check_output_folder(path: Path, option: str) -> None:
             raise UserError(label, "exists and is not a folder")
         _check_writable_folder(label, path)
         return
+    _check_not_dangling(label, path)
     missing = [path.name]
     ancestor = path.parent
     while not ancestor.exists() and ancestor != ancestor.parent:
+        _check_not_dangling(label, ancestor)
         missing.insert(0, ancestor.name)
         ancestor = ancestor.parent
     ancestor = ancestor if str(ancestor) else Path(".")
@@ -133,12 +142,16 @@ def atomic_write(path: Path, write: Callable[[object], None]) -> None:
         raise
 
 
-def write_text_files(files: Mapping[str, str], outdir: Path) -> list[Path]:
-    """Write {file name: text} into `outdir` (created if missing), each file atomically."""
-    outdir.mkdir(parents=True, exist_ok=True)
+def write_text_files(files: Mapping[str, str], outdir: Path, option: str = "-o") -> list[Path]:
+    """Write {file name: text} into `outdir` (created if missing), each file atomically. A failure the checks
+    could not foresee (a full disk, a folder removed meanwhile) is one line naming `option`."""
     written = []
-    for fname, text in files.items():
-        data = text.encode("utf-8")
-        atomic_write(outdir / fname, lambda fh, data=data: fh.write(data))
-        written.append(outdir / fname)
+    try:
+        outdir.mkdir(parents=True, exist_ok=True)
+        for fname, text in files.items():
+            data = text.encode("utf-8")
+            atomic_write(outdir / fname, lambda fh, data=data: fh.write(data))
+            written.append(outdir / fname)
+    except OSError as err:
+        raise UserError(f"{option} {outdir}", f"cannot write {err.filename or outdir}: {err.strerror or err}") from None
     return written

@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 import re
 import stat
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -79,6 +80,10 @@ def _expanded_size(root: yaml.Node, limit: int) -> int:
     return size(root)
 
 
+def _int_digits() -> int:
+    return getattr(sys, "get_int_max_str_digits", lambda: 4300)()
+
+
 def _file_kind(mode: int) -> str:
     if stat.S_ISDIR(mode):
         return "a folder"
@@ -129,6 +134,8 @@ def read_yaml(path: Path, what: str = "shape spec") -> Any:
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
         raise UserError(path, f"invalid YAML{where}: {problem[:80]} (expected a {what} file)") from None
     except ValueError as err:
+        if "integer string conversion" in str(err):  # Python's own limit, worded for Python programmers
+            raise UserError(path, f"refused YAML: a number is written with more than {_int_digits()} digits") from None
         raise UserError(path, f"refused YAML: {err}") from None
     except RecursionError:
         raise UserError(path, "invalid YAML: nested too deeply") from None

@@ -138,3 +138,24 @@ def random_rays(rng: np.random.Generator, n: int, spread: float = 2.0) -> tuple[
 @pytest.fixture(scope="session")
 def rng() -> np.random.Generator:
     return np.random.default_rng(20261121)
+
+
+# ------------------------------------------------------------------------------------------ Hypothesis
+
+# `make test` runs the "ci" profile: a modest, fixed number of examples, derandomized and without an example
+# database, so a run is reproducible and quick. HYPOTHESIS_PROFILE=long searches much longer, at random, for
+# a deep local run (docs/testing.md#fuzzing).
+from hypothesis import HealthCheck  # noqa: E402
+from hypothesis import settings as _hsettings  # noqa: E402
+
+_QUIET = [HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much, HealthCheck.large_base_example]
+_hsettings.register_profile("ci", derandomize=True, database=None, deadline=None, suppress_health_check=_QUIET)
+_hsettings.register_profile("long", derandomize=False, deadline=None, suppress_health_check=_QUIET, print_blob=True)
+HYPOTHESIS_PROFILE = os.environ.get("HYPOTHESIS_PROFILE", "ci")
+_hsettings.load_profile(HYPOTHESIS_PROFILE)
+FUZZ_SCALE = int(os.environ.get("IMPLGEN_FUZZ_SCALE", "50" if HYPOTHESIS_PROFILE == "long" else "1"))
+
+
+def fuzz_settings(examples: int):
+    """Settings for one fuzz property: `examples` in the ci profile, FUZZ_SCALE times as many otherwise."""
+    return _hsettings(max_examples=examples * FUZZ_SCALE)

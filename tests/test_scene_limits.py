@@ -238,3 +238,157 @@ def test_render_option_errors_name_the_option_as_typed(tmp_path, capsys):
     scene.write_text(f"objects: [{{shape: {SPHERE}}}]\n")
     assert cli_main(["render", str(scene), "-o", str(tmp_path / "o.png"), "--max-depth", "999"]) == 2
     assert "--max-depth: 999 is outside [0, 64]" in capsys.readouterr().err
+
+
+def test_output_folder_is_tried_for_real(tmp_path):
+    """Whether a folder takes a new file is decided by creating one, not by its mode bits (root writes into a
+    0500 folder; anyone else cannot): the check agrees with what actually happens, and leaves nothing."""
+    from implgen.outputs import check_output_file, check_output_folder
+
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        try:
+            (locked / "probe").write_text("")
+            (locked / "probe").unlink()
+            writable = True
+        except PermissionError:
+            writable = False
+        for check in (
+            lambda: check_output_folder(locked / "gen", "-o"),
+            lambda: check_output_file(locked / "o.png", "-o", (".png",)),
+        ):
+            if writable:
+                check()
+            else:
+                with pytest.raises(UserError, match="cannot write in"):
+                    check()
+        assert list(locked.iterdir()) == []
+    finally:
+        locked.chmod(0o700)
+
+
+@pytest.mark.parametrize("argv", [["render", "SCENE", "-o", "OUT/o.png"], ["SPEC", "-o", "OUT/gen"]])
+def test_output_under_a_link_loop_is_refused_before_work(tmp_path, capsys, argv):
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    scene = tmp_path / "s.yaml"
+    scene.write_text(f"objects: [{{shape: {SPHERE}}}]\n")
+    argv = [a.replace("SCENE", str(scene)).replace("SPEC", SPHERE).replace("OUT", str(tmp_path / "loop")) for a in argv]
+    assert cli_main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "is a link to nothing" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["loop", "s.yaml"]
+
+
+def test_a_write_that_fails_anyway_is_one_line(tmp_path, capsys, monkeypatch):
+    """A failure after the checks (a full disk, here simulated) is still one line, exit status 2."""
+    import errno
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr("implgen.outputs.atomic_write", full)
+    assert cli_main([SPHERE, "-o", str(tmp_path / "gen"), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "No space left on device" in err and err.startswith("implgen: error: -o ")
+
+
+# ------------------------------------------------------------------------------------------ YAML keys
+
+
+def test_merge_keys_are_overridden_by_the_mappings_own_keys(tmp_path):
+    path = tmp_path / "m.yaml"
+    path.write_text(
+        "materials:\n"
+        "  base: &base {color: [1, 0, 0], diffuse: 0.9, specular: 0.1}\n"
+        "  shiny: {<<: *base, specular: 0.8}\n"
+        f"objects: [{{shape: {SPHERE}, material: shiny}}, {{shape: {SPHERE}, material: base}}]\n"
+    )
+    scene = load_scene(path)
+    shiny, base = (leaf.material for leaf in scene.leaves())
+    assert (shiny.specular, shiny.diffuse, shiny.color) == (0.8, 0.9, (1.0, 0.0, 0.0))
+    assert (base.specular, base.diffuse) == (0.1, 0.9)
+
+
+def test_a_key_given_twice_is_still_refused_next_to_a_merge(tmp_path):
+    path = tmp_path / "m.yaml"
+    path.write_text("materials:\n  b: &b {diffuse: 0.5}\n  m: {<<: *b, specular: 0.1, specular: 0.2}\n")
+    with pytest.raises(UserError, match="duplicate key 'specular'"):
+        load_scene(path)
+
+
+# --------------------------------------------------------------------------------------- counts
+
+
+def test_ten_thousand_objects_load_and_one_more_is_refused(tmp_path):
+    """MAX_OBJECTS leaves (CSG operands count) load, one more is refused naming the object; a spec file used
+    by every one of them is looked up once."""
+    from implgen.scene import load
+
+    calls = []
+    real = load._find_spec_file
+    path = tmp_path / "many.yaml"
+    path.write_text("objects: [" + ", ".join(["&a {shape: " + SPHERE + "}"] + ["*a"] * (load.MAX_OBJECTS - 1)) + "]\n")
+    try:
+        load._find_spec_file = lambda *a: calls.append(a) or real(*a)
+        assert len(load_scene(path).leaves()) == load.MAX_OBJECTS
+    finally:
+        load._find_spec_file = real
+    assert len(calls) == 1
+    path.write_text("objects: [" + ", ".join(["&a {shape: " + SPHERE + "}"] + ["*a"] * load.MAX_OBJECTS) + "]\n")
+    with pytest.raises(UserError, match=rf"objects\[{load.MAX_OBJECTS}\]: more than {load.MAX_OBJECTS} objects"):
+        load_scene(path)
+
+
+def test_union_operands_count_as_objects():
+    from implgen.scene import load
+
+    per = 1000
+    objs = [{"union": _spheres(per)} for _ in range(load.MAX_OBJECTS // per)]
+    assert len(parse_scene({"objects": objs}, "<t>").leaves()) == load.MAX_OBJECTS
+    with pytest.raises(UserError, match=r"objects\[10\]: more than 10000 objects"):
+        parse_scene({"objects": [*objs, {"shape": SPHERE}]}, "<t>")
+
+
+# ------------------------------------------------------------------------------------------ equations
+
+
+@pytest.mark.parametrize("text", ["1and y", "1if x else y", "0x1for x", "1or x"])
+def test_python_syntax_warnings_are_syntax_errors_and_print_nothing(text, recwarn):
+    """Python warns about `1and` (a number run into a keyword); the warning is the syntax error it is, one
+    message, and nothing else is printed or warned."""
+    from implgen.codegen.spec import parse_spec
+
+    with pytest.raises(UserError, match="equation: syntax error|not a polynomial"):
+        parse_spec({"name": "s", "equation": text}, "<t>")
+    assert not [w for w in recwarn if issubclass(w.category, SyntaxWarning)]
+
+
+# ------------------------------------------------------------------------------------ param values
+
+
+def test_param_values_that_overflow_a_coefficient_are_refused():
+    """Each param is within range, but a^40 with a = 1e9 is 1e360: refused with the key named. The test is on
+    the exact terms (log2 |c| + sum e log2 |p|), so a = 1e9 to the 30th power (2^897) passes, and a zero param
+    makes its terms vanish."""
+    from implgen.codegen.spec import parse_spec
+
+    spec = parse_spec({"name": "p", "equation": "x^2 + y^2 + z^2 - a^30 - b^40", "params": {"a": 1, "b": 1}}, "<t>")
+    spec.check_values({"a": 1e9, "b": 0.0}, "<t>", "objects[0].params")
+    with pytest.raises(UserError, match=r"objects\[0\].params: with these params a coefficient of shape 'p' reaches"):
+        spec.check_values({"a": 1.0, "b": 1e9}, "<t>", "objects[0].params")
+    with pytest.raises(UserError, match="params: with these params"):
+        parse_spec({"name": "p", "equation": "x - a^40", "params": {"a": 1e9}}, "<t>")
+
+
+def test_param_values_must_keep_the_bounds_a_box():
+    from implgen.codegen.spec import load_spec
+
+    torus = load_spec(ROOT / "examples" / "shapes" / "torus_y.yaml")
+    torus.check_values({"a": 2.0, "b": 0.5}, "<t>", "k")
+    assert torus.box({"a": 2.0, "b": 0.5}) == [-2.5, -0.5, -2.5, 2.5, 0.5, 2.5]
+    with pytest.raises(UserError, match="k: with these params the bounds of shape 'torus_y' are empty along y"):
+        torus.check_values({"b": -0.5}, "<t>", "k")
+    with pytest.raises(UserError, match="leave"):
+        torus.check_values({"a": 1e9, "b": 1e9}, "<t>", "k")

@@ -9,13 +9,13 @@ to show why implgen uses the Taylor (series) form.
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import time
 from collections.abc import Sequence
 
 import sympy
 
+from implgen.cli import ArgumentParser
 from implgen.codegen.derive import derive, exact_ray_coefficients
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.codegen.spec import MAX_DEGREE, parse_spec
@@ -56,7 +56,7 @@ def _expanded_ops(equation: str) -> tuple[float, int]:
 
 
 def main(argv: Sequence[str]) -> int:
-    parser = argparse.ArgumentParser(prog="implgen bench gen", description=__doc__.splitlines()[0])
+    parser = ArgumentParser(prog="implgen bench gen", description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument(
         "--compare",

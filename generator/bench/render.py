@@ -21,7 +21,6 @@ is printed and written, with the machine and the load average, to the output fil
 
 from __future__ import annotations
 
-import argparse
 import ctypes
 import os
 import resource
@@ -34,6 +33,7 @@ import numpy as np
 
 from implgen import validate
 from implgen.bench.machine import cpu_model, load_average
+from implgen.cli import ArgumentParser
 from implgen.errors import UserError
 from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.build import build_scene
@@ -160,7 +160,7 @@ def _fold(scenes: list[Path], args, out: _Report) -> None:
 
 
 def main(argv: Sequence[str]) -> int:
-    ap = argparse.ArgumentParser(prog="implgen bench render")
+    ap = ArgumentParser(prog="implgen bench render")
     ap.add_argument("scenes", nargs="*", type=Path)
     ap.add_argument("--width", type=int, default=800)
     ap.add_argument("--height", type=int, default=600)

@@ -14,7 +14,6 @@ runtime does. Output: DIR/solvers.md, DIR/solvers.png (default DIR: bench/result
 
 from __future__ import annotations
 
-import argparse
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -24,6 +23,7 @@ import numpy as np
 
 from implgen.bench.machine import describe as machine
 from implgen.bench.solvers_high import degree_table, high_targets
+from implgen.cli import ArgumentParser
 from implgen.errors import UserError
 from implgen.roots.cases import CASE_SETS, HIGH_CASE_SETS, HIGH_RAYS, CaseSet, find_shapes_dir
 from implgen.roots.reference import Score, reference, score_first, score_one
@@ -315,7 +315,7 @@ def plot(rows: list[Row], path: Path) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="implgen bench solvers", description=__doc__.splitlines()[0])
+    ap = ArgumentParser(prog="implgen bench solvers", description=__doc__.splitlines()[0])
     ap.add_argument("-o", "--out", default="bench/results", help="output folder (default bench/results)")
     ap.add_argument("--timed", type=int, default=100_000, help="polynomials timed per case set (default 1e5)")
     ap.add_argument("--ref", type=int, default=400, help="polynomials per set checked against the exact reference")

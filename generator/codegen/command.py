@@ -12,19 +12,16 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+from implgen.cli import ArgumentParser
 from implgen.codegen.emit import LANGS, generate
 from implgen.codegen.spec import load_spec
 from implgen.errors import UserError
 from implgen.outputs import check_output_folder, write_text_files
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # argparse would exit itself; keep our one-line contract
-        raise UserError("command line", message)
-
-
 def _parser() -> argparse.ArgumentParser:
-    p = _Parser(
+    p = ArgumentParser(
+        label="command line",
         prog="implgen",
         description="Generate C and Python ray intersectors from implicit surface specs. "
         "Other commands: implgen render SCENE.yaml -o OUT.png | implgen bench solvers|gen|render | "

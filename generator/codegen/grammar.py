@@ -19,6 +19,7 @@ algebra is attempted. Constants are exact rationals whose numerator and denomina
 from __future__ import annotations
 
 import ast
+import math
 import re
 import string
 import warnings
@@ -34,6 +35,10 @@ MAX_NESTING = 100  # parentheses / operator nesting a user could mean
 MAX_CONST_BITS = 256  # numerators and denominators of constants stay below 2^256 (about 1e77)
 MAX_DIGITS = 80  # digits in one number as written
 _LONG_NUMBER = re.compile(rf"[0-9_]{{{MAX_DIGITS + 1},}}")
+MAX_TERMS = 20_000  # terms of the expanded polynomial: (x+y+z+1)^24 has 2925; (a+b+...+h)^20 would have 888,030
+_TERMS_CAP = 10**9
+MAX_EXPONENT = 400  # |e| in 1.5e-7 as written; every constant stays within 2^±256 anyway
+_EXPONENT = re.compile(r"[eE]([-+]?[0-9_]+)$")
 ALPHABET = frozenset(string.ascii_letters + string.digits + " \t\n._+-*/^()=")
 
 
@@ -46,6 +51,12 @@ class Parsed:
     expr: sympy.Expr
     degree_bound: int  # upper bound of the total degree in the "variables"
     param_degree_bound: int
+    terms: int = 1  # upper bound of the number of terms once expanded (capped at _TERMS_CAP)
+    names: frozenset[str] = frozenset()  # the variables and params it uses
+
+
+def _joined(a: Parsed, b: Parsed) -> frozenset[str]:
+    return a.names | b.names
 
 
 def _paren_depth(text: str) -> int:
@@ -73,6 +84,19 @@ class _Builder:
         self.params = params
         self.max_degree = max_degree
         self.max_param_degree = max_param_degree
+        self._line_starts: list[int] | None = None
+
+    def _segment(self, node: ast.AST) -> str | None:
+        """The text of `node`. ast.get_source_segment splits the whole text into lines on every call: once per
+        number, that made a long equation take quadratic time. The text is ASCII, so offsets are characters."""
+        if self._line_starts is None:
+            self._line_starts = [0] + [i + 1 for i, ch in enumerate(self.text) if ch == "\n"]
+        try:
+            start = self._line_starts[node.lineno - 1] + node.col_offset
+            end = self._line_starts[node.end_lineno - 1] + node.end_col_offset
+        except (AttributeError, TypeError, IndexError):
+            return None
+        return self.text[start:end]
 
     def build(self, node: ast.AST, depth: int = 0) -> Parsed:
         if depth > 4 * MAX_NESTING:
@@ -86,13 +110,13 @@ class _Builder:
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
             inner = self.build(node.operand, depth + 1)
             expr = -inner.expr if isinstance(node.op, ast.USub) else inner.expr
-            return Parsed(expr, inner.degree_bound, inner.param_degree_bound)
+            return Parsed(expr, inner.degree_bound, inner.param_degree_bound, inner.terms, inner.names)
         if isinstance(node, ast.BinOp):
             return self._binop(node, depth)
         raise ParseError(self._refusal(node))
 
     def _refusal(self, node: ast.AST) -> str:
-        segment = ast.get_source_segment(self.text, node) or type(node).__name__
+        segment = self._segment(node) or type(node).__name__
         if isinstance(node, ast.Call):
             what = "function calls are not allowed"
         elif isinstance(node, ast.Attribute):
@@ -113,7 +137,11 @@ class _Builder:
             if value != value or value in (float("inf"), float("-inf")):
                 raise ParseError("number is not finite")
             # The literal as written ("0.1") is exact as a decimal fraction: keep it exact.
-            segment = ast.get_source_segment(self.text, node) or repr(value)
+            segment = self._segment(node) or repr(value)
+            exponent = _EXPONENT.search(segment)
+            if exponent and abs(int(exponent.group(1).replace("_", ""))) > MAX_EXPONENT:
+                # 1e-99999999 underflows to a finite 0.0, but its exact value needs 10^99999999
+                raise ParseError(f"number {segment[:30]!r} has an exponent beyond ±{MAX_EXPONENT}")
             try:
                 frac = Fraction(segment.replace("_", ""))
             except ValueError:
@@ -123,9 +151,9 @@ class _Builder:
 
     def _name(self, name: str) -> Parsed:
         if name in self.variables:
-            return Parsed(self.variables[name], 1, 0)
+            return Parsed(self.variables[name], 1, 0, 1, frozenset([name]))
         if name in self.params:
-            return Parsed(self.params[name], 0, 1)
+            return Parsed(self.params[name], 0, 1, 1, frozenset([name]))
         known = ", ".join([*self.variables, *self.params]) or "none"
         raise ParseError(f"unknown symbol {name!r} (known: {known})")
 
@@ -135,36 +163,61 @@ class _Builder:
             return self._power(node, depth)
         if not isinstance(op, (ast.Add, ast.Sub, ast.Mult, ast.Div)):
             raise ParseError(self._refusal(node))
+        if isinstance(op, (ast.Add, ast.Sub, ast.Mult)):
+            return self._chain(node, depth)
         left = self.build(node.left, depth + 1)
         right = self.build(node.right, depth + 1)
-        if isinstance(op, (ast.Add, ast.Sub)):
-            expr = left.expr + right.expr if isinstance(op, ast.Add) else left.expr - right.expr
-            return self._constant_checked(
-                Parsed(
-                    expr,
-                    max(left.degree_bound, right.degree_bound),
-                    max(left.param_degree_bound, right.param_degree_bound),
-                )
-            )
-        if isinstance(op, ast.Mult):
-            return self._checked(
-                left.expr * right.expr,
-                left.degree_bound + right.degree_bound,
-                left.param_degree_bound + right.param_degree_bound,
-            )
         # Division: by a non-zero constant only.
         if right.degree_bound or right.param_degree_bound or not right.expr.is_Rational:
-            segment = ast.get_source_segment(self.text, node.right) or "?"
+            segment = self._segment(node.right) or "?"
             raise ParseError(f"division by a non-constant ({segment[:40]}) is not polynomial")
         if right.expr == 0:
             raise ParseError("division by zero")
-        return self._constant_checked(Parsed(left.expr / right.expr, left.degree_bound, left.param_degree_bound))
+        return self._constant_checked(
+            Parsed(left.expr / right.expr, left.degree_bound, left.param_degree_bound, left.terms, left.names)
+        )
+
+    def _chain(self, node: ast.BinOp, depth: int) -> Parsed:
+        """`a + b - c + ...` or `a * b * c ...`: Python's parser makes a left-leaning tree as deep as the list
+        is long; walk it as the flat list it is, so a sum of 500 terms is not "nested too deeply"."""
+        adding = isinstance(node.op, (ast.Add, ast.Sub))
+        kinds = (ast.Add, ast.Sub) if adding else (ast.Mult,)
+        steps = []
+        while isinstance(node, ast.BinOp) and isinstance(node.op, kinds):
+            steps.append((node.op, node.right))
+            node = node.left
+        result = self.build(node, depth + 1)
+        terms = [result.expr]
+        for op, right in reversed(steps):
+            item = self.build(right, depth + 1)
+            if adding:
+                terms.append(-item.expr if isinstance(op, ast.Sub) else item.expr)
+                result = self._counted(
+                    result.expr,
+                    max(result.degree_bound, item.degree_bound),
+                    max(result.param_degree_bound, item.param_degree_bound),
+                    result.terms + item.terms,
+                    _joined(result, item),
+                )
+            else:
+                result = self._checked(
+                    result.expr * item.expr,
+                    result.degree_bound + item.degree_bound,
+                    result.param_degree_bound + item.param_degree_bound,
+                    result.terms * item.terms,
+                    _joined(result, item),
+                )
+        if adding:
+            result = Parsed(
+                sympy.Add(*terms), result.degree_bound, result.param_degree_bound, result.terms, result.names
+            )
+        return self._constant_checked(result)
 
     def _power(self, node: ast.BinOp, depth: int) -> Parsed:
         base = self.build(node.left, depth + 1)
         exponent = self.build(node.right, depth + 1)
-        segment = (ast.get_source_segment(self.text, node.right) or "?")[:40]
         if exponent.degree_bound or exponent.param_degree_bound or not exponent.expr.is_Rational:
+            segment = (self._segment(node.right) or "?")[:40]
             raise ParseError(f"exponent must be a constant non-negative integer, not {segment!r}")
         if not exponent.expr.is_integer or exponent.expr < 0:
             raise ParseError(f"exponent must be a non-negative integer, not {exponent.expr}")
@@ -174,14 +227,27 @@ class _Builder:
             if k > 1 and bits * k > 2 * MAX_CONST_BITS:
                 raise ParseError(f"constant power too large: exponent {k}")
             return Parsed(_bounded(base.expr**k), 0, 0)
-        return self._checked(base.expr**k, base.degree_bound * k, base.param_degree_bound * k)
+        degree, param_degree = base.degree_bound * k, base.param_degree_bound * k
+        self._check_degrees(degree, param_degree)  # before the power: SymPy computes 2^k of (2*x)^k at once
+        terms = math.comb(base.terms + k - 1, k) if base.terms < _TERMS_CAP else _TERMS_CAP  # multinomial count
+        return self._checked(base.expr**k, degree, param_degree, terms, base.names)
 
-    def _checked(self, expr: sympy.Expr, degree: int, param_degree: int) -> Parsed:
+    def _check_degrees(self, degree: int, param_degree: int) -> None:
         if degree > self.max_degree:
             raise ParseError(f"degree would exceed {self.max_degree} (the highest supported)")
         if param_degree > self.max_param_degree:
             raise ParseError(f"parameters raised to a degree above {self.max_param_degree}")
-        return self._constant_checked(Parsed(expr, degree, param_degree))
+
+    def _checked(self, expr: sympy.Expr, degree: int, param_degree: int, terms: int, names: frozenset[str]) -> Parsed:
+        self._check_degrees(degree, param_degree)
+        return self._constant_checked(self._counted(expr, degree, param_degree, terms, names))
+
+    def _counted(self, expr: sympy.Expr, degree: int, param_degree: int, terms: int, names: frozenset[str]) -> Parsed:
+        """The term bound is also at most the number of monomials of that degree in the names used (which
+        keeps (x+y+z+1)^12 * (x-y+z-1)^12 at 2925, not 455^2)."""
+        nv = sum(1 for n in names if n in self.variables)
+        monomials = math.comb(degree + nv, nv) * math.comb(param_degree + len(names) - nv, len(names) - nv)
+        return Parsed(expr, degree, param_degree, min(terms, monomials, _TERMS_CAP), names)
 
     @staticmethod
     def _constant_checked(parsed: Parsed) -> Parsed:
@@ -194,7 +260,8 @@ class _Builder:
 def _bounded(value: sympy.Rational) -> sympy.Rational:
     if max(abs(value.p).bit_length(), abs(value.q).bit_length()) > MAX_CONST_BITS:
         raise ParseError(
-            f"constant too large: numerator and denominator must stay below 2^{MAX_CONST_BITS} (about 1e77)"
+            f"constant too large or too small: numerator and denominator must stay below 2^{MAX_CONST_BITS} "
+            "(about 1e77)"
         )
     return value
 
@@ -245,9 +312,18 @@ def parse_expression(
         raise ParseError("expression is nested too deeply") from err
     builder = _Builder(source, variables, params, max_degree, max_param_degree)
     try:
-        return builder.build(tree)
+        parsed = builder.build(tree)
     except RecursionError as err:
         raise ParseError("expression is nested too deeply") from err
+    check_terms(parsed.terms)
+    return parsed
+
+
+def check_terms(terms: int) -> None:
+    """Refuse what would expand to more than MAX_TERMS terms, before anything expands it."""
+    if terms > MAX_TERMS:
+        shown = f"{terms:,}" if terms < _TERMS_CAP else f"more than {_TERMS_CAP:,}"
+        raise ParseError(f"would expand to up to {shown} terms (at most {MAX_TERMS:,})")
 
 
 def split_equation(text: str) -> tuple[str, str]:

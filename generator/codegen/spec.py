@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -23,7 +24,7 @@ from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
 from implgen import abi, validate
-from implgen.codegen.grammar import ParseError, format_expression, parse_expression, split_equation
+from implgen.codegen.grammar import ParseError, check_terms, format_expression, parse_expression, split_equation
 from implgen.codegen.names import check_identifier, check_shape_name
 from implgen.errors import UserError
 from implgen.yamlfile import read_yaml
@@ -33,6 +34,10 @@ MAX_PARAMS = 64
 MAX_DESCRIPTION = 2_000
 MAX_COEFF_BITS = 900  # |numerator|, |denominator| of every expanded coefficient (2^900 ~ 8e270: room
 # for the multinomial factors the ray coefficients multiply them by)
+# Generation time grows with the size of f as written times its degree (Taylor coefficients, then one cse):
+# about 1 s per 700 on the 2-core test machine, and faster than linear past that (an expanded degree-24
+# polynomial of 1150 terms, size 169,000, took 8.5 minutes). The example shapes are below 400.
+MAX_SIZE_DEGREE = 10_000
 AXES = ("x", "y", "z")
 KEYS = ("name", "equation", "params", "bounds", "description")
 X, Y, Z = sympy.symbols("x y z", real=True)
@@ -62,13 +67,57 @@ class Spec:
         return [param_symbol(p) for p in self.params]
 
     def box(self, values: Mapping[str, float] | None = None) -> list[float] | None:
-        """The numeric box {xmin, ymin, zmin, xmax, ymax, zmax} for these param values (defaults else)."""
+        """The numeric box {xmin, ymin, zmin, xmax, ymax, zmax} for these param values (defaults else); an end
+        too large for a double is an infinity."""
         if self.bounds is None:
             return None
-        subs = {param_symbol(k): v for k, v in {**self.params, **(values or {})}.items()}
-        lo = [float(self.bounds[a][0].subs(subs)) if a in self.bounds else -math.inf for a in AXES]
-        hi = [float(self.bounds[a][1].subs(subs)) if a in self.bounds else math.inf for a in AXES]
+        full = {param_symbol(k): v for k, v in {**self.params, **(values or {})}.items()}
+        lo = [_evaluate(self.bounds[a][0], full) if a in self.bounds else -math.inf for a in AXES]
+        hi = [_evaluate(self.bounds[a][1], full) if a in self.bounds else math.inf for a in AXES]
         return lo + hi
+
+    @cached_property
+    def _param_terms(self) -> list[tuple[float, tuple[int, ...]]]:
+        """(log2 |coefficient|, param exponents) of every term of f in x, y, z and the params."""
+        poly = exact_polynomial(self.f, self.param_symbols)
+        return [
+            (math.log2(abs(c.numerator)) - math.log2(c.denominator), monom[3:]) for monom, c in poly.terms() if c != 0
+        ]
+
+    def check_values(self, values: Mapping[str, float], source: str, key: str) -> None:
+        """With these param values (defaults for the rest) every coefficient of the polynomial in x, y, z stays
+        within 2^MAX_COEFF_BITS, so the generated code computes finite numbers (a param within range can still
+        be raised to a power that overflows: a^40 with a = 1e9), and the bounds stay an ordered box."""
+        full = {**self.params, **values}
+        logs = [math.log2(abs(full[p])) if full[p] else None for p in self.params]
+        for log_c, exps in self._param_terms:
+            if any(e and lg is None for e, lg in zip(exps, logs)):
+                continue  # a zero param to a positive power: the term vanishes
+            size = log_c + sum(e * lg for e, lg in zip(exps, logs) if e)
+            if size > MAX_COEFF_BITS:
+                raise UserError(
+                    source,
+                    f"{key}: with these params a coefficient of shape {self.name!r} reaches 2^{size:.0f} "
+                    f"(beyond 2^{MAX_COEFF_BITS}: not a finite double once the ray is put in)",
+                )
+        box = self.box(values)
+        if box is not None:
+            for i, axis in enumerate(AXES):
+                lo, hi = box[i], box[i + 3]
+                if axis in self.bounds and not (
+                    abs(lo) <= validate.MAX_COORDINATE and abs(hi) <= validate.MAX_COORDINATE
+                ):
+                    raise UserError(
+                        source,
+                        f"{key}: with these params the bounds of shape {self.name!r} leave "
+                        f"[-{validate.MAX_COORDINATE:g}, {validate.MAX_COORDINATE:g}] along {axis}",
+                    )
+                if axis in self.bounds and not lo < hi:
+                    raise UserError(
+                        source,
+                        f"{key}: with these params the bounds of shape {self.name!r} are "
+                        f"empty along {axis} (from {lo:g} to {hi:g})",
+                    )
 
     def specialise(self, values: Mapping[str, float], name: str | None = None) -> Spec:
         """The same shape with the given params folded into the equation as constants."""
@@ -95,6 +144,27 @@ class Spec:
             bounds=bounds,
             folded={**self.folded, **{k: float(v) for k, v in values.items()}},
         )
+
+
+def _evaluate(expr: sympy.Expr, values: Mapping[sympy.Symbol, float]) -> float:
+    """A polynomial expression in the params as a double, walked directly (SymPy's subs is a thousand times
+    slower, and a scene may place the same shape 10,000 times); overflow gives an infinity."""
+    try:
+        if expr.is_Symbol:
+            return float(values[expr])
+        if expr.is_Number:
+            return float(expr)
+        if expr.is_Add:
+            return math.fsum(_evaluate(a, values) for a in expr.args)
+        if expr.is_Mul:
+            return math.prod(_evaluate(a, values) for a in expr.args)
+        if expr.is_Pow and expr.exp.is_Integer:
+            return _evaluate(expr.base, values) ** int(expr.exp)
+    except OverflowError:
+        return math.inf
+    except ValueError:  # inf - inf
+        return math.nan
+    return float(expr.subs(values))
 
 
 def load_spec(path: str | Path) -> Spec:
@@ -134,6 +204,7 @@ def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[s
         lhs_text, rhs_text = split_equation(str(text))
         lhs = parse_expression(lhs_text, VARIABLES, symbols, MAX_DEGREE)
         rhs = parse_expression(rhs_text, VARIABLES, symbols, MAX_DEGREE)
+        check_terms(lhs.terms + rhs.terms)
     except ParseError as err:
         raise UserError(source, f"equation: {err}") from None
     f = lhs.expr - rhs.expr
@@ -145,6 +216,13 @@ def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[s
         raise UserError(source, "equation: has no x, y or z (a constant, not a surface)")
     if degree > MAX_DEGREE:
         raise UserError(source, f"equation: degree {degree} is above the highest supported, {MAX_DEGREE}")
+    ops = int(sympy.count_ops(f))
+    if ops * degree > MAX_SIZE_DEGREE:
+        raise UserError(
+            source,
+            f"equation: too large to generate in bounded time: {ops} operations at degree {degree} "
+            f"(operations x degree at most {MAX_SIZE_DEGREE}; a factored form such as (x+y+z+1)^24 is small)",
+        )
     for coeff in poly.coeffs():
         if max(abs(int(coeff.numerator)).bit_length(), int(coeff.denominator).bit_length()) > MAX_COEFF_BITS:
             raise UserError(
@@ -214,7 +292,7 @@ def parse_spec(data: Any, source: str = "<spec>") -> Spec:
         raise UserError(source, "description: must be text")
     if len(description) > MAX_DESCRIPTION:
         raise UserError(source, f"description: longer than {MAX_DESCRIPTION} characters")
-    return Spec(
+    spec = Spec(
         name=name,
         equation=canonical_equation(f, params),
         params=params,
@@ -224,3 +302,5 @@ def parse_spec(data: Any, source: str = "<spec>") -> Spec:
         description=" ".join(description.split()),
         source=source,
     )
+    spec.check_values({}, source, "params")  # the defaults
+    return spec

@@ -11,9 +11,9 @@ import argparse
 import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
 from implgen import validate
+from implgen.cli import ArgumentParser
 from implgen.errors import UserError
 from implgen.scene import cluster
 from implgen.scene.batch import Runner, render_frames
@@ -36,13 +36,10 @@ def _positive(text: str) -> int:
     return v
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> Any:  # one line, exit 2, through UserError like every bad input
-        raise UserError("render", message)
-
-
-def _parser() -> _Parser:
-    ap = _Parser(prog="implgen render", description="Render a scene file: a still or an animation's frames.")
+def _parser() -> ArgumentParser:
+    ap = ArgumentParser(
+        label="render", prog="implgen render", description="Render a scene file: a still or an animation's frames."
+    )
     ap.add_argument("scene", type=Path)
     ap.add_argument(
         "-o", "--output", type=Path, required=True, help="OUT.png, a pattern like frames/f_%%04d.png, .mp4, .webm, .gif"
@@ -124,7 +121,10 @@ def _still(args: argparse.Namespace, frames: Frames, frame: int, opts: FrameOpti
         fold=args.fold or DEFAULT_FOLD,
         info=info,
     )
-    write_png(img, out.target)
+    try:
+        write_png(img, out.target)
+    except OSError as err:  # what the early check could not foresee: a full disk, a folder removed meanwhile
+        raise UserError(f"-o {args.output}", f"cannot write: {err.strerror or err}") from None
     total = sum(info.rays.values())
     print(
         f"implgen: wrote {out.target} ({img.shape[1]}x{img.shape[0]}, {info.seconds:.3f} s on "

@@ -15,6 +15,7 @@ checks the shape of a keyed mapping. The format is documented in docs/formats.md
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -54,9 +55,7 @@ class Keyed:
             return vs[0]
         if frame >= fs[-1]:
             return vs[-1]
-        i = 1
-        while fs[i] < frame:
-            i += 1
+        i = bisect.bisect_left(fs, frame)  # fs[i - 1] < frame <= fs[i]: a long key list costs log n per frame
         if fs[i] == frame:
             return vs[i]
         a, b = float(vs[i - 1]), float(vs[i])
@@ -108,16 +107,31 @@ def parse_keyed(source: str, key: str, raw: dict, frames: int | None) -> Keyed:
     return Keyed(frames=tuple(f for f, _ in items), values=tuple(v for _, v in items), ease=ease)
 
 
-def resolve(source: str, key: str, raw: Any, frame: int, frames: int | None, seen: list[str]) -> Any:
+def _cached(source: str, key: str, raw: dict, frames: int | None, cache: dict | None) -> Keyed:
+    """parse_keyed once per key path and keyed mapping for all frames of a load (`cache` lives that long and
+    holds `raw`, so its id stays its own): checking 5,000 keys again on each of 10,000 frames took minutes."""
+    if cache is None:
+        return parse_keyed(source, key, raw, frames)
+    entry = cache.get((key, id(raw)))
+    if entry is None or entry[0] is not raw:
+        entry = cache[(key, id(raw))] = (raw, parse_keyed(source, key, raw, frames), [])
+    return entry[1]
+
+
+def resolve(
+    source: str, key: str, raw: Any, frame: int, frames: int | None, seen: list[str], cache: dict | None = None
+) -> Any:
     """`raw` with every keyed value inside it replaced by its value at `frame` (for parts of a scene where
     every leaf is a number, such as a transform). The key paths of the keyed values found go to `seen`."""
     if is_keyed(raw):
         seen.append(key)
-        return parse_keyed(source, key, raw, frames).at(frame)
+        return _cached(source, key, raw, frames, cache).at(frame)
     if isinstance(raw, dict):
-        return {k: resolve(source, f"{key}.{validate.key_name(k)}", v, frame, frames, seen) for k, v in raw.items()}
+        return {
+            k: resolve(source, f"{key}.{validate.key_name(k)}", v, frame, frames, seen, cache) for k, v in raw.items()
+        }
     if isinstance(raw, list):
-        return [resolve(source, f"{key}[{i}]", v, frame, frames, seen) for i, v in enumerate(raw)]
+        return [resolve(source, f"{key}[{i}]", v, frame, frames, seen, cache) for i, v in enumerate(raw)]
     return raw
 
 
@@ -129,25 +143,29 @@ def number_at(
     frames: int | None,
     check: Callable[[str, Any], float],
     seen: list[str],
+    cache: dict | None = None,
 ) -> float:
     """A number that may be keyed, at `frame`, through `check(key, value)` (its range): each key's value is
     checked under its own name (`camera.fov.keys.47`), then the value at this frame."""
     if not is_keyed(raw):
         return check(key, raw)
     seen.append(key)
-    keyed = parse_keyed(source, key, raw, frames)
-    for f, v in zip(keyed.frames, keyed.values):
-        check(f"{key}.keys.{f}", v)
+    keyed = _cached(source, key, raw, frames, cache)
+    checked = cache[(key, id(raw))][2] if cache is not None else []
+    if not checked:  # the keys are the same on every frame: checked against this key's range once
+        for f, v in zip(keyed.frames, keyed.values):
+            check(f"{key}.keys.{f}", v)
+        checked.append(True)
     return check(key, keyed.at(frame))
 
 
-def inline_params(source: str, key: str, raw: Any, frames: int | None) -> tuple[Any, dict]:
+def inline_params(source: str, key: str, raw: Any, frames: int | None, cache: dict | None = None) -> tuple[Any, dict]:
     """An inline equation's `params` as (the shape's defaults, the keyed ones to pass per frame): a keyed
     param's default is its first key, so the shape is the same on every frame and only the value moves."""
     if not isinstance(raw, dict):
         return raw, {}  # the spec parser says what is wrong with it
     keyed = {k: v for k, v in raw.items() if is_keyed(v)}
-    first = {k: parse_keyed(source, f"{key}.{validate.key_name(k)}", v, frames).values[0] for k, v in keyed.items()}
+    first = {k: _cached(source, f"{key}.{validate.key_name(k)}", v, frames, cache).values[0] for k, v in keyed.items()}
     return {**raw, **first}, keyed
 
 
@@ -163,7 +181,7 @@ def contains_keyed(raw: Any) -> bool:
 
 
 def orbit_camera(
-    source: str, cam: dict, frame: int, frames: int | None, seen: list[str]
+    source: str, cam: dict, frame: int, frames: int | None, seen: list[str], cache: dict | None = None
 ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """`camera.orbit` at `frame`: (position, look_at). Its numbers may be keyed too."""
     for k in ("position", "look_at"):
@@ -176,7 +194,7 @@ def orbit_camera(
         def check(k: str, v: Any) -> float:
             return validate.number(source, k, v, lo, hi, lo_open=lo_open)
 
-        return number_at(source, f"camera.orbit.{key}", value, frame, frames, check, seen)
+        return number_at(source, f"camera.orbit.{key}", value, frame, frames, check, seen, cache)
 
     big = validate.MAX_COORDINATE
     center = raw.get("center", [0, 0, 0])

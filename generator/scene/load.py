@@ -8,6 +8,7 @@ the CLI prints one line and exits with status 2 before anything is compiled or w
 from __future__ import annotations
 
 import heapq
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -86,12 +87,13 @@ class _Ctx:
         self.frame = frame
         self.frames: int | None = None  # the animation's frame count; None without an `animation` block
         self.keyed: list[str] = []  # key paths of the values that change with the frame
+        self.keyed_cache: dict = memo.setdefault("keyed", {})  # keyed mappings parsed and checked once
         self.static: dict[int, tuple] = memo.setdefault("static", {})  # objects the same on every frame
         self.reused: set[int] = set()  # objects[i] taken from `static` on this frame
 
     def resolve(self, key: str, raw: Any) -> Any:
         """A part of the scene made only of numbers (a transform), with keyed values at this frame."""
-        return keys.resolve(self.source, key, raw, self.frame, self.frames, self.keyed)
+        return keys.resolve(self.source, key, raw, self.frame, self.frames, self.keyed, self.keyed_cache)
 
     def fail(self, key: str, msg: str) -> UserError:
         return UserError(self.source, f"{key}: {msg}")
@@ -99,6 +101,13 @@ class _Ctx:
     def count_shape(self, key: str) -> None:
         if self.inline_count + len(self.spec_cache) >= MAX_SHAPES:
             raise self.fail(key, f"more than {MAX_SHAPES} distinct shapes in one scene")
+
+
+def _given(raw: dict, key: str, default: Any) -> Any:
+    """raw[key], or `default` when the key is left out or empty (`lights:`); `0` or `[]` where a mapping
+    belongs is an error the caller reports, not a default."""
+    value = raw.get(key)
+    return default if value is None else value
 
 
 def _mapping(ctx: _Ctx, key: str, value: Any, allowed: tuple[str, ...]) -> dict:
@@ -116,7 +125,7 @@ def _num(
     def check(k: str, v: Any) -> float:
         return validate.number(ctx.source, k, v, lo, hi, lo_open=lo_open)
 
-    return keys.number_at(ctx.source, key, value, ctx.frame, ctx.frames, check, ctx.keyed)
+    return keys.number_at(ctx.source, key, value, ctx.frame, ctx.frames, check, ctx.keyed, ctx.keyed_cache)
 
 
 def _int(ctx: _Ctx, key: str, value: Any, lo: int, hi: int) -> int:
@@ -187,6 +196,8 @@ def _find_spec_file(ctx: _Ctx, key: str, p: Path) -> Path:
         for c in candidates:
             if c.exists():
                 return c.resolve()  # whatever it is: read_yaml says what is wrong with it
+            if os.path.lexists(c):
+                raise ctx.fail(key, f"{c} is a link to nothing (a missing target or a loop of links)")
     except (OSError, RuntimeError) as err:  # a name too long, a loop of links
         raise ctx.fail(key, f"cannot use this path ({getattr(err, 'strerror', None) or err})") from None
     tried = " or ".join(str(c) for c in candidates)
@@ -211,9 +222,12 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
         path = _resolve_shape_path(ctx, f"{key}.shape", raw["shape"])
         if path not in ctx.spec_cache:
             ctx.count_shape(f"{key}.shape")
-            ctx.spec_cache[path] = load_spec(path)
+            try:
+                ctx.spec_cache[path] = load_spec(path)
+            except UserError as err:  # the spec file's own message, after the scene's key that names it
+                raise ctx.fail(f"{key}.shape", str(err)) from None
         spec = ctx.spec_cache[path]
-        overrides = raw.get("params") or {}
+        overrides = _given(raw, "params", {})
     else:
         ctx.count_shape(f"{key}.equation")
         ctx.inline_count += 1
@@ -222,7 +236,9 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
             mapping["bounds"] = raw["bounds"]
         overrides: Any = {}
         if "params" in raw:
-            mapping["params"], overrides = keys.inline_params(ctx.source, f"{key}.params", raw["params"], ctx.frames)
+            mapping["params"], overrides = keys.inline_params(
+                ctx.source, f"{key}.params", raw["params"], ctx.frames, ctx.keyed_cache
+            )
         memo_key = f"{ctx.inline_count}:{mapping!r}"  # the same inline shape on every frame
         if memo_key not in ctx.inline_specs:
             ctx.inline_specs[memo_key] = parse_spec(mapping, f"{ctx.source}: {key}")
@@ -236,6 +252,8 @@ def _leaf(ctx: _Ctx, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
             where = f"{key}.params.{name}" if isinstance(name, str) and name.isidentifier() else f"{key}.params"
             raise ctx.fail(where, f"shape {spec.name!r} has no param {validate.describe(name)} (params: {known})")
         params[name] = _num(ctx, f"{key}.params.{name}", v)
+    if overrides:
+        spec.check_values(params, ctx.source, f"{key}.params")
     m = tf.parse_transform(ctx.source, f"{key}.transform", ctx.resolve(f"{key}.transform", raw.get("transform")))
     mat = _material_ref(ctx, f"{key}.material", raw["material"], named) if "material" in raw else None
     return Leaf(spec=spec, params=params, matrix=m, material=mat, where=key)
@@ -327,15 +345,15 @@ def parse_scene(data: Any, source: str | Path = "<scene>", *, frame: int = 0, me
         ctx.frames = sc.animation.frames
     if not 0 <= frame < sc.animation.frames:
         raise UserError(ctx.source, f"frame {frame} is outside [0, {sc.animation.frames - 1}]")
-    img = _mapping(ctx, "image", data.get("image") or {}, IMAGE_KEYS)
+    img = _mapping(ctx, "image", _given(data, "image", {}), IMAGE_KEYS)
     sc.width = _int(ctx, "image.width", img.get("width", sc.width), 1, MAX_SIZE)
     sc.height = _int(ctx, "image.height", img.get("height", sc.height), 1, MAX_SIZE)
     sc.spp = _int(ctx, "image.spp", img.get("spp", sc.spp), 1, MAX_SPP)
     sc.max_depth = _int(ctx, "image.max_depth", img.get("max_depth", sc.max_depth), 0, MAX_DEPTH)
-    cam = _mapping(ctx, "camera", data.get("camera") or {}, CAMERA_KEYS)
+    cam = _mapping(ctx, "camera", _given(data, "camera", {}), CAMERA_KEYS)
     c = Camera()
     if "orbit" in cam:
-        c.position, c.look_at = keys.orbit_camera(ctx.source, cam, ctx.frame, ctx.frames, ctx.keyed)
+        c.position, c.look_at = keys.orbit_camera(ctx.source, cam, ctx.frame, ctx.frames, ctx.keyed, ctx.keyed_cache)
     if "position" in cam:
         c.position = _vec(ctx, "camera.position", cam["position"])
     if "look_at" in cam:
@@ -352,7 +370,7 @@ def parse_scene(data: Any, source: str | Path = "<scene>", *, frame: int = 0, me
     sc.camera = c
     if "background" in data:
         sc.background = _color(ctx, "background", data["background"])
-    lights = data.get("lights") or []
+    lights = _given(data, "lights", [])
     if not isinstance(lights, list):
         raise ctx.fail("lights", "expected a list")
     for i, raw in enumerate(lights):
@@ -363,7 +381,7 @@ def parse_scene(data: Any, source: str | Path = "<scene>", *, frame: int = 0, me
         k = _num(ctx, f"lights[{i}].intensity", raw.get("intensity", 1.0), 0.0, INTENSITY_MAX)
         sc.lights.append(Light(_vec(ctx, f"lights[{i}].position", raw["position"]), tuple(k * x for x in col)))
     named: dict[str, Material] = {}
-    mats = data.get("materials") or {}
+    mats = _given(data, "materials", {})
     if not isinstance(mats, dict):
         raise ctx.fail("materials", "expected a mapping name -> material")
     for name, raw in mats.items():

@@ -84,6 +84,8 @@ def parse_transform(source: str, key: str, raw: Any) -> np.ndarray:
     if isinstance(raw, list):
         m = IDENTITY.copy()
         for i, step in enumerate(raw):
+            if not isinstance(step, dict):  # a list holds mappings; lists do not nest
+                raise UserError(source, f"{key}[{i}]: expected a mapping (scale/rotate/translate or position/axes)")
             m = compose(parse_transform(source, f"{key}[{i}]", step), m)
             check_matrix(source, key, m)  # the composition so far, before it can grow any further
         return m

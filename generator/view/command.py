@@ -7,23 +7,17 @@ one line and exit status 2. The server runs until Ctrl-C.
 
 from __future__ import annotations
 
-import argparse
 import socket
 import threading
 import webbrowser
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
 
+from implgen.cli import ArgumentParser
 from implgen.codegen.spec import parse_spec
 from implgen.errors import UserError
 from implgen.view.document import STARTER, Document
 from implgen.yamlfile import read_yaml
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> Any:
-        raise UserError("view", message)
 
 
 def document_factory(path: Path | None):
@@ -76,7 +70,9 @@ def serve(sock: socket.socket, make_document, threads: int | None = None, on_rea
 
 
 def main(argv: Sequence[str]) -> int:
-    ap = _Parser(prog="implgen view", description="Type an equation, turn it, drag its params: in the browser.")
+    ap = ArgumentParser(
+        label="view", prog="implgen view", description="Type an equation, turn it, drag its params: in the browser."
+    )
     ap.add_argument("file", type=Path, nargs="?", help="a spec or a scene (default: a torus)")
     ap.add_argument("--port", type=int, default=8765, help="0 picks a free port (default 8765)")
     ap.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine)")
