@@ -258,3 +258,50 @@ def test_a_cached_render_imports_no_sympy(cache: Path, tmp_path: Path, scene: st
     assert second.returncode == 0, second.stderr
     assert second.stdout.strip().splitlines()[-1] == "[]"  # no heavy module at all
     assert outs[0].read_bytes() == outs[1].read_bytes()
+
+
+POWER = {
+    "name": "power",
+    "equation": "x^2 + y^2 + z^2 - a^40*b",
+    "params": {"a": 1.0, "b": 1.0},
+    "bounds": {"x": ["-2*a", "2*a"], "y": [-2, "b^3 - 1 + a"], "z": ["-(a + b)^2", 3]},
+}
+
+
+@pytest.mark.parametrize(
+    "values",
+    [
+        {},
+        {"a": 1.5},
+        {"a": 1e9},  # a^40 = 1e360: the coefficient check
+        {"a": 2.0, "b": 1e-300},
+        {"a": 0.0},  # a zero param: its terms vanish
+        {"a": -1.0},  # the x bounds become empty
+        {"a": 1e8, "b": 1e8},  # the y bound leaves the coordinate range
+        {"b": -3.0},
+    ],
+)
+def test_a_cached_spec_checks_overrides_as_the_full_spec_does(cache: Path, values: dict) -> None:
+    full = speccache.parse_spec(POWER, "p.yaml")
+    cached = speccache.parse_spec(POWER, "p.yaml")
+    assert isinstance(full, Spec) and isinstance(cached, CachedSpec)
+
+    def outcome(spec):
+        try:
+            spec.check_values(values, "s.yaml", "objects[0].params")
+        except UserError as err:
+            return str(err)
+        return spec.box(values)
+
+    assert outcome(cached) == outcome(full)
+    assert cached._full is None  # decided from the cached terms and bounds trees, without parsing again
+
+
+def test_bounds_trees_evaluate_as_sympy_does() -> None:
+    spec = parse_full(POWER, "p.yaml")
+    for a, b in ((1.0, 1.0), (0.3, -2.5), (7.0, 1e-3)):
+        for k, pair in spec.bounds.items():
+            exact = [float(e.subs({spec.param_symbols[0]: a, spec.param_symbols[1]: b})) for e in pair]
+            box = spec.box({"a": a, "b": b})
+            i = "xyz".index(k)
+            assert box[i] == pytest.approx(exact[0], rel=1e-15) and box[i + 3] == pytest.approx(exact[1], rel=1e-15)

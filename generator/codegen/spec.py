@@ -24,6 +24,7 @@ from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
 from implgen import abi, validate
+from implgen.codegen import paramvalues
 from implgen.codegen.grammar import ParseError, check_terms, format_expression, parse_expression, split_equation
 from implgen.codegen.names import check_identifier, check_shape_name
 from implgen.errors import UserError
@@ -32,13 +33,13 @@ from implgen.yamlfile import read_yaml
 MAX_DEGREE = abi.value("IG_MAX_DEGREE")  # the solvers' limit, read from runtime_c/roots.h
 MAX_PARAMS = 64
 MAX_DESCRIPTION = 2_000
-MAX_COEFF_BITS = 900  # |numerator|, |denominator| of every expanded coefficient (2^900 ~ 8e270: room
-# for the multinomial factors the ray coefficients multiply them by)
+MAX_COEFF_BITS = paramvalues.MAX_COEFF_BITS  # |numerator|, |denominator| of every expanded coefficient
+# (2^900 ~ 8e270: room for the multinomial factors the ray coefficients multiply them by)
 # Generation time grows with the size of f as written times its degree (Taylor coefficients, then one cse):
 # about 1 s per 700 on the 2-core test machine, and faster than linear past that (an expanded degree-24
 # polynomial of 1150 terms, size 169,000, took 8.5 minutes). The example shapes are below 400.
 MAX_SIZE_DEGREE = 10_000
-AXES = ("x", "y", "z")
+AXES = paramvalues.AXES
 KEYS = ("name", "equation", "params", "bounds", "description")
 X, Y, Z = sympy.symbols("x y z", real=True)
 VARIABLES = {"x": X, "y": Y, "z": Z}
@@ -66,18 +67,27 @@ class Spec:
     def param_symbols(self) -> list[sympy.Symbol]:
         return [param_symbol(p) for p in self.params]
 
+    @cached_property
+    def bounds_trees(self) -> paramvalues.Trees | None:
+        """The bounds as expression trees in the param names (codegen/paramvalues.py), which the spec cache
+        keeps: a cached spec's box and checks are computed by the same code."""
+        if self.bounds is None:
+            return None
+        names = {param_symbol(p): p for p in self.params}
+        trees = {
+            a: (paramvalues.tree_of(lo, names), paramvalues.tree_of(hi, names)) for a, (lo, hi) in self.bounds.items()
+        }
+        if any(t is None for pair in trees.values() for t in pair):
+            raise ValueError(f"bounds of {self.name!r} are not polynomials in the params")  # the parser ensures it
+        return trees
+
     def box(self, values: Mapping[str, float] | None = None) -> list[float] | None:
         """The numeric box {xmin, ymin, zmin, xmax, ymax, zmax} for these param values (defaults else); an end
         too large for a double is an infinity."""
-        if self.bounds is None:
-            return None
-        full = {param_symbol(k): v for k, v in {**self.params, **(values or {})}.items()}
-        lo = [_evaluate(self.bounds[a][0], full) if a in self.bounds else -math.inf for a in AXES]
-        hi = [_evaluate(self.bounds[a][1], full) if a in self.bounds else math.inf for a in AXES]
-        return lo + hi
+        return paramvalues.box(self.params, self.bounds_trees, values)
 
     @cached_property
-    def _param_terms(self) -> list[tuple[float, tuple[int, ...]]]:
+    def param_terms(self) -> paramvalues.Terms:
         """(log2 |coefficient|, param exponents) of every term of f in x, y, z and the params."""
         poly = exact_polynomial(self.f, self.param_symbols)
         return [
@@ -85,39 +95,9 @@ class Spec:
         ]
 
     def check_values(self, values: Mapping[str, float], source: str, key: str) -> None:
-        """With these param values (defaults for the rest) every coefficient of the polynomial in x, y, z stays
-        within 2^MAX_COEFF_BITS, so the generated code computes finite numbers (a param within range can still
-        be raised to a power that overflows: a^40 with a = 1e9), and the bounds stay an ordered box."""
-        full = {**self.params, **values}
-        logs = [math.log2(abs(full[p])) if full[p] else None for p in self.params]
-        for log_c, exps in self._param_terms:
-            if any(e and lg is None for e, lg in zip(exps, logs)):
-                continue  # a zero param to a positive power: the term vanishes
-            size = log_c + sum(e * lg for e, lg in zip(exps, logs) if e)
-            if size > MAX_COEFF_BITS:
-                raise UserError(
-                    source,
-                    f"{key}: with these params a coefficient of shape {self.name!r} reaches 2^{size:.0f} "
-                    f"(beyond 2^{MAX_COEFF_BITS}: not a finite double once the ray is put in)",
-                )
-        box = self.box(values)
-        if box is not None:
-            for i, axis in enumerate(AXES):
-                lo, hi = box[i], box[i + 3]
-                if axis in self.bounds and not (
-                    abs(lo) <= validate.MAX_COORDINATE and abs(hi) <= validate.MAX_COORDINATE
-                ):
-                    raise UserError(
-                        source,
-                        f"{key}: with these params the bounds of shape {self.name!r} leave "
-                        f"[-{validate.MAX_COORDINATE:g}, {validate.MAX_COORDINATE:g}] along {axis}",
-                    )
-                if axis in self.bounds and not lo < hi:
-                    raise UserError(
-                        source,
-                        f"{key}: with these params the bounds of shape {self.name!r} are "
-                        f"empty along {axis} (from {lo:g} to {hi:g})",
-                    )
+        """With these param values every coefficient stays a finite double and the bounds an ordered box
+        (paramvalues.check)."""
+        paramvalues.check(self.name, self.params, self.param_terms, self.bounds_trees, values, source, key)
 
     def specialise(self, values: Mapping[str, float], name: str | None = None) -> Spec:
         """The same shape with the given params folded into the equation as constants."""
@@ -144,27 +124,6 @@ class Spec:
             bounds=bounds,
             folded={**self.folded, **{k: float(v) for k, v in values.items()}},
         )
-
-
-def _evaluate(expr: sympy.Expr, values: Mapping[sympy.Symbol, float]) -> float:
-    """A polynomial expression in the params as a double, walked directly (SymPy's subs is a thousand times
-    slower, and a scene may place the same shape 10,000 times); overflow gives an infinity."""
-    try:
-        if expr.is_Symbol:
-            return float(values[expr])
-        if expr.is_Number:
-            return float(expr)
-        if expr.is_Add:
-            return math.fsum(_evaluate(a, values) for a in expr.args)
-        if expr.is_Mul:
-            return math.prod(_evaluate(a, values) for a in expr.args)
-        if expr.is_Pow and expr.exp.is_Integer:
-            return _evaluate(expr.base, values) ** int(expr.exp)
-    except OverflowError:
-        return math.inf
-    except ValueError:  # inf - inf
-        return math.nan
-    return float(expr.subs(values))
 
 
 def load_spec(path: str | Path) -> Spec:

@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from implgen import abi, clib
+from implgen.codegen import paramvalues
 from implgen.codegen.names import check_identifier, check_shape_name
 from implgen.errors import UserError
 from implgen.outputs import atomic_write
@@ -37,10 +38,22 @@ from implgen.yamlfile import read_yaml
 if TYPE_CHECKING:
     from implgen.codegen.spec import Spec
 
-FORMAT = 1
+FORMAT = 2
 MAX_ENTRY_BYTES = 8 << 20  # an entry holds the printed equation of a spec file of at most 1 MiB
 MAX_NESTING = 8  # a spec mapping is four levels deep (bounds -> axis -> pair -> end); deeper is never valid
-_ENTRY_KEYS = {"format", "key", "name", "equation", "params", "degree", "description", "box", "spec_key"}
+_ENTRY_KEYS = {
+    "format",
+    "key",
+    "name",
+    "equation",
+    "params",
+    "degree",
+    "description",
+    "box",
+    "spec_key",
+    "terms",
+    "bounds",
+}
 _HEX24 = re.compile(r"[0-9a-f]{24}\Z")
 
 
@@ -70,6 +83,10 @@ class CachedSpec:
         self.folded: dict[str, float] = {}
         self.spec_key: str = entry["spec_key"]  # build.spec_key of the full spec
         self._box: list[float] | None = entry["box"]
+        self.param_terms: paramvalues.Terms = [(c, tuple(e)) for c, e in entry["terms"]]
+        self.bounds_trees: paramvalues.Trees | None = (
+            None if entry["bounds"] is None else {a: (lo, hi) for a, (lo, hi) in entry["bounds"].items()}
+        )
         self._content = content
         self._full: Spec | None = None
 
@@ -87,7 +104,11 @@ class CachedSpec:
             return None
         if not values or all(k in self.params and self.params[k] == v for k, v in values.items()):
             return list(self._box)
-        return self.full().box(values)
+        return paramvalues.box(self.params, self.bounds_trees, values)
+
+    def check_values(self, values: dict[str, float], source: str, key: str) -> None:
+        """As Spec.check_values, from the cached terms and bounds trees (the same code)."""
+        paramvalues.check(self.name, self.params, self.param_terms, self.bounds_trees, values, source, key)
 
     def __getattr__(self, attr: str) -> Any:  # only called for what __init__ did not set
         if attr.startswith("_"):
@@ -208,6 +229,10 @@ def _entry_ok(entry: Any, key: str, data: dict) -> bool:
         return False
     if not isinstance(entry["spec_key"], str) or not _HEX24.match(entry["spec_key"]):
         return False
+    if not _terms_ok(entry["terms"], len(params)) or not _trees_ok(entry["bounds"], [p[0] for p in params]):
+        return False
+    if (box is None) != (entry["bounds"] is None):
+        return False
     if box is None:
         return data.get("bounds") is None
     if not isinstance(box, list) or len(box) != 6 or data.get("bounds") is None:
@@ -215,6 +240,35 @@ def _entry_ok(entry: Any, key: str, data: dict) -> bool:
     if not all(isinstance(v, float) and not math.isnan(v) for v in box):
         return False
     return all(box[i] < box[i + 3] for i in range(3))
+
+
+def _terms_ok(terms: Any, nparams: int) -> bool:
+    return isinstance(terms, list) and all(
+        isinstance(t, list)
+        and len(t) == 2
+        and isinstance(t[0], float)
+        and math.isfinite(t[0])
+        and isinstance(t[1], list)
+        and len(t[1]) == nparams
+        and all(isinstance(e, int) and not isinstance(e, bool) and e >= 0 for e in t[1])
+        for t in terms
+    )
+
+
+def _trees_ok(trees: Any, params: list[str]) -> bool:
+    if trees is None:
+        return True
+    return (
+        isinstance(trees, dict)
+        and 1 <= len(trees) <= 3
+        and all(
+            axis in paramvalues.AXES
+            and isinstance(pair, list)
+            and len(pair) == 2
+            and all(paramvalues.tree_ok(t, params) for t in pair)
+            for axis, pair in trees.items()
+        )
+    )
 
 
 def _write_entry(path: Path, key: str, spec: Spec) -> None:
@@ -231,6 +285,8 @@ def _write_entry(path: Path, key: str, spec: Spec) -> None:
         "description": spec.description,
         "box": None if box is None else [float(v) for v in box],
         "spec_key": spec_key(spec),
+        "terms": [[c, list(e)] for c, e in spec.param_terms],
+        "bounds": None if spec.bounds_trees is None else {a: list(pair) for a, pair in spec.bounds_trees.items()},
     }
     data = json.dumps(entry, allow_nan=True).encode()
     try:
