@@ -20,8 +20,6 @@ ROOT = Path(__file__).resolve().parent.parent
 # until you do). Only bench/results/ files belong here.
 PENDING = {
     "bench/results/gen.md",  # `implgen bench gen`: generation time and ops against degree
-    "bench/results/render.md",  # `implgen bench render`: render speed by ray kind
-    "bench/results/startup.md",  # bench/startup.py: a tiny cached render against bare Python
     "bench/results/fold.md",  # `implgen bench render --fold-compare`: params folded or not
     "bench/results/build_cache.md",  # bench/build_cache.py: a cold and a warm `implgen render`
     "bench/results/spawn_offsets.md",  # bench/spawn_offsets.py: secondary-ray self-hits per seed and factor
