@@ -21,8 +21,6 @@ ROOT = Path(__file__).resolve().parent.parent
 PENDING = {
     "bench/results/gen.md",  # `implgen bench gen`: generation time and ops against degree
     "bench/results/fold.md",  # `implgen bench render --fold-compare`: params folded or not
-    "bench/results/build_cache.md",  # bench/build_cache.py: a cold and a warm `implgen render`
-    "bench/results/spawn_offsets.md",  # bench/spawn_offsets.py: secondary-ray self-hits per seed and factor
 }
 
 
