@@ -19,8 +19,6 @@ ROOT = Path(__file__).resolve().parent.parent
 # nowhere for now; everything else must resolve. Take an entry out once its file exists (a test below fails
 # until you do). Only bench/results/ files belong here.
 PENDING = {
-    "bench/results/gen.md",  # `implgen bench gen`: generation time and ops against degree
-    "bench/results/fold.md",  # `implgen bench render --fold-compare`: params folded or not
 }
 
 

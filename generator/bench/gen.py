@@ -4,7 +4,8 @@ Two families per degree n: a dense one, the product of n/2 offset spheres (every
 sparse one, x^n + y^n + z^n = 1. For each: the median wall time of parse + derive + emit (C and Python), and
 the operation count of the generated coefficient code. With --compare, also the expanded alternative
 (compose in the polynomial ring QQ[o, d][t], then one cse) up to the degree it finishes in reasonable time,
-to show why implgen uses the Taylor (series) form.
+to show why implgen uses the Taylor (series) form. Prints the table and writes it, with the machine, to -o
+(default bench/results/gen.md).
 """
 
 from __future__ import annotations
@@ -12,14 +13,17 @@ from __future__ import annotations
 import statistics
 import time
 from collections.abc import Sequence
+from pathlib import Path
 
 import sympy
 
+from implgen.bench.machine import describe, load_average
 from implgen.cli import ArgumentParser
 from implgen.codegen.derive import derive, exact_ray_coefficients
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.codegen.spec import MAX_DEGREE, parse_spec
 from implgen.errors import UserError
+from implgen.outputs import atomic_write, check_output_file
 
 DEGREES = (2, 4, 6, 8, 12, 16, 20, 24)
 
@@ -66,18 +70,26 @@ def main(argv: Sequence[str]) -> int:
         help="also time the expanded form up to degree N (0 to skip; default 8)",
     )
     parser.add_argument("--degrees", type=int, nargs="*", default=list(DEGREES))
+    parser.add_argument("-o", "--output", type=Path, default=Path("bench/results/gen.md"))
     args = parser.parse_args(list(argv))
     if any(not 1 <= n <= MAX_DEGREE for n in args.degrees) or args.repeats < 1:
         raise UserError("bench gen", f"degrees must be within 1..{MAX_DEGREE} and repeats at least 1")
-    print(
+    check_output_file(args.output, "-o", (".md",))
+    lines = [
+        "# Generation time against degree",
+        "",
+        f"Written by `implgen bench gen` on {describe()}. Load average before: {load_average()}.",
+        "",
         f"Generation time (parse + derive + emit C and Python; median of {args.repeats}) "
-        f"and operations in the generated coefficient code. Highest supported degree: {MAX_DEGREE}.\n"
-    )
+        f"and operations in the generated coefficient code. Highest supported degree: {MAX_DEGREE}.",
+        "",
+    ]
+    print("\n".join(lines))
     header = "| degree | dense: time | dense: ops | sparse: time | sparse: ops |"
     if args.compare:
         header += " dense expanded+cse: time | ops |"
-    print(header)
-    print("|" + "---|" * (header.count("|") - 1))
+    table = [header, "|" + "---|" * (header.count("|") - 1)]
+    print("\n".join(table))
     for n in args.degrees:
         dense_t, dense_ops, _ = _time_generation(dense_equation(n), args.repeats)
         sparse_t, sparse_ops, _ = _time_generation(sparse_equation(n), args.repeats)
@@ -89,4 +101,9 @@ def main(argv: Sequence[str]) -> int:
             else:
                 row += " – | – |"
         print(row, flush=True)
+        table.append(row)
+    data = ("\n".join(lines + table) + "\n").encode()
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(args.output, lambda fh: fh.write(data))
+    print(f"wrote {args.output}")
     return 0
