@@ -18,8 +18,7 @@ ROOT = Path(__file__).resolve().parent.parent
 # Result files that a benchmark script will write but has not written yet. A link to one of these may point
 # nowhere for now; everything else must resolve. Take an entry out once its file exists (a test below fails
 # until you do). Only bench/results/ files belong here.
-PENDING = {
-}
+PENDING = {}
 
 
 def doc_files() -> list[Path]:
