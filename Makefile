@@ -9,7 +9,7 @@ SOURCES := pyproject.toml $(shell find generator templates runtime_c -type f \( 
                        -o -name '*.html' -o -name '*.js' -o -name '*.css' \) 2>/dev/null)
 C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c)
 
-.PHONY: demo test lint tools browser screenshot install regen gallery bench clean
+.PHONY: demo test lint tools browser povray screenshot install regen gallery bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -26,13 +26,17 @@ install: $(STAMP)
 demo: install
 	$(BIN)/implgen demo
 
-test: install browser
+test: install browser povray
 	$(BIN)/python -m pytest -q tests
 
 # Headless Chromium and its driver for the viewer's browser test (Debian packages; run as root, as CI does).
 browser:
 	@command -v chromium >/dev/null && command -v chromedriver >/dev/null || \
 	  { apt-get update -qq && apt-get install -y -qq chromium chromium-driver >/dev/null; }
+
+# POV-Ray for the exporter's tests that render with it (Debian package; run as root, as CI does).
+povray:
+	@command -v povray >/dev/null || { apt-get update -qq && apt-get install -y -qq povray >/dev/null; }
 
 # The README's picture of `implgen view`, taken by the browser test.
 screenshot: install browser
