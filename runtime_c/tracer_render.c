@@ -13,7 +13,7 @@
  * threads start: only rows a cancelled render never reached are cleared, after it).
  */
 #if defined(__linux__) && !defined(_GNU_SOURCE)
-#define _GNU_SOURCE /* pthread_setaffinity_np, sched_getaffinity: one thread per core when all cores render */
+#define _GNU_SOURCE /* sched_getaffinity, sched_setaffinity: one thread per core when all cores render */
 #endif
 #include "tracer_internal.h"
 
@@ -39,6 +39,7 @@ struct rt_render {
     char pad_before[64];
     pthread_mutex_t lock;
     int next_row, rows_done, cancel;
+    int pin, pinned; /* pin: each worker keeps itself on its own allowed core; pinned: workers numbered so far */
     double stats[RT_NSTATS];
     char pad_after[64];
 };
@@ -180,6 +181,45 @@ static void render_row(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
     }
 }
 
+/* When a render uses exactly the cores it may run on, worker k keeps itself on the k-th of them. Rows are
+ * handed out dynamically, so a core another process keeps busy only gives its thread fewer rows; but a
+ * scheduler that packs new threads onto the cores already running (some virtual machines' kernels do, for
+ * tens of milliseconds) can no longer run a short render's threads one after the other on one core.
+ * Each worker pins itself, while it runs: pinning a worker from outside after it has finished (a tiny render)
+ * reaches a thread the kernel no longer has, and glibc then pins the calling thread instead, so every later
+ * render from that thread would inherit one core. */
+static int pinning_wanted(int n)
+{
+#ifdef __linux__
+    cpu_set_t allowed;
+    return n >= 2 && sched_getaffinity(0, sizeof allowed, &allowed) == 0 && CPU_COUNT(&allowed) == n;
+#else
+    (void)n;
+    return 0;
+#endif
+}
+
+/* Keep the calling thread on the k-th core of those it may run on (a new thread inherits its creator's). */
+static void pin_self(int k)
+{
+#ifdef __linux__
+    cpu_set_t allowed, one;
+    int cpu;
+    if (sched_getaffinity(0, sizeof allowed, &allowed) != 0)
+        return;
+    for (cpu = 0; cpu < CPU_SETSIZE; ++cpu) {
+        if (!CPU_ISSET(cpu, &allowed) || k-- > 0)
+            continue;
+        CPU_ZERO(&one);
+        CPU_SET(cpu, &one);
+        sched_setaffinity(0, sizeof one, &one); /* a failure leaves the thread where it was */
+        return;
+    }
+#else
+    (void)k;
+#endif
+}
+
 static void *worker(void *arg)
 {
     rt_render *r = arg;
@@ -187,6 +227,12 @@ static void *worker(void *arg)
     int *perm = malloc((size_t)r->spp * sizeof(int)), y = -1, a;
     if (!perm)
         return NULL;
+    if (r->pin) {
+        pthread_mutex_lock(&r->lock);
+        a = r->pinned++;
+        pthread_mutex_unlock(&r->lock);
+        pin_self(a);
+    }
     for (;;) {
         pthread_mutex_lock(&r->lock); /* one lock per row: the row done, and the next one claimed */
         if (y >= 0)
@@ -205,30 +251,6 @@ static void *worker(void *arg)
     return NULL;
 }
 
-/* When a render uses exactly the cores it may run on, thread i is kept on the i-th of them. Rows are handed
- * out dynamically, so a core another process keeps busy only gives its thread fewer rows; but a scheduler
- * that packs new threads onto the cores already running (some virtual machines' kernels do, for tens of
- * milliseconds) can no longer run a short render's threads one after the other on one core. */
-static void spread_threads(const pthread_t *ids, int n)
-{
-#ifdef __linux__
-    cpu_set_t allowed, one;
-    int cpu, k = 0;
-    if (n < 2 || sched_getaffinity(0, sizeof allowed, &allowed) != 0 || CPU_COUNT(&allowed) != n)
-        return;
-    for (cpu = 0; cpu < CPU_SETSIZE && k < n; ++cpu) {
-        if (!CPU_ISSET(cpu, &allowed))
-            continue;
-        CPU_ZERO(&one);
-        CPU_SET(cpu, &one);
-        pthread_setaffinity_np(ids[k++], sizeof one, &one); /* a failure leaves the thread where it was */
-    }
-#else
-    (void)ids;
-    (void)n;
-#endif
-}
-
 int rt_render_run(rt_render *r, float *rgb)
 {
     pthread_t *ids;
@@ -239,6 +261,8 @@ int rt_render_run(rt_render *r, float *rgb)
     pthread_mutex_lock(&r->lock);
     r->next_row = r->y0;
     r->rows_done = 0;
+    r->pin = pinning_wanted(n);
+    r->pinned = 0;
     pthread_mutex_unlock(&r->lock);
     ids = malloc((size_t)n * sizeof *ids);
     if (!ids)
@@ -254,7 +278,6 @@ int rt_render_run(rt_render *r, float *rgb)
         free(ids);
         return -1;
     }
-    spread_threads(ids, started);
     for (i = 0; i < started; ++i)
         pthread_join(ids[i], NULL);
     free(ids);

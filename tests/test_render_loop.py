@@ -5,6 +5,7 @@ reached (the output is not cleared before the threads start, so stale contents m
 from __future__ import annotations
 
 import ctypes
+import os
 from pathlib import Path
 
 import numpy as np
@@ -67,3 +68,15 @@ def test_a_band_of_rows_is_those_rows_of_the_whole_image(scene: CScene) -> None:
         assert code == 0 and done == 7 and np.array_equal(band, whole[5:12])
     code, band, _, done = run(scene, 2, cancel_first=True, rows=(5, 12))
     assert code == 1 and done == 0 and np.array_equal(band, np.zeros_like(band))
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_getaffinity") or len(os.sched_getaffinity(0)) < 2, reason="one core")
+def test_keeping_threads_on_their_cores_never_pins_the_caller(scene: CScene) -> None:
+    """The render threads go one per allowed core; the thread that called the render keeps its own cores.
+    (A worker done before it was pinned had no kernel thread left, and pinning it pinned the caller instead:
+    every later render then ran all its threads on one core, half as fast.)"""
+    allowed = os.sched_getaffinity(0)
+    for _ in range(200):  # tiny renders: workers often finish before the last one is even started
+        code = run(scene, len(allowed), spp=1, rows=(0, 2))[0]
+        assert code == 0
+        assert os.sched_getaffinity(0) == allowed
