@@ -30,6 +30,7 @@ import time
 from pathlib import Path
 
 from implgen.bench.machine import describe as machine
+from implgen.bench.machine import write_results
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -146,8 +147,7 @@ def main() -> int:
         "",
     ]
     text = "\n".join(lines)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text(text, encoding="utf-8")
+    write_results(args.output, text)
     print(text)
     print(f"wrote {args.output}")
     return 0

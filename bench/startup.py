@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 from implgen.bench.machine import describe as machine
-from implgen.bench.machine import load_average
+from implgen.bench.machine import load_average, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "bench" / "scenes"
@@ -113,8 +113,7 @@ def main() -> int:
     ]
     text = "\n".join(lines)
     print(text)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text(text, encoding="utf-8")
+    write_results(args.output, text)
     print(f"wrote {args.output}")
     return 0
 

@@ -27,6 +27,7 @@ from pathlib import Path
 from websockets.sync.client import connect
 
 from implgen.bench.machine import describe as machine
+from implgen.bench.machine import write_results
 from implgen.codegen.spec import load_spec
 from implgen.view.dump import spec_mapping
 from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, MAX_RENDERS_PER_SECOND
@@ -207,8 +208,7 @@ def main() -> int:
     ]
     text = "\n".join(lines)
     print(text)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text(text, encoding="utf-8")
+    write_results(args.output, text)
     return 0
 
 

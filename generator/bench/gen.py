@@ -17,13 +17,13 @@ from pathlib import Path
 
 import sympy
 
-from implgen.bench.machine import describe, load_average
+from implgen.bench.machine import describe, load_average, write_results
 from implgen.cli import ArgumentParser
 from implgen.codegen.derive import derive, exact_ray_coefficients
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.codegen.spec import MAX_DEGREE, parse_spec
 from implgen.errors import UserError
-from implgen.outputs import atomic_write, check_output_file
+from implgen.outputs import check_output_file
 
 DEGREES = (2, 4, 6, 8, 12, 16, 20, 24)
 
@@ -102,8 +102,6 @@ def main(argv: Sequence[str]) -> int:
                 row += " – | – |"
         print(row, flush=True)
         table.append(row)
-    data = ("\n".join(lines + table) + "\n").encode()
-    args.output.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write(args.output, lambda fh: fh.write(data))
+    write_results(args.output, "\n".join(lines + table) + "\n")
     print(f"wrote {args.output}")
     return 0

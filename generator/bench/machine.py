@@ -1,10 +1,12 @@
-"""What machine a benchmark ran on, for the header of every results file the benchmarks write."""
+"""What machine a benchmark ran on, for the header of every results file the benchmarks write, and writing that
+file."""
 
 from __future__ import annotations
 
 import os
 import platform
 import subprocess
+from pathlib import Path
 
 
 def cpu_model() -> str:
@@ -33,3 +35,12 @@ def load_average() -> str:
         return ", ".join(f"{v:.2f}" for v in os.getloadavg())
     except OSError:
         return "unknown"
+
+
+def write_results(path: Path, text: str) -> None:
+    """Write a results file whole (a temporary name renamed into place: an interrupted run leaves the old one)."""
+    from implgen.outputs import atomic_write
+
+    data = text.encode("utf-8")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(path, lambda fh: fh.write(data))
