@@ -14,6 +14,7 @@
 #include "numerics.h"
 
 #include <math.h>
+#include <stddef.h>
 
 void ig_shape_prepare(const ig_shape *shape, const double *params, ig_shape_prep *prep)
 {
@@ -93,7 +94,8 @@ static double shift_point(const ig_shape_prep *prep, const double o[3], const do
 }
 
 int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_prep *prep, const double o[3],
-                   const double d[3], double tmin, double tmax, ig_root_method method, int first, double *roots)
+                   const double d[3], double tmin, double tmax, ig_root_method method, int first, double *roots,
+                   ig_shape_expansion *ex)
 {
     for (int i = 0; i < 3; ++i)
         if (!isfinite(o[i]) || !isfinite(d[i]))
@@ -126,6 +128,11 @@ int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_p
         if (m == 0 || t > roots[m - 1])
             roots[m++] = t;
     }
+    if (ex && m > 0) {
+        ex->ts = ts;
+        for (int i = 0; i <= n; ++i)
+            ex->c[i] = c[i];
+    }
     return m;
 }
 
@@ -137,7 +144,7 @@ static int shape_solve(const ig_shape *shape, const double *params, const double
     if (!shape || !shape->coeffs || !roots)
         return 0;
     ig_shape_prepare(shape, params, &prep);
-    return ig_shape_solve(shape, params, &prep, o, d, tmin, tmax, method, first, roots);
+    return ig_shape_solve(shape, params, &prep, o, d, tmin, tmax, method, first, roots, NULL);
 }
 
 int ig_shape_roots(const ig_shape *shape, const double *params, const double o[3], const double d[3], double tmin,

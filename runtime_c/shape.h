@@ -52,9 +52,19 @@ typedef struct ig_shape_prep {
 
 void ig_shape_prepare(const ig_shape *shape, const double *params, ig_shape_prep *prep);
 
-/* shape, params and roots must not be NULL; prep must come from ig_shape_prepare(shape, params). */
+/* The expansion a solve worked on: roots are ts + s for the roots s of sum_k c[k] s^k (degree prep->degree).
+ * A caller that needs the solver's own view of f near a root (the tracer's error bound of a hit point) reads
+ * it here instead of computing the coefficients again. */
+typedef struct ig_shape_expansion {
+    double ts;
+    double c[IG_MAX_DEGREE + 1];
+} ig_shape_expansion;
+
+/* shape, params and roots must not be NULL; prep must come from ig_shape_prepare(shape, params). ex may be
+ * NULL; otherwise, when a root is returned, *ex holds the expansion it came from (else *ex is unspecified). */
 int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_prep *prep, const double o[3],
-                   const double d[3], double tmin, double tmax, ig_root_method method, int first, double *roots);
+                   const double d[3], double tmin, double tmax, ig_root_method method, int first, double *roots,
+                   ig_shape_expansion *ex);
 
 /* Unit outward normal at p. At a singular point (grad f = 0 or not finite, e.g. a cone's apex) writes
  * (0, 0, 0) and returns 0 -- never NaN; the caller picks a fallback (e.g. facing the ray). Returns 1 otherwise. */

@@ -23,7 +23,7 @@ int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], doub
     u[0] = od[0] / L;
     u[1] = od[1] / L;
     u[2] = od[2] / L;
-    k = ig_shape_solve(n->shape, n->params, &n->prep, oo, u, lo * L, hi * L, IG_ROOTS_AUTO, 0, r);
+    k = ig_shape_solve(n->shape, n->params, &n->prep, oo, u, lo * L, hi * L, IG_ROOTS_AUTO, 0, r, NULL);
     for (i = 0; i < k; ++i)
         r[i] /= L;
     return k;
@@ -204,6 +204,21 @@ int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d
     return n;
 }
 
+/* The solver's view of f at its root s (see solver_noise in tracer_hit.c): Horner's running error sum
+ * sum |c_k| |tau|^k and the expansion's value at tau, the root's offset from the shift point. */
+static void expansion_noise(const ig_shape_expansion *ex, int deg, double s, rt_pending *hit)
+{
+    double tau = s - ex->ts, a = fabs(tau), sum = 0.0, val = 0.0;
+    int k;
+    for (k = deg; k >= 0; --k) {
+        sum = sum * a + fabs(ex->c[k]);
+        val = val * tau + ex->c[k];
+    }
+    hit->noise_known = 1;
+    hit->noise_sum = sum;
+    hit->noise_val = val;
+}
+
 int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, rt_pending *hit)
 {
     int k = s->objects[object];
@@ -220,6 +235,7 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
             return 0;
     }
     hit->object = object;
+    hit->noise_known = 0;
     if (n->kind == RT_LEAF) {
         /* A top-level leaf is a surface: its nearest root after tmin. The solver stops at the first root in
          * [lo, hi]; only when that one is not after tmin (a root exactly at tmin) are all of them needed. The
@@ -227,6 +243,7 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
          * ray's own. */
         double oo[3], od[3], u[3], L = ray->len, r[IG_MAX_DEGREE + 2];
         const double *po = ray->o, *pu = ray->u;
+        ig_shape_expansion ex;
         int nr, i;
         if (!n->identity) {
             rt_xform_point(n->minv, ray->o, oo);
@@ -242,9 +259,9 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
         } else if (!(L > 0.0) || !isfinite(L)) {
             return 0;
         }
-        nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, 1, r);
+        nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, 1, r, &ex);
         if (nr && !(r[0] / L > tmin))
-            nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, 0, r);
+            nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, 0, r, &ex);
         for (i = 0; i < nr; ++i) {
             double t = r[i] / L;
             if (t > tmin && t < tmax) {
@@ -253,6 +270,7 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
                 hit->face = 0;
                 hit->entering = 0;
                 hit->entering_known = 0;
+                expansion_noise(&ex, n->prep.degree, r[i], hit);
                 return 1;
             }
         }

@@ -97,32 +97,38 @@ static int ray_box(const double box[6], const rt_ray *r, double *t0, double *t1)
  * value(p) -- two roundings of the same number, which catches cancellation inside the coefficients (a
  * cubed factor expanded into monomials) that the first estimate cannot see. Measured by
  * tests/c/tracer_offsets.c. */
-static double solver_noise(const rt_node *n, const double oo[3], const double od[3], const double po[3], double fp,
-                           double t)
+static double solver_noise(const rt_node *n, const rt_hit_lazy *lz, const double po[3], double fp, double t)
 {
-    double c[IG_MAX_DEGREE + 1], os[3], num = 0.0, den = 0.0, ts, tau, pw = 1.0, sum = 0.0, horner;
+    double sum = 0.0, horner;
     int a, k, deg = n->shape->degree;
-    for (k = 0; k < n->prep.nfinite; ++k) { /* the box's finite axes (none for an unbounded shape) */
-        a = n->prep.finite[k];
-        num += od[a] * (n->prep.centre[a] - oo[a]);
-        den += od[a] * od[a];
+    if (lz->noise_known) { /* the solve that found the hit handed its expansion over (rt_object_hit) */
+        sum = lz->noise_sum;
+        horner = lz->noise_val;
+    } else { /* a CSG leaf's root: an expansion by shape.c's rule (without its clamp to the clipped range) */
+        const double *oo = lz->oo, *od = lz->od;
+        double c[IG_MAX_DEGREE + 1], os[3], num = 0.0, den = 0.0, ts, tau, pw = 1.0;
+        for (k = 0; k < n->prep.nfinite; ++k) { /* the box's finite axes (none for an unbounded shape) */
+            a = n->prep.finite[k];
+            num += od[a] * (n->prep.centre[a] - oo[a]);
+            den += od[a] * od[a];
+        }
+        if (!(den > 0.0)) {
+            num = -rt_dot(oo, od);
+            den = rt_dot(od, od);
+        }
+        ts = den > 0.0 ? num / den : 0.0;
+        if (!isfinite(ts))
+            ts = 0.0;
+        for (a = 0; a < 3; ++a)
+            os[a] = oo[a] + ts * od[a];
+        n->shape->coeffs(os, od, n->params, c);
+        tau = t - ts;
+        for (k = 0; k <= deg; ++k) {
+            sum += fabs(c[k]) * pw;
+            pw *= fabs(tau);
+        }
+        horner = ig_horner(c, deg, tau);
     }
-    if (!(den > 0.0)) {
-        num = -rt_dot(oo, od);
-        den = rt_dot(od, od);
-    }
-    ts = den > 0.0 ? num / den : 0.0;
-    if (!isfinite(ts))
-        ts = 0.0;
-    for (a = 0; a < 3; ++a)
-        os[a] = oo[a] + ts * od[a];
-    n->shape->coeffs(os, od, n->params, c);
-    tau = t - ts;
-    for (k = 0; k <= deg; ++k) {
-        sum += fabs(c[k]) * pw;
-        pw *= fabs(tau);
-    }
-    horner = ig_horner(c, deg, tau);
     /* The secondary ray will be solved from its own shift point, not this one; when this ray's shift point
      * happens to sit at the hit, the sum above sees only |f(po)| ~ 0. So also expand along the segment from
      * the box centre (the coordinate origin on open axes) to po: the noise any ray solved inside the box
@@ -147,11 +153,29 @@ static double solver_noise(const rt_node *n, const double oo[3], const double od
 /* How far from po the surface can be, given |f(po)| plus its noise: along the direction u (the normal, or
  * the ray at a singular point) f(po + s u) = c_0 + c_1 s + c_2 s^2 + ...; the smallest s at which one term
  * c_k s^k reaches |c_0| + noise. With k = 1 this is the familiar (|f| + noise) / |grad f|; the higher terms
- * keep the estimate finite where grad f vanishes (a cusp, or the heart's singular equator). */
-static double distance_bound(const rt_node *n, const double po[3], const double u[3], double level)
+ * keep the estimate finite where grad f vanishes (a cusp, or the heart's singular equator). They can only
+ * lower it, so where the first-order distance is already below RT_DIST_FIRST_ORDER of the object's size it
+ * stands on its own (an error bound that much larger than needed moves no secondary ray visibly), and the
+ * expansion -- a full set of coefficients, the costliest part of a hit's error -- is skipped. gl is |grad f|
+ * when u is the normal, else 0. */
+#ifndef RT_DIST_FIRST_ORDER
+#define RT_DIST_FIRST_ORDER 1e-6
+#endif
+static double distance_bound(const rt_node *n, const double po[3], const double u[3], double gl, double level)
 {
     double c[IG_MAX_DEGREE + 1], best = INFINITY, best_pow = INFINITY;
     int k, deg = n->shape->degree;
+    if (gl > 0.0) {
+        double first = level / gl, size = rt_maxabs3(po);
+        for (k = 0; k < n->prep.nfinite; ++k) {
+            int a = n->prep.finite[k];
+            double half = 0.5 * (n->prep.hi[a] - n->prep.lo[a]);
+            if (half > size)
+                size = half;
+        }
+        if (deg == 1 || first <= RT_DIST_FIRST_ORDER * size)
+            return isfinite(first) ? first : 0.0;
+    }
     n->shape->coeffs(po, u, n->params, c);
     for (k = 1; k <= deg; ++k) {
         double q;
@@ -188,6 +212,10 @@ void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], c
         lz->u[a] = 0.0;
     }
     lz->f = 0.0;
+    lz->gl = 0.0;
+    lz->noise_known = pd->noise_known;
+    lz->noise_sum = pd->noise_sum;
+    lz->noise_val = pd->noise_val;
     if (face == 0) {
         double f = n->shape->value(hit->po, n->params), gl;
         n->shape->gradient(hit->po, n->params, g);
@@ -198,6 +226,7 @@ void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], c
         if (!singular) {
             for (a = 0; a < 3; ++a)
                 lz->u[a] = g[a] / gl;
+            lz->gl = gl;
         } else {
             double l = sqrt(rt_dot(lz->od, lz->od));
             for (a = 0; a < 3; ++a)
@@ -263,9 +292,9 @@ void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lz)
     lz->pending = 0;
     if (hit->face == 0) {
         double f = lz->f, level;
-        level = isfinite(f) ? fabs(f) + solver_noise(n, lz->oo, lz->od, hit->po, f, t) : 0.0;
+        level = isfinite(f) ? fabs(f) + solver_noise(n, lz, hit->po, f, t) : 0.0;
         /* distance of the computed point from f = 0, including how far the solver's noise can move a root */
-        dist = level > 0.0 ? distance_bound(n, hit->po, lz->u, level) : 0.0;
+        dist = level > 0.0 ? distance_bound(n, hit->po, lz->u, lz->gl, level) : 0.0;
     }
     /* Error bound of the hit point, in world units. The object-space part: the measured distance |f|/|grad f|
      * of the computed point, plus the rounding noise of evaluating f and of forming o' + t d' (relative to

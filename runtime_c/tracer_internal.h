@@ -71,6 +71,10 @@ typedef struct rt_span {
 typedef struct rt_pending {
     double t;
     int object, leaf, face, entering, entering_known;
+    /* noise_known: the solve that found t handed over its expansion's view of f there (see solver_noise):
+     * noise_sum = sum |c_k| |tau|^k and noise_val = the expansion's value at the root's offset tau */
+    int noise_known;
+    double noise_sum, noise_val;
 } rt_pending;
 
 /* A world ray with what every object test along it would otherwise work out again. */
@@ -90,6 +94,9 @@ typedef struct rt_hit_lazy {
     double oo[3], od[3]; /* the ray in the leaf's object space */
     double u[3];         /* the unit direction distance_bound expands along (normal, or ray at a singular point) */
     double f;            /* f at the object-space hit point */
+    double gl;           /* |grad f| there when u is the normal, else 0 */
+    int noise_known;     /* the pending hit's noise_known, noise_sum and noise_val */
+    double noise_sum, noise_val;
 } rt_hit_lazy;
 
 /* Closest-hit query modes. RT_ANY_OPAQUE: the same, except that the search stops at the first hit on an
