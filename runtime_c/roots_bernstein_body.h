@@ -7,8 +7,10 @@
  */
 #ifdef BZ_ANY_DEGREE
 #define N n
+#define BZ_FIXED_UNROLL
 #else
 #define N BZ_TAG
+#define BZ_FIXED_UNROLL BZ_UNROLL
 #endif
 #define BZ_FN(name) BZ_CAT(name, BZ_TAG)
 
@@ -23,7 +25,9 @@ static void BZ_FN(to_bernstein_mid)(const double *p, int n, double m, double rl,
     t[0] = p[0];
     for (int k = 1; k <= N; ++k)
         t[k] = p[k];
+    BZ_FIXED_UNROLL
     for (int i = 0; i < N; ++i) /* Taylor shift: t(y) = p(m + y), repeated synthetic division */
+        BZ_FIXED_UNROLL
         for (int k = N - 1; k >= i; --k)
             t[k] += m * t[k + 1];
     double fl = 1.0, fr = 1.0;   /* (-rl)^j / C(n, j), rr^j / C(n, j); C(n, j) = C(n, j - 1) (n - j + 1) / j */
@@ -37,7 +41,9 @@ static void BZ_FN(to_bernstein_mid)(const double *p, int n, double m, double rl,
         W[j] = t[j] * fl;
         R[j] = t[j] * fr;
     }
+    BZ_FIXED_UNROLL
     for (int k = 1; k <= N; ++k) /* b_i = sum_j C(i, j) w_j: Pascal's triangle, additions only */
+        BZ_FIXED_UNROLL
         for (int i = N; i >= k; --i) {
             W[i] += W[i - 1];
             R[i] += R[i - 1];
@@ -56,7 +62,9 @@ static void BZ_FN(split_half)(const double *b, int n, double *L, double *R)
         w[i] = b[i];
     L[0] = w[0];
     R[N] = w[N];
+    BZ_FIXED_UNROLL
     for (int k = 1; k <= N; ++k) {
+        BZ_FIXED_UNROLL
         for (int i = 0; i <= N - k; ++i)
             w[i] = 0.5 * (w[i] + w[i + 1]);
         L[k] = w[0];
@@ -173,6 +181,7 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double tl, double tr, int s
 }
 
 #undef BZ_FN
+#undef BZ_FIXED_UNROLL
 #undef N
 #undef BZ_TAG
 #ifdef BZ_ANY_DEGREE
