@@ -1,8 +1,8 @@
 /* Body of the Bernstein-subdivision solver, included by roots_bernstein.c once per specialised degree.
  *
  * Before each inclusion define BZ_TAG (the suffix of the function names: a degree such as 4, or `any`) and,
- * for the any-degree version, BZ_ANY_DEGREE. With a fixed degree N is a constant and the compiler unrolls
- * the O(n^2) loops; otherwise N is the run-time degree n. Every function takes n either way. Not a public
+ * for the any-degree version, BZ_ANY_DEGREE. With a fixed degree N is a constant and the O(n^2) loops are
+ * unrolled completely (BZ_UNROLL), so the coefficients stay in registers; otherwise N is the run-time degree n. Every function takes n either way. Not a public
  * header: it has no include guard on purpose, and it undefines its macros at the end.
  */
 #ifdef BZ_ANY_DEGREE
@@ -26,10 +26,11 @@ static void BZ_FN(to_bernstein_mid)(const double *p, int n, double m, double rl,
     for (int k = 1; k <= N; ++k)
         t[k] = p[k];
     BZ_FIXED_UNROLL
-    for (int i = 0; i < N; ++i) /* Taylor shift: t(y) = p(m + y), repeated synthetic division */
+    for (int i = 0; i < N; ++i) { /* Taylor shift: t(y) = p(m + y), repeated synthetic division */
         BZ_FIXED_UNROLL
         for (int k = N - 1; k >= i; --k)
             t[k] += m * t[k + 1];
+    }
     double fl = 1.0, fr = 1.0;   /* (-rl)^j / C(n, j), rr^j / C(n, j); C(n, j) = C(n, j - 1) (n - j + 1) / j */
     double W[IG_MAX_DEGREE + 1]; /* the left half in the reflected variable (0 at m, 1 at m - rl) */
     W[0] = t[0];
@@ -42,12 +43,13 @@ static void BZ_FN(to_bernstein_mid)(const double *p, int n, double m, double rl,
         R[j] = t[j] * fr;
     }
     BZ_FIXED_UNROLL
-    for (int k = 1; k <= N; ++k) /* b_i = sum_j C(i, j) w_j: Pascal's triangle, additions only */
+    for (int k = 1; k <= N; ++k) { /* b_i = sum_j C(i, j) w_j: Pascal's triangle, additions only */
         BZ_FIXED_UNROLL
         for (int i = N; i >= k; --i) {
             W[i] += W[i - 1];
             R[i] += R[i - 1];
         }
+    }
     for (int i = 0; i <= N; ++i)
         L[i] = W[N - i];
 }
