@@ -33,6 +33,9 @@ static inline void ig_two_prod(double a, double b, double *p, double *e)
     *p = x;
 }
 
+/* The larger of a and b, ignoring a NaN in b (fmax is a library call unless math errors are off). */
+static inline double ig_max(double a, double b) { return b > a ? b : a; }
+
 /* c[0] + c[1] x + ... + c[n] x^n by Horner's rule. */
 static inline double ig_horner(const double *c, int n, double x)
 {

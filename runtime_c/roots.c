@@ -74,7 +74,7 @@ static int solve_general(const double *p, int n, double lo, double hi, int metho
         if (a > b)
             return 0;
     }
-    double big = fmax(fabs(a), fabs(b));
+    double big = ig_max(fabs(a), fabs(b));
     /* coefficients are at most ~2^200 (see ig_real_roots_any); |x|^n below 2^524 keeps Horner and the
      * splitting of Dekker's product (another 2^27) far from overflow */
     if (big <= 0x1p20 || (double)n * ilogb(big) < 500.0) /* n <= 24: 2^20 is always safe */

@@ -157,7 +157,7 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
      * scaling (3 roundings per power) and Pascal's additions (n levels) add gamma_4n relative to what they sum.
      * Every term is bounded by M = sum |p_k| (|m| + r)^k with r the larger half, |m| + r = max(|a|, |b|), so
      * each coefficient is within 6 n u M (with room for the second-order terms below) of the exact one. */
-    double M = ig_horner_abs(p, n, fmax(fabs(a), fabs(b)));
+    double M = ig_horner_abs(p, n, ig_max(fabs(a), fabs(b)));
     double tol = 7.0 * n * IG_U * M;
     if (!isfinite(tol))
         return ig_bracket_interval(p, n, a, b, out);

@@ -161,14 +161,14 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double tl, double tr, int s
     /* Coefficients of uncertain sign: converted afresh on this piece, the rounding is at the scale of p here,
      * sum |p_k| max(|tl|, |tr|)^k, which can be far below the inherited one (p small near the expansion point
      * of the ray polynomial, or a piece far from the larger end of the interval). */
-    double tol_here = unsure > 0 ? 7.0 * N * IG_U * ig_horner_abs(c->p, n, fmax(fabs(tl), fabs(tr))) : tol;
+    double tol_here = unsure > 0 ? 7.0 * N * IG_U * ig_horner_abs(c->p, n, ig_max(fabs(tl), fabs(tr))) : tol;
     if (tol_here < 0.25 * tol) {
         BZ_FN(to_bernstein_mid)(c->p, n, tm, tm - tl, tr - tm, L, R);
         tol = tol_here;
     } else {
         double big = 0.0;
         for (int i = 0; i <= N; ++i)
-            big = fmax(big, fabs(b[i]));
+            big = ig_max(big, fabs(b[i]));
         BZ_FN(split_half)(b, n, L, R);
         /* the halving's own rounding: one per level of averages, each below u times the largest coefficient */
         tol += (N + 1) * IG_U * big;

@@ -79,7 +79,7 @@ static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n
     double big = 0.0, g2m = 2.0 * m * IG_U;
     g2m = g2m / (1.0 - g2m);
     if (final) {
-        big = ig_horner_abs(q, m, fmax(fabs(a), fabs(b))) * g2m;
+        big = ig_horner_abs(q, m, ig_max(fabs(a), fabs(b))) * g2m;
     }
     for (int i = 0; i < np; ++i) {
         v[i] = ig_horner(q, m, xs[i]);

@@ -92,6 +92,21 @@ typedef struct rt_tracer {
     double *stats;
 } rt_tracer;
 
+/* x^e for the Phong highlight, x in (0, 1]: a whole exponent up to 1024 (the usual shininess) by repeated
+ * squaring, a few multiplications instead of a call to pow; any other by pow. */
+static double highlight_power(double x, double e)
+{
+    if (e >= 0.0 && e <= 1024.0 && e == (double)(int)e) {
+        double r = 1.0;
+        int k = (int)e;
+        for (; k > 0; k >>= 1, x *= x)
+            if (k & 1)
+                r *= x;
+        return r;
+    }
+    return pow(x, e);
+}
+
 static double media_ior(const rt_scene *s, const rt_media *m)
 {
     return m->n > 0 ? s->materials[m->mat[m->n - 1]].ior : 1.0;
@@ -236,7 +251,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
                 normalize3(hv);
                 ndh = rt_dot(nf, hv);
                 if (ndh > 0.0)
-                    spec = m->specular * pow(ndh, m->shininess);
+                    spec = m->specular * highlight_power(ndh, m->shininess);
             }
             for (a = 0; a < 3; ++a)
                 local[a] += T[a] * lc[a] * (m->diffuse * base[a] * ndl + spec);
