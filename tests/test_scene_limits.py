@@ -118,7 +118,8 @@ def test_alias_bomb_is_refused_at_once(tmp_path):
     start = time.perf_counter()
     with pytest.raises(UserError, match=f"more than {MAX_YAML_NODES} values once its aliases are expanded"):
         load_scene(path)
-    assert time.perf_counter() - start < 1.0
+    # a hang guard, not a timing: expanding the 2^40 values would take hours and all the memory there is
+    assert time.perf_counter() - start < 10.0
 
 
 def test_recursive_alias_is_refused(tmp_path):
