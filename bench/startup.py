@@ -54,6 +54,20 @@ def heavy_imports(render_args: list[str], env: dict) -> list[str]:
     return [m for m in line.removeprefix("heavy:").split(",") if m]
 
 
+def runtime_compile_times(tmp: Path) -> list[tuple[str, float]]:
+    """Seconds to compile each C runtime source once with the build flags (what the first build of a new
+    cache pays, one file per core; afterwards the cache keeps the objects), slowest first."""
+    from implgen.clib import BASE_FLAGS, compiler
+    from implgen.resources import runtime_dir
+
+    src = runtime_dir()
+    out = []
+    for c in sorted(src.glob("*.c")):
+        cmd = [compiler(), *BASE_FLAGS, "-c", str(c), "-o", str(tmp / (c.stem + ".o")), f"-I{src}"]
+        out.append((c.name, timed(cmd, dict(os.environ))))
+    return sorted(out, key=lambda x: -x[1])
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=5, help="timed rounds (default 5)")
@@ -76,6 +90,7 @@ def main() -> int:
             cold[name] = timed(implgen_command() + a, env)  # parse, generate, compile: fills the cache
             commands[f"implgen render {name} (cached)"] = implgen_command() + a
         heavy = heavy_imports(next(iter(render_args.values())), env)
+        compile_times = runtime_compile_times(Path(tmp))
         times: dict[str, list[float]] = {k: [] for k in commands}
         for _ in range(max(1, args.runs)):
             for k, cmd in commands.items():
@@ -109,6 +124,16 @@ def main() -> int:
         "",
         f"Slowest cached render: {worst:.3f} s, target {TARGET} s: **{verdict}**. "
         f"Heavy modules a cached render imports ({', '.join(HEAVY)}): {', '.join(heavy) or 'none'}.",
+        "",
+        "## First build of the C runtime",
+        "",
+        "Wall seconds to compile each runtime source once with the build flags (timed once each, one after "
+        "another; a first build runs one compiler per core, and the build cache keeps every object after that). "
+        f"Total: {sum(t for _, t in compile_times):.2f} s.",
+        "",
+        "| source | compile (s) |",
+        "|---|---:|",
+        *(f"| {name} | {t:.2f} |" for name, t in compile_times),
         "",
     ]
     text = "\n".join(lines)
