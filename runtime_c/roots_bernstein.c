@@ -30,6 +30,10 @@
  * both modes and each undecided piece is bracketed the same way, so the first root in first-root mode is
  * bitwise the first root of the full search.
  *
+ * `auto` (roots.c) uses this method except on the whole line at degree <= 8 when every root may be real
+ * (Newton's inequalities hold): there isolating each root by halving from the root bound is what bracketing
+ * does better, and multiple roots and clusters would end here after BZ_MAX_DEPTH halvings anyway.
+ *
  * Speed: the body (roots_bernstein_body.h) is compiled once per degree 3 .. 12 and 14, 16, .. 24 with the
  * degree a constant, so the O(n^2) loops unroll into straight-line code, and once more for any degree.
  */
