@@ -81,7 +81,7 @@ static int end_sign(const bz_ctx *c, double bv, double t, double tol, double *va
 static void bz_fallback(bz_ctx *c, double tl, double tr)
 {
     double r[IG_ROOT_BUF];
-    int k = ig_bracket_interval(c->p, c->n, tl, tr, r);
+    int k = c->first ? ig_bracket_first(c->p, c->n, tl, tr, r) : ig_bracket_interval(c->p, c->n, tl, tr, r);
     for (int i = 0; i < k && c->nfb < IG_MAX_DEGREE + 2; ++i)
         c->fb[c->nfb++] = r[i];
     if (c->fallbacks)
@@ -144,11 +144,17 @@ static const struct {
                             BZ_ENTRY(18), BZ_ENTRY(20), BZ_ENTRY(22), BZ_ENTRY(24)};
 #undef BZ_ENTRY
 
+/* [a, b] as a whole to bracketing (its first-root mode when first != 0: bitwise the first of its list). */
+static int bracket_whole(const double *p, int n, double a, double b, int first, double *out)
+{
+    return first ? ig_bracket_first(p, n, a, b, out) : ig_bracket_interval(p, n, a, b, out);
+}
+
 static int bernstein(const double *p, int n, double a, double b, int first, double *out, int *fallbacks)
 {
     double m = 0.5 * a + 0.5 * b;
     if (!(m > a && m < b) || !isfinite(b - a))
-        return ig_bracket_interval(p, n, a, b, out);
+        return bracket_whole(p, n, a, b, first, out);
     /* Rounding: the Taylor shift to m errs by at most gamma_2n times the same shift on |p_k| and |m|; the
      * scaling (3 roundings per power) and Pascal's additions (n levels) add gamma_4n relative to what they sum.
      * Every term is bounded by M = sum |p_k| (|m| + r)^k with r the larger half, |m| + r = max(|a|, |b|), so
@@ -156,7 +162,7 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     double M = ig_horner_abs(p, n, fmax(fabs(a), fabs(b)));
     double tol = 7.0 * n * IG_U * M;
     if (!isfinite(tol))
-        return ig_bracket_interval(p, n, a, b, out);
+        return bracket_whole(p, n, a, b, first, out);
     bz_ctx c;
     c.p = p;
     c.n = n;
@@ -176,7 +182,7 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     int sl = end_sign(&c, L[0], a, tol, &vl), sr = end_sign(&c, R[n], b, tol, &vr);
     int sm = end_sign(&c, R[0], m, tol, &vm);
     if (sl == 0 || sr == 0 || sm == 0) /* a root at an end or the middle (within rounding) */
-        return ig_bracket_interval(p, n, a, b, out);
+        return bracket_whole(p, n, a, b, first, out);
     piece(&c, L, a, m, sl, sm, vl, vm, tol, 1);
     piece(&c, R, m, b, sm, sr, vm, vr, tol, 1);
     if (first) { /* the leftmost piece holding a root ended the search */

@@ -11,7 +11,7 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from implgen.roots.solvers import first_root, real_roots, real_roots_batch
+from implgen.roots.solvers import first_root, first_root_batch, real_roots, real_roots_batch
 
 
 def exact_poly(roots, pairs=()) -> np.ndarray:
@@ -148,3 +148,30 @@ def test_random_real_rooted_quartics_to_octics() -> None:
         got = auto[i, : counts[i]]
         check_roots(c[i][: len(want) + 1], want, got, i)
         assert first_root(c[i]) == got[0]
+
+
+@pytest.mark.parametrize("method", ["bracket", "auto", "bernstein"])
+def test_first_root_mode_on_multiple_roots(method: str) -> None:
+    """Bracketing's first-root mode stops at the first root of its last level; with multiple roots (two
+    polished reports of one triple root can come out in either order) it must still be bitwise the smallest
+    of the full list. Degrees 3-12, dyadic roots of multiplicity 1-4, whole line and finite intervals."""
+    rng = np.random.default_rng(21)
+    triple = exact_poly([-3.0] * 3 + [-2.25, -1.0, 0.375, 0.625])  # reported twice near -3, out of order
+    assert real_roots(triple, method="bracket").size == 6
+    rows, lo, hi = [np.pad(triple, (0, 5))], [-np.inf], [np.inf]
+    for _ in range(300):
+        n = int(rng.integers(3, 13))
+        roots: list[float] = []
+        while len(roots) < n:
+            roots += [float(rng.integers(-24, 25)) / 8.0] * int(rng.integers(1, 5))
+        rows.append(np.pad(exact_poly(roots[:n]), (0, 12 - n)))
+        finite = rng.random() < 0.4
+        lo.append(float(rng.uniform(-4, 0)) if finite else -np.inf)
+        hi.append(float(rng.uniform(0, 4)) if finite else np.inf)
+    c, lo, hi = np.array(rows), np.array(lo), np.array(hi)
+    roots, counts = real_roots_batch(c, lo, hi, method)
+    first, fcounts = first_root_batch(c, lo, hi, method)
+    assert np.array_equal(fcounts, (counts > 0).astype(fcounts.dtype))
+    has = counts > 0
+    assert has.sum() > 200
+    np.testing.assert_array_equal(first[has], roots[has, 0])
