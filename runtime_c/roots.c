@@ -33,7 +33,7 @@ static int solve_interval(int method, int first, int *fallbacks, const double *p
         return first ? ig_bernstein_first(p, n, a, b, fallbacks, out)
                      : ig_bernstein_interval(p, n, a, b, fallbacks, out);
     default:
-        return first ? ig_bracket_first(p, n, a, b, out) : ig_bracket_interval(p, n, a, b, out);
+        return ig_bracket_roots(p, n, a, b, first, out);
     }
 }
 

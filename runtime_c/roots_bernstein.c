@@ -81,7 +81,7 @@ static int end_sign(const bz_ctx *c, double bv, double t, double tol, double *va
 static void bz_fallback(bz_ctx *c, double tl, double tr)
 {
     double r[IG_ROOT_BUF];
-    int k = c->first ? ig_bracket_first(c->p, c->n, tl, tr, r) : ig_bracket_interval(c->p, c->n, tl, tr, r);
+    int k = ig_bracket_roots(c->p, c->n, tl, tr, c->first, r);
     for (int i = 0; i < k && c->nfb < IG_MAX_DEGREE + 2; ++i)
         c->fb[c->nfb++] = r[i];
     if (c->fallbacks)
@@ -147,7 +147,7 @@ static const struct {
 /* [a, b] as a whole to bracketing (its first-root mode when first != 0: bitwise the first of its list). */
 static int bracket_whole(const double *p, int n, double a, double b, int first, double *out)
 {
-    return first ? ig_bracket_first(p, n, a, b, out) : ig_bracket_interval(p, n, a, b, out);
+    return ig_bracket_roots(p, n, a, b, first, out);
 }
 
 static int bernstein(const double *p, int n, double a, double b, int first, double *out, int *fallbacks)

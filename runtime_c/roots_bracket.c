@@ -220,7 +220,7 @@ static int derivative_chain(const double *p, int n, double a, double b, double (
     return nc;
 }
 
-static int bracket(const double *p, int n, double a, double b, int first, double *out)
+int ig_bracket_roots(const double *p, int n, double a, double b, int first, double *out)
 {
     double chain[IG_MAX_DEGREE][IG_MAX_DEGREE + 1];
     double buf[2][IG_MAX_DEGREE + 2];
@@ -234,6 +234,12 @@ static int bracket(const double *p, int n, double a, double b, int first, double
     return nc;
 }
 
-int ig_bracket_interval(const double *p, int n, double a, double b, double *out) { return bracket(p, n, a, b, 0, out); }
+int ig_bracket_interval(const double *p, int n, double a, double b, double *out)
+{
+    return ig_bracket_roots(p, n, a, b, 0, out);
+}
 
-int ig_bracket_first(const double *p, int n, double a, double b, double *out) { return bracket(p, n, a, b, 1, out); }
+int ig_bracket_first(const double *p, int n, double a, double b, double *out)
+{
+    return ig_bracket_roots(p, n, a, b, 1, out);
+}

@@ -62,6 +62,9 @@ int ig_bracket_interval(const double *c, int n, double a, double b, double *r);
  * derivative levels run lazily left to right. */
 int ig_bracket_first(const double *c, int n, double a, double b, double *r);
 
+/* ig_bracket_first when first != 0, else ig_bracket_interval. */
+int ig_bracket_roots(const double *c, int n, double a, double b, int first, double *r);
+
 /* Bernstein subdivision on a finite [a, b], same preconditions; hands a piece it cannot decide to
  * ig_bracket_interval (and counts it in *fallbacks unless that is NULL). _first: the leftmost root only. */
 int ig_bernstein_interval(const double *c, int n, double a, double b, int *fallbacks, double *r);
