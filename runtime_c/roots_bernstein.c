@@ -30,6 +30,10 @@
  * both modes and each undecided piece is bracketed the same way, so the first root in first-root mode is
  * bitwise the first root of the full search.
  *
+ * `auto` (roots.c) uses this method except on the whole line at degree <= 8 when every root may be real
+ * (Newton's inequalities hold): there isolating each root by halving from the root bound is what bracketing
+ * does better, and multiple roots and clusters would end here after BZ_MAX_DEPTH halvings anyway.
+ *
  * Speed: the body (roots_bernstein_body.h) is compiled once per degree 3 .. 12 and 14, 16, .. 24 with the
  * degree a constant, so the O(n^2) loops unroll into straight-line code, and once more for any degree.
  */
@@ -77,7 +81,7 @@ static int end_sign(const bz_ctx *c, double bv, double t, double tol, double *va
 static void bz_fallback(bz_ctx *c, double tl, double tr)
 {
     double r[IG_ROOT_BUF];
-    int k = ig_bracket_interval(c->p, c->n, tl, tr, r);
+    int k = ig_bracket_roots(c->p, c->n, tl, tr, c->first, r);
     for (int i = 0; i < k && c->nfb < IG_MAX_DEGREE + 2; ++i)
         c->fb[c->nfb++] = r[i];
     if (c->fallbacks)
@@ -148,11 +152,17 @@ static const struct {
                             BZ_ENTRY(18), BZ_ENTRY(20), BZ_ENTRY(22), BZ_ENTRY(24)};
 #undef BZ_ENTRY
 
+/* [a, b] as a whole to bracketing (its first-root mode when first != 0: bitwise the first of its list). */
+static int bracket_whole(const double *p, int n, double a, double b, int first, double *out)
+{
+    return ig_bracket_roots(p, n, a, b, first, out);
+}
+
 static int bernstein(const double *p, int n, double a, double b, int first, double *out, int *fallbacks)
 {
     double m = 0.5 * a + 0.5 * b;
     if (!(m > a && m < b) || !isfinite(b - a))
-        return ig_bracket_interval(p, n, a, b, out);
+        return bracket_whole(p, n, a, b, first, out);
     /* Rounding: the Taylor shift to m errs by at most gamma_2n times the same shift on |p_k| and |m|; the
      * scaling (3 roundings per power) and Pascal's additions (n levels) add gamma_4n relative to what they sum.
      * Every term is bounded by M = sum |p_k| (|m| + r)^k with r the larger half, |m| + r = max(|a|, |b|), so
@@ -160,7 +170,7 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     double M = ig_horner_abs(p, n, ig_max(fabs(a), fabs(b)));
     double tol = 7.0 * n * IG_U * M;
     if (!isfinite(tol))
-        return ig_bracket_interval(p, n, a, b, out);
+        return bracket_whole(p, n, a, b, first, out);
     bz_ctx c;
     c.p = p;
     c.n = n;
@@ -180,7 +190,7 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     int sl = end_sign(&c, L[0], a, tol, &vl), sr = end_sign(&c, R[n], b, tol, &vr);
     int sm = end_sign(&c, R[0], m, tol, &vm);
     if (sl == 0 || sr == 0 || sm == 0) /* a root at an end or the middle (within rounding) */
-        return ig_bracket_interval(p, n, a, b, out);
+        return bracket_whole(p, n, a, b, first, out);
     piece(&c, L, a, m, sl, sm, vl, vm, tol, 1);
     piece(&c, R, m, b, sm, sr, vm, vr, tol, 1);
     if (first) { /* the leftmost piece holding a root ended the search */

@@ -3,6 +3,9 @@
  * (roots_refine.c); those roots cut the interval for p^(n-4), and so on up to p. A piece end where p is zero
  * within rounding (certified by a compensated evaluation) is reported as a root: that is how a tangent (even
  * multiplicity) root, which has no sign change, is found, and why a tiny positive minimum is not.
+ *
+ * First-root mode (ig_bracket_first) runs the same levels and stops the last one at its first root, with the
+ * same helpers on the same inputs, so the root is bitwise the first of ig_bracket_interval's list.
  */
 #include "roots_impl.h"
 
@@ -55,6 +58,65 @@ static double polish_multiple(const double (*chain)[IG_MAX_DEGREE + 1], int n, d
     return best;
 }
 
+/* The rounding bound of a level: gamma_2m, and at the final level one a-priori bound for the whole interval,
+ * gamma_2m sum |q_k| max(|a|,|b|)^k. */
+static inline void level_bounds(const double *q, int m, double a, double b, int final, double *big, double *g2m)
+{
+    double g = 2.0 * m * IG_U;
+    *g2m = g / (1.0 - g);
+    *big = final ? ig_horner_abs(q, m, ig_max(fabs(a), fabs(b))) * *g2m : 0.0;
+}
+
+/* q at a point x of the level: value and sign; at the final level, where the coarse bound cannot decide, the
+ * bound at this very point, then the compensated value (the plain one may even have the wrong sign: refine
+ * must see the right one). *unsure: the certified sign was needed (a candidate for polish_multiple). */
+static inline void level_point(const double *q, int m, double x, int final, double big, double g2m, double *v, int *s,
+                               int *unsure)
+{
+    *v = ig_horner(q, m, x);
+    *s = (*v > 0.0) - (*v < 0.0);
+    *unsure = 0;
+    if (final && !(fabs(*v) > big)) {
+        double sum = ig_horner_abs(q, m, fabs(x)), vc;
+        if (fabs(*v) > g2m * sum)
+            return;
+        *s = ig_sign_certified(q, m, x, &vc);
+        *v = vc;
+        *unsure = 1;
+    }
+}
+
+/* An interior point of the final level whose sign needed certifying and is not zero: maybe a multiple root the
+ * critical point missed by rounding. Polish, and take it only if p is then certified zero (a tiny extremum that
+ * is not a root stays as it was). */
+static void level_polish(const double (*chain)[IG_MAX_DEGREE + 1], int n, const double *xs, int i, int *s, double *rv)
+{
+    double y = polish_multiple(chain, n, xs[i], xs[i - 1], xs[i + 1]), vy;
+    if (ig_sign_certified(chain[0], n, y, &vy) == 0) {
+        *s = 0;
+        *rv = y;
+    }
+}
+
+/* Start guess for the bracket [xs[i], xs[i+1]] of a level (last: the index of the last point, or any number
+ * above i + 1 while that is not known): the quadratic Taylor model at the critical end with the smaller |q|
+ * (q' = 0 there), q(xc) + q''(xc) (x - xc)^2 / 2 = 0. Near a tangent -- two roots either side of a shallow
+ * extremum -- Newton would otherwise converge only linearly towards them. */
+static inline double level_guess(const double *ddq, int m, const double *xs, const double *v, int i, int last)
+{
+    int e = fabs(v[i]) <= fabs(v[i + 1]) ? i : i + 1;
+    if (e == 0 || e == last)
+        e = (e == 0 && last > 1 && i + 1 < last) ? i + 1 : (e == last && i > 0 ? i : -1);
+    double x0 = NAN;
+    if (e >= 0) {
+        double dd = ig_horner(ddq, m - 2, xs[e]) * ((double)m * (m - 1));
+        double t = -2.0 * v[e] / dd;
+        if (t > 0.0)
+            x0 = xs[e] + (e == i ? 1.0 : -1.0) * sqrt(t);
+    }
+    return x0;
+}
+
 /* Roots of q (degree m) on [a, b] given its critical points crit[] (ascending, inside (a, b)): q is
  * monotonic between consecutive points. final != 0: q is the polynomial itself -- refine to full accuracy,
  * decide zeros with the certified sign (after polishing the critical point on dq = q' when q is small
@@ -62,7 +124,7 @@ static double polish_multiple(const double (*chain)[IG_MAX_DEGREE + 1], int n, d
  * the next level: a plain sign and a looser tolerance are enough (missing an even-multiplicity root of an
  * intermediate derivative leaves the next polynomial monotonic across it). out[] needs nc + 2 entries. */
 static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n, double a, double b,
-                          const double *crit, int nc, int final, double *out)
+                          const double *crit, int nc, int final, int first, double *out)
 {
     const double *q = chain[j], *ddq = chain[j + 2];
     const int m = n - j;
@@ -75,35 +137,44 @@ static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n
             xs[np++] = crit[i];
     if (b > a)
         xs[np++] = b;
-    /* one a-priori rounding bound for the whole interval: gamma_2m sum |q_k| max(|a|,|b|)^k */
-    double big = 0.0, g2m = 2.0 * m * IG_U;
-    g2m = g2m / (1.0 - g2m);
-    if (final) {
-        big = ig_horner_abs(q, m, ig_max(fabs(a), fabs(b))) * g2m;
-    }
-    for (int i = 0; i < np; ++i) {
-        v[i] = ig_horner(q, m, xs[i]);
-        s[i] = (v[i] > 0.0) - (v[i] < 0.0);
-        rv[i] = xs[i];
-        if (final && !(fabs(v[i]) > big)) {
-            /* the coarse bound could not decide: the bound at this very point, then the compensated value */
-            double sum = ig_horner_abs(q, m, fabs(xs[i])), vc;
-            if (fabs(v[i]) > g2m * sum)
-                continue;
-            s[i] = ig_sign_certified(q, m, xs[i], &vc);
-            v[i] = vc; /* the plain value may even have the wrong sign: refine must see the right one */
-            if (s[i] != 0 && i > 0 && i < np - 1) {
-                /* maybe a multiple root the critical point missed by rounding: polish, and take it only if p
-                 * is then certified zero (a tiny extremum that is not a root stays as it was) */
-                double y = polish_multiple(chain, n, xs[i], xs[i - 1], xs[i + 1]), vy;
-                if (ig_sign_certified(q, m, y, &vy) == 0) {
-                    s[i] = 0;
-                    rv[i] = y;
+    double big, g2m;
+    level_bounds(q, m, a, b, final, &big, &g2m);
+    double tol = final ? 2.0 * IG_U : 1e-7;
+    int unsure[IG_MAX_DEGREE + 2];
+    if (first) {
+        /* the first root only: points evaluated (and polished) left to right as far as the first root needs;
+         * the point after a bracket too, since a polish reads both neighbours of a point */
+        int known = 0;
+        for (int i = 0; i < np; ++i) {
+            for (; known < np && known <= i + 1; ++known) {
+                level_point(q, m, xs[known], final, big, g2m, &v[known], &s[known], &unsure[known]);
+                rv[known] = xs[known];
+            }
+            for (int k = i; k <= i + 1 && k < np; ++k)
+                if (unsure[k] && s[k] != 0 && k > 0 && k < np - 1) {
+                    level_polish(chain, n, xs, k, &s[k], &rv[k]);
+                    unsure[k] = 0;
                 }
+            if (s[i] == 0 && (final || (i > 0 && i < np - 1))) {
+                /* a polished zero may lie anywhere between its neighbours, so the next point's, when it is a
+                 * zero too, can be the smaller one (two critical points at a triple root); no later one can */
+                int next = i + 1 < np && s[i + 1] == 0 && (final || i + 1 < np - 1) && rv[i + 1] < rv[i];
+                out[0] = next ? rv[i + 1] : rv[i];
+                return 1;
+            }
+            if (i + 1 < np && s[i] * s[i + 1] < 0) { /* ig_refine_many is ig_refine lane by lane */
+                out[0] = ig_refine(q, m, xs[i], xs[i + 1], v[i], v[i + 1], tol, level_guess(ddq, m, xs, v, i, np - 1));
+                return 1;
             }
         }
+        return 0;
     }
-    double tol = final ? 2.0 * IG_U : 1e-7;
+    for (int i = 0; i < np; ++i) {
+        level_point(q, m, xs[i], final, big, g2m, &v[i], &s[i], &unsure[i]);
+        rv[i] = xs[i];
+        if (unsure[i] && s[i] != 0 && i > 0 && i < np - 1)
+            level_polish(chain, n, xs, i, &s[i], &rv[i]);
+    }
     /* brackets to refine, all at once (ig_refine_many); slot[] is where each root goes in out[] */
     double bl[IG_MAX_DEGREE + 1], br[IG_MAX_DEGREE + 1], bvl[IG_MAX_DEGREE + 1], bvr[IG_MAX_DEGREE + 1];
     double bx0[IG_MAX_DEGREE + 1], broot[IG_MAX_DEGREE + 1];
@@ -113,24 +184,11 @@ static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n
         if (s[i] == 0 && (final || (i > 0 && i < np - 1)))
             out[cnt++] = rv[i];
         if (i + 1 < np && s[i] * s[i + 1] < 0) {
-            /* Start guess from the quadratic Taylor model at the critical end with the smaller |q| (q' = 0
-             * there): q(xc) + q''(xc) (x - xc)^2 / 2 = 0. Near a tangent -- two roots either side of a
-             * shallow extremum -- Newton would otherwise converge only linearly towards them. */
-            int e = fabs(v[i]) <= fabs(v[i + 1]) ? i : i + 1;
-            if (e == 0 || e == np - 1)
-                e = (e == 0 && np > 2 && i + 1 < np - 1) ? i + 1 : (e == np - 1 && i > 0 ? i : -1);
-            double x0 = NAN;
-            if (e >= 0) {
-                double dd = ig_horner(ddq, m - 2, xs[e]) * ((double)m * (m - 1));
-                double t = -2.0 * v[e] / dd;
-                if (t > 0.0)
-                    x0 = xs[e] + (e == i ? 1.0 : -1.0) * sqrt(t);
-            }
             bl[nb] = xs[i];
             br[nb] = xs[i + 1];
             bvl[nb] = v[i];
             bvr[nb] = v[i + 1];
-            bx0[nb] = x0;
+            bx0[nb] = level_guess(ddq, m, xs, v, i, np - 1);
             slot[nb++] = cnt++;
         }
     }
@@ -142,11 +200,10 @@ static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n
     return cnt;
 }
 
-int ig_bracket_interval(const double *p, int n, double a, double b, double *out)
+/* chain[j] = p^(j) scaled to keep the leading coefficient of p: degree n - j, so p^(j) = n (n-1) ... (n-j+1)
+ * chain[j]; and the roots of chain[n - 2] (a quadratic) inside (a, b), ascending, into q2 (returns how many). */
+static int derivative_chain(const double *p, int n, double a, double b, double (*chain)[IG_MAX_DEGREE + 1], double *q2)
 {
-    /* chain[j] = p^(j) scaled to keep the leading coefficient of p: degree n - j, so p^(j) =
-     * n (n-1) ... (n-j+1) chain[j] */
-    double chain[IG_MAX_DEGREE][IG_MAX_DEGREE + 1];
     memcpy(chain[0], p, (size_t)(n + 1) * sizeof(double));
     for (int j = 1; j <= n - 1; ++j) {
         int m = n - j + 1; /* degree of chain[j - 1] */
@@ -154,20 +211,35 @@ int ig_bracket_interval(const double *p, int n, double a, double b, double *out)
         for (int k = 0; k < m; ++k)
             chain[j][k] = chain[j - 1][k + 1] * ((k + 1) * inv);
     }
+    double q[2];
+    const double *c2 = chain[n - 2];
+    int k = ig_quadratic(c2[0], c2[1], c2[2], q), nc = 0;
+    for (int i = 0; i < k; ++i)
+        if (q[i] > a && q[i] < b)
+            q2[nc++] = q[i];
+    return nc;
+}
+
+int ig_bracket_roots(const double *p, int n, double a, double b, int first, double *out)
+{
+    double chain[IG_MAX_DEGREE][IG_MAX_DEGREE + 1];
     double buf[2][IG_MAX_DEGREE + 2];
-    int cur = 0, nc = 0;
-    {
-        double q[2];
-        const double *c2 = chain[n - 2];
-        int k = ig_quadratic(c2[0], c2[1], c2[2], q);
-        for (int i = 0; i < k; ++i)
-            if (q[i] > a && q[i] < b)
-                buf[cur][nc++] = q[i];
-    }
+    int cur = 0, nc = derivative_chain(p, n, a, b, chain, buf[0]);
     for (int j = n - 3; j >= 0; --j) {
-        nc = monotone_level((const double(*)[IG_MAX_DEGREE + 1]) chain, j, n, a, b, buf[cur], nc, j == 0, buf[1 - cur]);
+        nc = monotone_level((const double(*)[IG_MAX_DEGREE + 1]) chain, j, n, a, b, buf[cur], nc, j == 0,
+                            first && j == 0, buf[1 - cur]);
         cur = 1 - cur;
     }
     memcpy(out, buf[cur], (size_t)nc * sizeof(double));
     return nc;
+}
+
+int ig_bracket_interval(const double *p, int n, double a, double b, double *out)
+{
+    return ig_bracket_roots(p, n, a, b, 0, out);
+}
+
+int ig_bracket_first(const double *p, int n, double a, double b, double *out)
+{
+    return ig_bracket_roots(p, n, a, b, 1, out);
 }

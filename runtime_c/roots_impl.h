@@ -58,6 +58,13 @@ int ig_closed_quartic(const double *c, double lo, double hi, int polish, double 
 /* Derivative bracketing on a finite [a, b] for exact degree n >= 3 (c[n] != 0, c[0] != 0). */
 int ig_bracket_interval(const double *c, int n, double a, double b, double *r);
 
+/* Its first root only (at most one, into r[0]): bitwise the first of ig_bracket_interval's list, with the
+ * derivative levels run lazily left to right. */
+int ig_bracket_first(const double *c, int n, double a, double b, double *r);
+
+/* ig_bracket_first when first != 0, else ig_bracket_interval. */
+int ig_bracket_roots(const double *c, int n, double a, double b, int first, double *r);
+
 /* Bernstein subdivision on a finite [a, b], same preconditions; hands a piece it cannot decide to
  * ig_bracket_interval (and counts it in *fallbacks unless that is NULL). _first: the leftmost root only. */
 int ig_bernstein_interval(const double *c, int n, double a, double b, int *fallbacks, double *r);
