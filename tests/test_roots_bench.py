@@ -121,7 +121,7 @@ def test_score_first() -> None:
 
 def test_bench_first_batch_matches_first_root_batch() -> None:
     c, lo, hi = shape_set(["torus_y", "torus_z"], 300, np.random.default_rng(9), shapes_dir=SHAPES_DIR)
-    for m in FIRST_METHODS + ["bracket"]:
+    for m in FIRST_METHODS:
         r1, n1, ns, total = bench_first_batch(c, lo, hi, m)
         r2, n2 = first_root_batch(c, lo, hi, m)
         np.testing.assert_array_equal(n1, n2)

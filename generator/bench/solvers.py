@@ -58,7 +58,7 @@ class Row:
 
 
 #: methods also timed in first-root mode (ig_first_root: the nearest hit, what the tracer asks for)
-FIRST_METHODS = ["bernstein", "auto"]
+FIRST_METHODS = ["bracket", "bernstein", "auto"]
 FIRST = " (first root)"
 
 
