@@ -1,4 +1,4 @@
-"""`auto` on the whole line: bracketing when Newton's inequalities say every root may be real (degree <= 8),
+"""`auto` on the whole line: bracketing when Newton's inequalities say every root may be real (degree <= 6),
 Bernstein subdivision otherwise (runtime_c/roots.c, auto_method). Checked against exact references: polynomials
 built from dyadic roots, whose double coefficients are the exact ones (asserted), so the roots are known exactly --
 double and quadruple (tangent) roots, a cluster 2^-10 apart, roots over 2^-24 .. 2^12; and that first-root mode
@@ -79,14 +79,15 @@ REAL_ROOTED = [
     ("cluster 2^-10 apart", [1.0, 1.0 + 2.0**-10, 1.0 + 2.0**-9, 1.0 + 3 * 2.0**-10, -1.5], []),
     ("roots 2^-24 .. 2^12", [2.0**-24, -(2.0**-12), 1.0, 2.0**12], []),
     ("cubic with a double root", [0.5, 0.5, -3.0], []),
-    ("degree 8, simple", [-3.0, -2.0, -1.0, -0.5, 0.25, 1.5, 2.5, 3.0], []),
-    ("degree 7, triple root", [0.375] * 3 + [-2.0, -1.0, 1.5, 2.5], []),
+    ("degree 6, simple", [-3.0, -2.0, -0.5, 0.25, 1.5, 3.0], []),
+    ("degree 6, triple root", [0.375] * 3 + [-2.0, 1.5, 2.5], []),
 ]
 # whole-line polynomials auto leaves to Bernstein subdivision
 NOT_SWITCHED = [
     ("complex pair", [1.0, -2.0], [(0.5, 1.0)], -np.inf, np.inf),
     ("double root beside a complex pair", [0.75, 0.75], [(-1.0, 2.0)], -np.inf, np.inf),
-    ("degree 9, real-rooted", [-3.0, -2.0, -1.0, -0.5, 0.25, 1.5, 2.5, 3.0, 3.5], [], -np.inf, np.inf),
+    ("degree 7, real-rooted", [-3.0, -2.0, -1.0, -0.5, 0.25, 1.5, 2.5], [], -np.inf, np.inf),
+    ("degree 7, triple root", [0.375] * 3 + [-2.0, -1.0, 1.5, 2.5], [], -np.inf, np.inf),
     ("real-rooted, finite interval", [0.75, 0.75, -2.0, 3.5], [], -4.0, 4.0),
     ("real-rooted, half line", [0.75, 0.75, -2.0, 3.5], [], 0.0, np.inf),
 ]
@@ -116,26 +117,26 @@ def test_other_polynomials_stay_with_bernstein(name: str, roots, pairs, lo: floa
 
 def test_dispatch_shows_in_the_last_bits() -> None:
     """Where bracketing and Bernstein disagree in the last bits, auto is bitwise the one the rule picks."""
-    deg8 = exact_poly([-3.0, -2.0, -1.0, -0.5, 0.25, 1.5, 2.5, 3.0])
-    deg9 = exact_poly([-3.0, -2.0, -1.0, -0.5, 0.25, 1.5, 2.5, 3.0, 3.5])
-    for c, pick in ((deg8, "bracket"), (deg9, "bernstein")):
+    deg6 = exact_poly([-2.5, -1.25, -0.5, 0.75, 1.5, 3.0])
+    deg7 = exact_poly([-3.0, -2.0, -1.0, -0.5, 0.25, 1.5, 2.5])
+    for c, pick in ((deg6, "bracket"), (deg7, "bernstein")):
         other = "bernstein" if pick == "bracket" else "bracket"
         assert not np.array_equal(real_roots(c, method=pick), real_roots(c, method=other))
         np.testing.assert_array_equal(real_roots(c), real_roots(c, method=pick))
 
 
-def test_random_real_rooted_quartics_to_octics() -> None:
-    """Products of random dyadic roots (some repeated), degree 3-8 on the whole line: exact count and values,
+def test_random_real_rooted_cubics_to_sextics() -> None:
+    """Products of random dyadic roots (some repeated), degree 3-6 on the whole line: exact count and values,
     auto equal to bracketing, first root bitwise the first of the list, in the batch entry points too."""
     rng = np.random.default_rng(12)
     rows, wants = [], []  # wants: the roots with multiplicity
     for _ in range(60):
-        n = int(rng.integers(3, 9))
+        n = int(rng.integers(3, 7))
         roots = [float(v) / 8.0 for v in rng.integers(-24, 25, size=n)]
         if rng.random() < 0.5:  # a double or triple root
             roots[1:3] = [roots[0], roots[0]] if rng.random() < 0.5 else [roots[0], roots[1]]
         c = exact_poly(roots)
-        rows.append(np.pad(c, (0, 8 - n)))
+        rows.append(np.pad(c, (0, 6 - n)))
         wants.append(roots)
     c = np.array(rows)
     auto, counts = real_roots_batch(c, method="auto")
