@@ -114,14 +114,14 @@ def render(
             result["code"] = cs.lib.rt_render_run(ctx, ptr)
             ends.append(time.perf_counter())  # here, not after the polling loop: that wakes every 0.1 s
 
-        t0 = time.perf_counter()
-        worker = threading.Thread(target=work, name="implgen-render", daemon=True)
-        worker.start()
         bar = None
-        if progress:
+        if progress:  # imported and drawn before the render starts: not beside it, competing for a core
             from tqdm import tqdm
 
             bar = tqdm(total=y1 - y0, unit="row", desc=Path(sc.source).name, leave=True)
+        t0 = time.perf_counter()
+        worker = threading.Thread(target=work, name="implgen-render", daemon=True)
+        worker.start()
         try:
             done = 0
             while True:
