@@ -71,7 +71,7 @@ static int clip_box(const ig_shape_prep *prep, const double o[3], const double d
 }
 
 /* The shift point: minimises sum over finite axes of (o_i + t d_i - c_i)^2, clamped to [t0, t1]. */
-static double shift_point(const ig_shape_prep *prep, const double o[3], const double d[3], double t0, double t1)
+double ig_shape_shift_point(const ig_shape_prep *prep, const double o[3], const double d[3], double t0, double t1)
 {
     double num = 0.0, den = 0.0;
     for (int k = 0; k < prep->nfinite; ++k) {
@@ -110,7 +110,7 @@ int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_p
     double t0 = tmin, t1 = tmax;
     if (prep->bounded && !clip_box(prep, o, d, &t0, &t1))
         return 0;
-    double ts = shift_point(prep, o, d, t0, t1);
+    double ts = ig_shape_shift_point(prep, o, d, t0, t1);
     if (!isfinite(ts))
         ts = 0.0;
     double os[3] = {o[0] + ts * d[0], o[1] + ts * d[1], o[2] + ts * d[2]};

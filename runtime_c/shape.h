@@ -52,6 +52,10 @@ typedef struct ig_shape_prep {
 
 void ig_shape_prepare(const ig_shape *shape, const double *params, ig_shape_prep *prep);
 
+/* The point ts of the ray o + t d, clamped to [t0, t1], that ig_shape_solve expands f(o + t d) around (shape.c
+ * explains the rule); 0 when it is not finite. */
+double ig_shape_shift_point(const ig_shape_prep *prep, const double o[3], const double d[3], double t0, double t1);
+
 /* The expansion a solve worked on: roots are ts + s for the roots s of sum_k c[k] s^k (degree prep->degree).
  * A caller that needs the solver's own view of f near a root (the tracer's error bound of a hit point) reads
  * it here instead of computing the coefficients again. */

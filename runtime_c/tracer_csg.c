@@ -204,21 +204,6 @@ int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d
     return n;
 }
 
-/* The solver's view of f at its root s (see solver_noise in tracer_hit.c): Horner's running error sum
- * sum |c_k| |tau|^k and the expansion's value at tau, the root's offset from the shift point. */
-static void expansion_noise(const ig_shape_expansion *ex, int deg, double s, rt_pending *hit)
-{
-    double tau = s - ex->ts, a = fabs(tau), sum = 0.0, val = 0.0;
-    int k;
-    for (k = deg; k >= 0; --k) {
-        sum = sum * a + fabs(ex->c[k]);
-        val = val * tau + ex->c[k];
-    }
-    hit->noise_known = 1;
-    hit->noise_sum = sum;
-    hit->noise_val = val;
-}
-
 int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, rt_pending *hit)
 {
     int k = s->objects[object];
@@ -270,7 +255,8 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
                 hit->face = 0;
                 hit->entering = 0;
                 hit->entering_known = 0;
-                expansion_noise(&ex, n->prep.degree, r[i], hit);
+                hit->noise_known = 1;
+                rt_expansion_noise(&ex, n->prep.degree, r[i], &hit->noise_sum, &hit->noise_val);
                 return 1;
             }
         }

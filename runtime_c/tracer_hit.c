@@ -90,6 +90,18 @@ static int ray_box(const double box[6], const rt_ray *r, double *t0, double *t1)
 #define RT_ERR_WORLD 32.0 /* x eps x magnitude of the world-space computation */
 #endif
 
+void rt_expansion_noise(const ig_shape_expansion *ex, int deg, double s, double *sum, double *val)
+{
+    double tau = s - ex->ts, a = fabs(tau), su = 0.0, v = 0.0;
+    int k;
+    for (k = deg; k >= 0; --k) {
+        su = su * a + fabs(ex->c[k]);
+        v = v * tau + ex->c[k];
+    }
+    *sum = su;
+    *val = v;
+}
+
 /* Rounding noise of f near the hit as the root solver sees it. The solver expands f(o + t d) around a point
  * of the ray next to the object (shape.c's shift point: nearest the centre of the box's finite axes, else the
  * coordinate origin). Two estimates, the larger wins: Horner's running error bound eps * sum |c_k| |tau|^k
@@ -105,29 +117,13 @@ static double solver_noise(const rt_node *n, const rt_hit_lazy *lz, const double
         sum = lz->noise_sum;
         horner = lz->noise_val;
     } else { /* a CSG leaf's root: an expansion by shape.c's rule (without its clamp to the clipped range) */
-        const double *oo = lz->oo, *od = lz->od;
-        double c[IG_MAX_DEGREE + 1], os[3], num = 0.0, den = 0.0, ts, tau, pw = 1.0;
-        for (k = 0; k < n->prep.nfinite; ++k) { /* the box's finite axes (none for an unbounded shape) */
-            a = n->prep.finite[k];
-            num += od[a] * (n->prep.centre[a] - oo[a]);
-            den += od[a] * od[a];
-        }
-        if (!(den > 0.0)) {
-            num = -rt_dot(oo, od);
-            den = rt_dot(od, od);
-        }
-        ts = den > 0.0 ? num / den : 0.0;
-        if (!isfinite(ts))
-            ts = 0.0;
+        ig_shape_expansion ex;
+        double os[3];
+        ex.ts = ig_shape_shift_point(&n->prep, lz->oo, lz->od, -INFINITY, INFINITY);
         for (a = 0; a < 3; ++a)
-            os[a] = oo[a] + ts * od[a];
-        n->shape->coeffs(os, od, n->params, c);
-        tau = t - ts;
-        for (k = 0; k <= deg; ++k) {
-            sum += fabs(c[k]) * pw;
-            pw *= fabs(tau);
-        }
-        horner = ig_horner(c, deg, tau);
+            os[a] = lz->oo[a] + ex.ts * lz->od[a];
+        n->shape->coeffs(os, lz->od, n->params, ex.c);
+        rt_expansion_noise(&ex, deg, t, &sum, &horner);
     }
     /* The secondary ray will be solved from its own shift point, not this one; when this ray's shift point
      * happens to sit at the hit, the sum above sees only |f(po)| ~ 0. So also expand along the segment from

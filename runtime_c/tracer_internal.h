@@ -119,6 +119,9 @@ int rt_clip_box(const double box[6], const double o[3], const double d[3], doubl
  * error bound hit->err too; otherwise hit->err is left for rt_hit_error, and lazy keeps what it needs. */
 void rt_finish_hit(const rt_scene *s, const rt_pending *p, const double o[3], const double d[3], rt_hit *hit,
                    rt_hit_lazy *lazy);
+/* The solver's view of f at the root s of the expansion ex (degree deg; see shape.h): Horner's running error
+ * sum |c_k| |tau|^k and the expansion's value at tau = s - ex->ts, the root's offset from the shift point. */
+void rt_expansion_noise(const ig_shape_expansion *ex, int deg, double s, double *sum, double *val);
 /* Works out hit->err if rt_finish_hit left it pending (else does nothing): the same value either way. */
 void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lazy);
 
