@@ -10,6 +10,11 @@ Used to check that a tracer change leaves pictures unchanged:
 per scene, how many pixels differ in the float image and in the 8-bit PNG, and lists the first differing ones.
 The scenes render at half their own size (at least 200 wide) with their own samples and depth.
 
+`time` times the render loop of each scene given (one thread, the C loop alone, as `implgen bench render`
+does) with a base runtime and with this one, interleaved run by run, and prints the medians and their ratio:
+
+    python bench/picture_diff.py time bench/scenes/heart.yaml --base /tmp/base/runtime_c --runs 7
+
 `callgrind` runs the render loop of one scene at 1 thread under valgrind (collecting only inside the render
 worker) and prints the instruction count:
 
@@ -128,6 +133,33 @@ def cmd_callgrind(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_time(args: argparse.Namespace) -> int:
+    import statistics
+
+    from implgen.bench.render import _measure
+    from implgen.scene.build import build_scene
+    from implgen.scene.load import load_scene
+    from implgen.scene.tracer import CScene
+
+    size = argparse.Namespace(width=args.width, height=args.height, spp=1)
+    for scene in map(Path, args.scenes):
+        sides = []
+        for runtime in (args.base, args.runtime):
+            _use_runtime(Path(runtime))
+            sc = load_scene(scene)
+            sides.append((CScene(sc, build_scene(sc)), sc))
+        seconds: list[list[float]] = [[], []]
+        for _ in range(args.runs):
+            for k, (cs, sc) in enumerate(sides):
+                seconds[k].append(_measure(cs, sc, size, 1)[0])
+        base, new = (statistics.median(s) for s in seconds)
+        line = f"{scene.stem}: base {base * 1e3:.1f} ms, this {new * 1e3:.1f} ms, this/base {new / base:.3f}"
+        print(line, flush=True)
+        for cs, _ in sides:
+            cs.close()
+    return 0
+
+
 def cmd_inner_render(args: argparse.Namespace) -> int:
     _render_one(Path(args.scene), Path(args.runtime), args.width, args.height, 1)
     return 0
@@ -146,6 +178,14 @@ def main() -> int:
     c.add_argument("b")
     c.add_argument("--show", type=int, default=10)
     c.set_defaults(func=cmd_compare)
+    t = sub.add_parser("time")
+    t.add_argument("scenes", nargs="+")
+    t.add_argument("--base", required=True, help="the runtime_c folder to compare against")
+    t.add_argument("--runtime", default=str(ROOT / "runtime_c"))
+    t.add_argument("--width", type=int, default=800)
+    t.add_argument("--height", type=int, default=600)
+    t.add_argument("--runs", type=int, default=7)
+    t.set_defaults(func=cmd_time)
     g = sub.add_parser("callgrind")
     g.add_argument("scene")
     g.add_argument("--runtime", default=str(ROOT / "runtime_c"))
