@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -60,7 +61,17 @@ def run(argv: Sequence[str]) -> int:
     return _resolve("implgen.codegen.command:main")(argv)
 
 
+def quiet_blas() -> None:
+    """NumPy's OpenBLAS starts a thread per core when it is imported, and each spins for ~0.1 s (again after
+    every large product) -- on the cores the render's threads need: measured on the sextic heart, 800x600,
+    2 threads, the render loop took 0.067-0.069 s beside the spinning pool and 0.060-0.063 s without it
+    (docs/tracer.md). implgen's linear algebra is 3x3, so one BLAS thread is plenty. Set before NumPy is
+    first imported (a subcommand's import); a value the user exported is left alone."""
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    quiet_blas()
     try:
         code = run(sys.argv[1:] if argv is None else argv)
     except UserError as err:
