@@ -8,6 +8,7 @@
  */
 #include "tracer_internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -204,6 +205,40 @@ int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d
     return n;
 }
 
+/* A plane: a top-level leaf of degree 1 without bounds, the ground of most scenes. Along the ray f is
+ * c0 + c1 t, with one root t = -c0 / c1, so the general solve's set-up is skipped: no unit direction (the
+ * quotient does not depend on the direction's length, so the world parameter t comes out directly, with one
+ * division), no shift point (for a line it gains nothing: f(o) is rounded relative to |grad f| |o|, as
+ * o + t d itself is), no solver call chain. 1: a hit in (tmin, tmax) and [lo, hi]; 0: no hit; -1: a
+ * coefficient not finite or c1 not a normal number -- the general path decides. */
+static int plane_hit(const rt_node *n, int k, const rt_ray *ray, double tmin, double tmax, double lo, double hi,
+                     rt_pending *hit)
+{
+    double oo[3], od[3], c[2], t;
+    const double *po = ray->o, *pd = ray->d;
+    if (!n->identity) {
+        rt_xform_point(n->minv, ray->o, oo);
+        rt_xform_vector(n->minv, ray->d, od);
+        po = oo;
+        pd = od;
+    }
+    n->shape->coeffs(po, pd, n->params, c);
+    if (!(fabs(c[0]) <= DBL_MAX) || !(fabs(c[1]) >= DBL_MIN && fabs(c[1]) <= DBL_MAX))
+        return -1;
+    t = -c[0] / c[1];
+    if (!(t > tmin && t < tmax && t >= lo && t <= hi))
+        return 0;
+    hit->t = t;
+    hit->leaf = k;
+    hit->face = 0;
+    hit->entering = 0;
+    hit->entering_known = 0;
+    hit->noise_known = 1; /* the expansion c0 + c1 t around the ray's origin, as rt_expansion_noise sums it */
+    hit->noise_sum = fabs(c[1]) * fabs(t) + fabs(c[0]);
+    hit->noise_val = c[1] * t + c[0];
+    return 1;
+}
+
 int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, rt_pending *hit)
 {
     int k = s->objects[object];
@@ -230,6 +265,11 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
         const double *po = ray->o, *pu = ray->u;
         ig_shape_expansion ex;
         int nr, i;
+        if (n->prep.degree == 1 && !n->prep.bounded) {
+            int got = plane_hit(n, k, ray, tmin, tmax, lo, hi, hit);
+            if (got >= 0)
+                return got;
+        }
         if (!n->identity) {
             rt_xform_point(n->minv, ray->o, oo);
             rt_xform_vector(n->minv, ray->d, od);

@@ -46,6 +46,7 @@ def test_ray_level_analytic(tmp_path: Path) -> None:
     assert "0 failures" in out
     assert re.search(r"sphere: 20000 random rays, hit/miss disagreements 0", out)
     assert re.search(r"transformed torus: 20000 rays \(\d+ hits\), hit/miss disagreements 0", out)
+    assert re.search(r"plane path: \d+ hits within 0\.\d+ of the tolerance", out)
 
 
 def test_a_band_of_rows_is_exactly_those_rows_of_the_image(tmp_path: Path) -> None:

@@ -362,6 +362,7 @@ int main(void)
     test_unbounded_and_shading();
     test_glass();
     test_shortcuts();
+    test_plane_path();
     printf("%d failures\n", failures);
     return failures;
 }

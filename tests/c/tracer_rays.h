@@ -9,6 +9,7 @@
 #include "torus_z.h"
 #include "piriform.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -77,5 +78,6 @@ void test_optics(void);
 void test_unbounded_and_shading(void);
 void test_glass(void);
 void test_shortcuts(void);
+void test_plane_path(void);
 
 #endif

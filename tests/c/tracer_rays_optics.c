@@ -389,3 +389,98 @@ void test_shortcuts(void)
         rt_scene_free(c);
     }
 }
+
+/* The plane path of rt_object_hit (a top-level leaf of degree 1 without bounds: one division instead of the
+ * general solve). Its t against the plane's answer worked out in long double from the transform, and against
+ * the general solve of the same leaf (rt_leaf_roots); rays parallel to the plane, starting on it, or with a
+ * direction component below the normal range (the general path decides those). */
+void test_plane_path(void)
+{
+    unsigned long long seed = 4242;
+    double worst = 0.0, worst_general = 0.0;
+    int trial, hits = 0, misses = 0, agree = 0;
+    for (trial = 0; trial < 40; ++trial) {
+        double R[9], M[12], axis[3], sc[3], T[3], cond;
+        rt_scene *s = rt_scene_new();
+        int i, k, obj, mat = add_matte(s);
+        for (i = 0; i < 3; ++i) {
+            axis[i] = 2 * urand(&seed) - 1;
+            sc[i] = trial % 2 ? pow(10.0, 4 * urand(&seed) - 2) : 1.0; /* non-uniform scales 1e-2 .. 1e2 */
+            T[i] = trial % 3 ? 20 * urand(&seed) - 10 : 1e4 * (2 * urand(&seed) - 1);
+        }
+        cond = fmax(fmax(sc[0], sc[1]), sc[2]) / fmin(fmin(sc[0], sc[1]), sc[2]);
+        rot_axis(axis, 6.28 * urand(&seed), R);
+        for (i = 0; i < 3; ++i) {
+            for (k = 0; k < 3; ++k)
+                M[4 * i + k] = R[3 * i + k] * sc[k];
+            M[4 * i + 3] = T[i];
+        }
+        obj = rt_scene_add_object(s, rt_scene_add_leaf(s, &plane_y, NULL, 0, M, mat));
+        CHECK(rt_scene_commit(s) == 0, "commit: %s", rt_scene_error(s));
+        for (k = 0; k < 500; ++k) {
+            double o[3], d[3], len = pow(10.0, 6 * urand(&seed) - 3), oo[3], od[3], r[IG_MAX_DEGREE + 2];
+            long double num = 0, den = 0, ts, mag = 0, magd = 0;
+            rt_pending ph;
+            int got, ng;
+            for (i = 0; i < 3; ++i) {
+                o[i] = T[i] + 40 * urand(&seed) - 20;
+                d[i] = len * (2 * urand(&seed) - 1);
+            }
+            /* world plane: column 1 of R (the object y axis, scaled) dotted with p - T vanishes */
+            for (i = 0; i < 3; ++i) {
+                num += (long double)R[3 * i + 1] * ((long double)T[i] - o[i]);
+                den += (long double)R[3 * i + 1] * d[i];
+                mag += fabsl((long double)R[3 * i + 1]) * (fabsl((long double)o[i]) + fabsl((long double)T[i]));
+                magd += fabsl((long double)R[3 * i + 1] * d[i]);
+            }
+            ts = num / den;
+            got = rt_scene_closest(s, o, d, 0, INFINITY, RT_CLOSEST, -1, &ph);
+            rt_to_object(&s->nodes[s->objects[obj]], o, d, oo, od);
+            ng = rt_leaf_roots(&s->nodes[s->objects[obj]], oo, od, 0, INFINITY, r);
+            if (ts > 0 && ts * len < 0.5 * s->far) {
+                /* t is off by the rounding of f(o) (relative to |o| + |T|) and of c1 (relative to the sum
+                 * of |terms|: a grazing ray cancels), times the condition number of the transform (its
+                 * inverse is rounded) */
+                long double tol = 64 * DBL_EPSILON * cond * (mag + ts * magd) / fabsl(den);
+                long double e = fabsl(ph.t - ts) / tol;
+                CHECK(got && ph.object == obj, "plane path: no hit at t = %.17g", (double)ts);
+                if (got) {
+                    ++hits;
+                    worst = (double)e > worst ? (double)e : worst;
+                }
+                if (ng > 0) {
+                    double eg = (double)(fabsl(r[0] - ts) / tol);
+                    worst_general = eg > worst_general ? eg : worst_general;
+                    agree += got && fabs(r[0] - ph.t) <= (double)tol;
+                }
+            } else if (ts <= 0) {
+                CHECK(!got, "plane path: a hit at t = %.17g behind the ray (plane at %.17g)", ph.t, (double)ts);
+                ++misses;
+            }
+        }
+        rt_scene_free(s);
+    }
+    CHECK(worst <= 1.0 && hits > 5000 && misses > 5000, "plane path: worst %.3g of tolerance, %d hits, %d misses",
+          worst, hits, misses);
+    CHECK(agree == hits, "plane path and general solve agree on %d of %d hits", agree, hits);
+    /* parallel, on the plane, a tiny direction component: the general path's answer */
+    {
+        rt_scene *s = rt_scene_new();
+        double o[3] = {0.3, 2.0, -1.0}, d[3] = {1.0, 0.0, 0.5}, on[3] = {0.3, 0.0, -1.0}, up[3] = {0.1, 1.0, 0};
+        double tiny[3] = {1.0, -1e-310, 0.0};
+        rt_pending ph;
+        int mat = add_matte(s);
+        rt_scene_add_object(s, rt_scene_add_leaf(s, &plane_y, NULL, 0, IDENTITY, mat));
+        CHECK(rt_scene_commit(s) == 0, "commit: %s", rt_scene_error(s));
+        CHECK(!rt_scene_closest(s, o, d, 0, INFINITY, RT_CLOSEST, -1, &ph), "a ray parallel to the plane hits it");
+        CHECK(!rt_scene_closest(s, on, up, 0, INFINITY, RT_CLOSEST, -1, &ph), "a ray leaving the plane hits it");
+        CHECK(!rt_scene_closest(s, on, d, 0, INFINITY, RT_CLOSEST, -1, &ph), "a ray inside the plane hits it");
+        d[1] = -1.0;
+        CHECK(rt_scene_closest(s, o, d, 0, INFINITY, RT_CLOSEST, -1, &ph) && ph.t == 2.0, "t = %.17g, not 2", ph.t);
+        /* c1 = -1e-310 is subnormal: the general path's root at 2e310 lies beyond the scene's far limit */
+        CHECK(!rt_scene_closest(s, o, tiny, 0, INFINITY, RT_CLOSEST, -1, &ph), "a hit beyond the far limit");
+        rt_scene_free(s);
+    }
+    printf("plane path: %d hits within %.3g of the tolerance (general solve %.3g), %d misses\n", hits, worst,
+           worst_general, misses);
+}
