@@ -30,6 +30,8 @@ static int solve_interval(int method, int first, int *fallbacks, const double *p
     case IG_ROOTS_STURM:
         return ig_sturm_interval(p, n, a, b, out);
     case IG_ROOTS_BERNSTEIN:
+        if (first == IG_ANY_ROOT)
+            return ig_bernstein_any(p, n, a, b, fallbacks, out);
         return first ? ig_bernstein_first(p, n, a, b, fallbacks, out)
                      : ig_bernstein_interval(p, n, a, b, fallbacks, out);
     default:

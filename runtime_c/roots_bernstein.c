@@ -47,7 +47,7 @@
 typedef struct {
     const double *p; /* power-form coefficients, exact degree n */
     int n;
-    int first; /* stop at the leftmost root */
+    int first; /* stop at the leftmost root (IG_FIRST_ROOT), left unrefined with IG_ANY_ROOT */
     double *out;
     int cnt;
     /* pieces the subdivision could not decide went to bracketing: their roots, and how many pieces */
@@ -212,5 +212,10 @@ int ig_bernstein_interval(const double *p, int n, double a, double b, int *fallb
 
 int ig_bernstein_first(const double *p, int n, double a, double b, int *fallbacks, double *out)
 {
-    return bernstein(p, n, a, b, 1, out, fallbacks);
+    return bernstein(p, n, a, b, IG_FIRST_ROOT, out, fallbacks);
+}
+
+int ig_bernstein_any(const double *p, int n, double a, double b, int *fallbacks, double *out)
+{
+    return bernstein(p, n, a, b, IG_ANY_ROOT, out, fallbacks);
 }

@@ -140,6 +140,10 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double tl, double tr, int s
         return;
     if (v == 1) { /* one simple root: refined now in first-root mode, else with the others at the end */
         double x0 = BZ_FN(polygon_crossing)(b, n, tl, tr);
+        if (c->first == IG_ANY_ROOT) { /* the root lies strictly inside (tl, tr): any point there says so */
+            c->out[c->cnt++] = x0 > tl && x0 < tr ? x0 : 0.5 * tl + 0.5 * tr;
+            return;
+        }
         if (c->first) {
             c->out[c->cnt++] = ig_refine(c->p, n, tl, tr, vl, vr, 2.0 * IG_U, x0);
             return;

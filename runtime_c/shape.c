@@ -12,6 +12,7 @@
  */
 #include "shape.h"
 #include "numerics.h"
+#include "roots_impl.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -117,7 +118,7 @@ int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_p
     double c[IG_MAX_DEGREE + 1];
     shape->coeffs(os, d, params, c);
     double s[IG_MAX_DEGREE];
-    int k = first ? ig_first_root(c, n, t0 - ts, t1 - ts, method, s) : ig_real_roots(c, n, t0 - ts, t1 - ts, method, s);
+    int k = ig_roots_core(c, n, t0 - ts, t1 - ts, (int)method, first, s);
     int m = 0;
     for (int i = 0; i < k; ++i) {
         double t = ts + s[i];

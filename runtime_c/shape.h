@@ -65,7 +65,10 @@ typedef struct ig_shape_expansion {
 } ig_shape_expansion;
 
 /* shape, params and roots must not be NULL; prep must come from ig_shape_prepare(shape, params). ex may be
- * NULL; otherwise, when a root is returned, *ex holds the expansion it came from (else *ex is unspecified). */
+ * NULL; otherwise, when a root is returned, *ex holds the expansion it came from (else *ex is unspecified).
+ * first: 0 all roots (ig_shape_roots), 1 the first (ig_shape_first_root), 2 a yes/no query -- at most one
+ * value, where a root may sit, possibly unrefined (the tracer's opaque shadow rays; roots_impl.h's
+ * IG_ANY_ROOT). */
 int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_prep *prep, const double o[3],
                    const double d[3], double tmin, double tmax, ig_root_method method, int first, double *roots,
                    ig_shape_expansion *ex);

@@ -7,6 +7,7 @@
  * merge. Operators combine span lists of their children with one sweep over the sorted endpoints.
  */
 #include "tracer_internal.h"
+#include "roots_impl.h"
 
 #include <float.h>
 #include <math.h>
@@ -239,7 +240,7 @@ static int plane_hit(const rt_node *n, int k, const rt_ray *ray, double tmin, do
     return 1;
 }
 
-int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, rt_pending *hit)
+int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, int any, rt_pending *hit)
 {
     int k = s->objects[object];
     const rt_node *n = &s->nodes[k];
@@ -284,8 +285,12 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
         } else if (!(L > 0.0) || !isfinite(L)) {
             return 0;
         }
-        nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, 1, r, &ex);
-        if (nr && !(r[0] / L > tmin))
+        /* an opaque shadow ray only asks whether there is a hit: the root need not be refined */
+        if (any && (n->material < 0 || s->materials[n->material].transparency > 0.0))
+            any = 0;
+        nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO,
+                            any ? IG_ANY_ROOT : IG_FIRST_ROOT, r, &ex);
+        if (nr && (!(r[0] / L > tmin) || (any && !(r[0] / L < tmax)))) /* (an unrefined point at an end) */
             nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, 0, r, &ex);
         for (i = 0; i < nr; ++i) {
             double t = r[i] / L;
@@ -295,8 +300,9 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
                 hit->face = 0;
                 hit->entering = 0;
                 hit->entering_known = 0;
-                hit->noise_known = 1;
-                rt_expansion_noise(&ex, n->prep.degree, r[i], &hit->noise_sum, &hit->noise_val);
+                hit->noise_known = !any; /* an opaque shadow hit is never finished */
+                if (!any)
+                    rt_expansion_noise(&ex, n->prep.degree, r[i], &hit->noise_sum, &hit->noise_val);
                 return 1;
             }
         }

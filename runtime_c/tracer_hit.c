@@ -328,7 +328,7 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
     /* A hit is kept when it is closer than the best so far (rt_object_hit only reports t < best). In
      * RT_ANY_OPAQUE mode a hit on an opaque material ends the search. */
 #define RT_TAKE(obj)                                                                                                   \
-    if ((obj) != skip && rt_object_hit(s, (obj), &ray, tmin, best, &h)) {                                              \
+    if ((obj) != skip && rt_object_hit(s, (obj), &ray, tmin, best, mode == RT_ANY_OPAQUE, &h)) {                       \
         *out = h;                                                                                                      \
         best = h.t;                                                                                                    \
         found = 1;                                                                                                     \

@@ -101,7 +101,8 @@ typedef struct rt_hit_lazy {
 
 /* Closest-hit query modes. RT_ANY_OPAQUE: the same, except that the search stops at the first hit on an
  * opaque material it meets (a shadow ray: any opaque hit in range is full shadow), which may not be the
- * closest one; a hit on a transparent material is still the closest hit. */
+ * closest one, and whose t may be unrefined (rt_object_hit's `any`); a hit on a transparent material is
+ * still the closest hit, refined. */
 enum { RT_CLOSEST = 0, RT_ANY_OPAQUE = 1 };
 /* The object a ray spawned at hit h need not test (rt_scene_closest's `skip`): h's object when it is flat
  * (a plane meets a line once, and that is h itself), else -1. */
@@ -133,7 +134,10 @@ int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], doub
 int rt_spans(const rt_scene *s, int node, const double o[3], const double d[3], double a, double b, rt_span *out,
              int max);
 /* Closest hit of one top-level object with tmin < t < tmax: 1 and *hit filled, or 0. */
-int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, rt_pending *hit);
+/* The nearest hit of one top-level object in (tmin, tmax). any != 0: a yes/no query for an opaque shadow ray --
+ * on an opaque top-level leaf the hit's t may be left unrefined (any point of the certified piece that holds
+ * the root, see IG_ANY_ROOT), so only its existence may be used. */
+int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, int any, rt_pending *hit);
 
 /* small vector helpers */
 static inline double rt_dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }

@@ -8,6 +8,7 @@
 
 #include "poly_from_roots.h"
 #include "roots.h"
+#include "roots_impl.h"
 
 /* method masks: bit m for ig_root_method m */
 #define NMETHODS 5
@@ -49,6 +50,30 @@ static void check_first(const char *name, const double *c, int n, double lo, dou
     }
 }
 
+/* The yes/no query (IG_ANY_ROOT, the tracer's opaque shadow rays): a value exactly when a root lies in
+ * [lo, hi], one double at most, inside [lo, hi] and -- a refined root or a point of a piece no longer than half
+ * the interval that holds one -- within half the interval of a wanted root. */
+static void check_any(const char *name, const double *c, int n, double lo, double hi, const double *want, int nw, int m)
+{
+    double f[4] = {-12345.0, -12345.0, -12345.0, -12345.0}, near = INFINITY;
+    int got = ig_roots_core(c, n, lo, hi, m, IG_ANY_ROOT, f);
+    int ok = got == (nw > 0) && f[1] == -12345.0 && f[2] == -12345.0 && f[3] == -12345.0;
+    for (int i = 0; i < nw; ++i)
+        near = fmin(near, fabs(f[0] - want[i]));
+    if (ok && got && (f[0] < lo || f[0] > hi || (isfinite(hi - lo) && !(near <= 0.5 * (hi - lo) * (1 + 1e-15)))))
+        ok = 0;
+    /* a certified piece holds one root and nothing else: no other wanted root between the value and its
+     * nearest (wanted roots are listed once, so two at the same distance means one on each side) */
+    for (int i = 0, at = 0; ok && got && i < nw; ++i)
+        if (fabs(f[0] - want[i]) == near && ++at > 1)
+            ok = 0;
+    if (!ok) {
+        ++failures;
+        fprintf(stderr, "FAIL any root of %s [%s]: got %d (%.17g), want %d\n", name, method_names[m], got, f[0],
+                nw > 0);
+    }
+}
+
 static void expect(const char *name, const double *c, int n, double lo, double hi, const double *want, int nw,
                    double rtol, int methods)
 {
@@ -82,6 +107,7 @@ static void expect(const char *name, const double *c, int n, double lo, double h
             fprintf(stderr, "\n");
         }
         check_first(name, c, n, lo, hi, want, nw, rtol, m, k, r);
+        check_any(name, c, n, lo, hi, want, nw, m);
     }
 }
 
@@ -251,6 +277,58 @@ int main(void)
             ++failures;
             fprintf(stderr, "FAIL first root: degree out of range accepted\n");
         }
+    }
+    { /* the yes/no query on simple dyadic roots (exact coefficients) over random dyadic intervals, so
+       * that Bernstein certifies pieces and answers with unrefined points */
+        unsigned long long st = 12345;
+        int unrefined = 0, queries = 0;
+        for (int trial = 0; trial < 3000; ++trial) {
+            double r[8], quad[3][2], w[8], lo, hi, c1[IG_MAX_DEGREE + 3], first = NAN, any = NAN;
+            int nr = 1 + (int)(trial % 5), nq = (int)(trial / 5 % 3), nw = 0;
+            for (int i = 0; i < nr; ++i) {
+                int again;
+                do { /* distinct multiples of 1/8 in [-2, 2] */
+                    st = st * 6364136223846793005ULL + 1442695040888963407ULL;
+                    r[i] = (double)((int)(st >> 33) % 33 - 16) / 8.0;
+                    again = 0;
+                    for (int j = 0; j < i; ++j)
+                        again |= r[j] == r[i];
+                } while (again);
+            }
+            for (int i = 0; i < nq; ++i) { /* x^2 + b x + q without real roots */
+                quad[i][0] = 0.25 * (double)(i + 1);
+                quad[i][1] = 0.5 + 0.5 * (double)i;
+            }
+            n = from_roots(r, nr, quad, nq, 1.0, c1);
+            st = st * 6364136223846793005ULL + 1442695040888963407ULL;
+            lo = (double)((int)(st >> 33) % 65 - 40) / 16.0 + 1.0 / 32.0; /* never a root */
+            st = st * 6364136223846793005ULL + 1442695040888963407ULL;
+            hi = lo + (double)(1 + (int)(st >> 33) % 64) / 16.0;
+            for (int i = 0; i < nr; ++i) /* sorted wanted roots inside [lo, hi] */
+                if (r[i] >= lo && r[i] <= hi) {
+                    int k = nw++;
+                    while (k > 0 && w[k - 1] > r[i]) {
+                        w[k] = w[k - 1];
+                        --k;
+                    }
+                    w[k] = r[i];
+                }
+            for (int m = 0; m < NMETHODS; ++m) {
+                if (!((1 << m) & GENERAL))
+                    continue;
+                check_any("random dyadic", c1, n, lo, hi, w, nw, m);
+                ++queries;
+                if (m == IG_ROOTS_BERNSTEIN && nw > 0 && ig_roots_core(c1, n, lo, hi, m, IG_ANY_ROOT, &any) == 1 &&
+                    ig_first_root(c1, n, lo, hi, (ig_root_method)m, &first) == 1 && any != first)
+                    ++unrefined;
+            }
+        }
+        if (unrefined < 1000) {
+            ++failures;
+            fprintf(stderr, "FAIL any root: only %d unrefined answers (the certified-piece path untested)\n",
+                    unrefined);
+        }
+        printf("any root: %d queries, %d answered by Bernstein with an unrefined point\n", queries, unrefined);
     }
     if (failures == 0)
         printf("test_roots: all cases passed\n");

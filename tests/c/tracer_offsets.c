@@ -75,7 +75,7 @@ static void random_rotation(unsigned long long *s, double R[9])
 }
 
 typedef struct counts {
-    long hits, rays, match, near, self, miss, extra, ambiguous, lost;
+    long hits, rays, match, near, self, miss, extra, ambiguous, lost, any_checked, any_differ;
     double err_max, err_sum, near_max;
 } counts;
 
@@ -179,6 +179,19 @@ static void run_scale(const ig_shape *shape, const double *params, double scale,
                     v[i] = h2.p[i] - h.p[i];
                 dist_tr = sqrt(rt_dot(v, v));
             }
+            { /* a shadow ray's yes/no query (RT_ANY_OPAQUE: the root may be left unrefined) says yes exactly when
+               * the closest-hit query finds a hit, on the whole ray and on segments ending short of and past
+               * the second hit */
+                double ends[3] = {INFINITY, got2 ? 0.75 * h2.t : 1.0, got2 ? 1.25 * h2.t : 2.0};
+                int e;
+                for (e = 0; e < 3 && c->hits % 4 == 0; ++e) { /* on every 4th hit point: the test's time */
+                    rt_pending pc, pa;
+                    int hc = rt_scene_closest(s, q, d2, 0.0, ends[e], RT_CLOSEST, -1, &pc);
+                    int ha = rt_scene_closest(s, q, d2, 0.0, ends[e], RT_ANY_OPAQUE, -1, &pa);
+                    ++c->any_checked;
+                    c->any_differ += hc != ha;
+                }
+            }
             if (D2 >= 0.0 && D2 * cosn < 2.0 * h.err) {
                 ++c->ambiguous; /* the second hit lies inside the band the offset skips */
             } else if (D2 >= 0.0 && self + 2 < nr && (roots[self + 2] - roots[self + 1]) * dl < 1e-4 * scale &&
@@ -264,9 +277,9 @@ int main(int argc, char **argv)
         for (j = 0; j < 5; ++j)
             run_scale(rt_test_shapes[k], rt_test_params[k], scales[j], per_shape / 5, &seed, &c);
         printf("%-10s hits %7ld rays %7ld match %7ld self-hits %ld misses %ld other %ld ambiguous %ld lost %ld "
-               "near %ld (worst %.1e) err/scale max %.2e mean %.2e\n",
+               "near %ld (worst %.1e) err/scale max %.2e mean %.2e any-opaque %ld differ %ld\n",
                rt_test_shapes[k]->name, c.hits, c.rays, c.match, c.self, c.miss, c.extra, c.ambiguous, c.lost, c.near,
-               c.near_max, c.err_max, c.hits ? c.err_sum / c.hits : 0.0);
+               c.near_max, c.err_max, c.hits ? c.err_sum / c.hits : 0.0, c.any_checked, c.any_differ);
         fails += c.self + c.miss;
     }
     printf("%ld failures\n", fails);
