@@ -4,7 +4,7 @@
 # second, checked for up to 2 minutes -- so that the tail of one run (a Dask cluster shutting down, page cache
 # writes) does not weigh on the next.
 #
-#   sh bench/run_all.sh                      # all of them, about 20 minutes on the project's 2-core machine
+#   sh bench/run_all.sh                      # all of them, about 12 minutes on the project's 2-core machine
 #   sh bench/run_all.sh solvers povray       # some: solvers gen render startup view animation povray gallery
 set -e
 cd "$(dirname "$0")/.."
