@@ -206,6 +206,16 @@ int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d
     return n;
 }
 
+/* A top-level leaf's surface hit at t, before rt_finish_hit works out its normal and side. */
+static void surface_hit(rt_pending *hit, int leaf, double t)
+{
+    hit->t = t;
+    hit->leaf = leaf;
+    hit->face = 0;
+    hit->entering = 0;
+    hit->entering_known = 0;
+}
+
 /* A plane: a top-level leaf of degree 1 without bounds, the ground of most scenes. Along the ray f is
  * c0 + c1 t, with one root t = -c0 / c1, so the general solve's set-up is skipped: no unit direction (the
  * quotient does not depend on the direction's length, so the world parameter t comes out directly, with one
@@ -229,11 +239,7 @@ static int plane_hit(const rt_node *n, int k, const rt_ray *ray, double tmin, do
     t = -c[0] / c[1];
     if (!(t > tmin && t < tmax && t >= lo && t <= hi))
         return 0;
-    hit->t = t;
-    hit->leaf = k;
-    hit->face = 0;
-    hit->entering = 0;
-    hit->entering_known = 0;
+    surface_hit(hit, k, t);
     hit->noise_known = 1; /* the expansion c0 + c1 t around the ray's origin, as rt_expansion_noise sums it */
     hit->noise_sum = fabs(c[1]) * fabs(t) + fabs(c[0]);
     hit->noise_val = c[1] * t + c[0];
@@ -286,7 +292,7 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
             return 0;
         }
         /* an opaque shadow ray only asks whether there is a hit: the root need not be refined */
-        if (any && (n->material < 0 || s->materials[n->material].transparency > 0.0))
+        if (any && !rt_leaf_opaque(s, n))
             any = 0;
         nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO,
                             any ? IG_ANY_ROOT : IG_FIRST_ROOT, r, &ex);
@@ -295,11 +301,7 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
         for (i = 0; i < nr; ++i) {
             double t = r[i] / L;
             if (t > tmin && t < tmax) {
-                hit->t = t;
-                hit->leaf = k;
-                hit->face = 0;
-                hit->entering = 0;
-                hit->entering_known = 0;
+                surface_hit(hit, k, t);
                 hit->noise_known = !any; /* an opaque shadow hit is never finished */
                 if (!any)
                     rt_expansion_noise(&ex, n->prep.degree, r[i], &hit->noise_sum, &hit->noise_val);

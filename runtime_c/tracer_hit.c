@@ -332,7 +332,7 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
         *out = h;                                                                                                      \
         best = h.t;                                                                                                    \
         found = 1;                                                                                                     \
-        if (mode == RT_ANY_OPAQUE && s->materials[s->nodes[h.leaf].material].transparency <= 0.0)                      \
+        if (mode == RT_ANY_OPAQUE && rt_leaf_opaque(s, &s->nodes[h.leaf]))                                             \
             return 1;                                                                                                  \
     }
     for (i = 0; i < s->nunbounded; ++i)

@@ -99,6 +99,12 @@ typedef struct rt_hit_lazy {
     double noise_sum, noise_val;
 } rt_hit_lazy;
 
+/* A leaf whose material stops light: a shadow ray that meets it is in full shadow (RT_ANY_OPAQUE). */
+static inline int rt_leaf_opaque(const rt_scene *s, const rt_node *n)
+{
+    return n->material >= 0 && s->materials[n->material].transparency <= 0.0;
+}
+
 /* Closest-hit query modes. RT_ANY_OPAQUE: the same, except that the search stops at the first hit on an
  * opaque material it meets (a shadow ray: any opaque hit in range is full shadow), which may not be the
  * closest one, and whose t may be unrefined (rt_object_hit's `any`); a hit on a transparent material is
