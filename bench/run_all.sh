@@ -35,13 +35,16 @@ run() {
     animation) $BIN/python bench/animation.py ;;
     povray) $BIN/python bench/povray_compare.py --runs 5 ;;
     gallery) $BIN/python bench/gallery.py ;;
-    *) echo "bench/run_all.sh: unknown benchmark '$1'" >&2 && exit 2 ;;
     esac
 }
 
-[ $# -gt 0 ] || set -- solvers gen render startup view animation povray gallery
-for b in "$@"; do # check every name before the first long run
-    case $b in solvers | gen | render | startup | view | animation | povray | gallery) ;; *) run "$b" ;; esac
+ALL="solvers gen render startup view animation povray gallery"
+[ $# -gt 0 ] || set -- $ALL
+for b in "$@"; do # every name checked before the first long run
+    case " $ALL " in
+    *" $b "*) ;;
+    *) echo "bench/run_all.sh: unknown benchmark '$b'" >&2 && exit 2 ;;
+    esac
 done
 for b in "$@"; do
     settle "$b"
