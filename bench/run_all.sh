@@ -5,7 +5,7 @@
 # writes) does not weigh on the next.
 #
 #   sh bench/run_all.sh                      # all of them, about 12 minutes on the project's 2-core machine
-#   sh bench/run_all.sh solvers povray       # some: solvers gen render startup view animation povray gallery
+#   sh bench/run_all.sh solvers povray       # some: solvers gen render startup blas view animation povray gallery
 set -e
 cd "$(dirname "$0")/.."
 BIN=.venv/bin
@@ -31,6 +31,7 @@ run() {
     gen) $BIN/implgen bench gen ;;
     render) $BIN/implgen bench render --fold-compare ;;
     startup) $BIN/python bench/startup.py ;;
+    blas) $BIN/python bench/blas_threads.py ;;
     view) $BIN/python bench/view_latency.py ;;
     animation) $BIN/python bench/animation.py ;;
     povray) $BIN/python bench/povray_compare.py --runs 5 ;;
@@ -38,7 +39,7 @@ run() {
     esac
 }
 
-ALL="solvers gen render startup view animation povray gallery"
+ALL="solvers gen render startup blas view animation povray gallery"
 [ $# -gt 0 ] || set -- $ALL
 for b in "$@"; do # every name checked before the first long run
     case " $ALL " in

@@ -63,9 +63,8 @@ def run(argv: Sequence[str]) -> int:
 
 def quiet_blas() -> None:
     """NumPy's OpenBLAS starts a thread per core when it is imported, and each spins for ~0.1 s (again after
-    every large product) -- on the cores the render's threads need: measured on the sextic heart, 800x600,
-    2 threads, the render loop took 0.067-0.069 s beside the spinning pool and 0.060-0.063 s without it
-    (docs/tracer.md). implgen's linear algebra is 3x3, so one BLAS thread is plenty. Set before NumPy is
+    every large product) -- on the cores the render's threads need (bench/blas_threads.py measures what that
+    costs a render). implgen's linear algebra is 3x3, so one BLAS thread is plenty. Set before NumPy is
     first imported (a subcommand's import); a value the user exported is left alone."""
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
