@@ -162,13 +162,7 @@ static double distance_bound(const rt_node *n, const double po[3], const double 
     double c[IG_MAX_DEGREE + 1], best = INFINITY, best_pow = INFINITY;
     int k, deg = n->shape->degree;
     if (gl > 0.0) {
-        double first = level / gl, size = rt_maxabs3(po);
-        for (k = 0; k < n->prep.nfinite; ++k) {
-            int a = n->prep.finite[k];
-            double half = 0.5 * (n->prep.hi[a] - n->prep.lo[a]);
-            if (half > size)
-                size = half;
-        }
+        double first = level / gl, size = ig_max(rt_maxabs3(po), n->half);
         if (deg == 1 || first <= RT_DIST_FIRST_ORDER * size)
             return isfinite(first) ? first : 0.0;
     }

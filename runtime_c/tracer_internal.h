@@ -20,6 +20,7 @@ typedef struct rt_node {
     double obox[6];     /* object-space bounds box */
     int obounded;       /* the spec gives bounds (some sides may still be infinite) */
     ig_shape_prep prep; /* shape.c's per-shape clip and shift data, worked out once (ig_shape_solve) */
+    double half;        /* the largest half-extent of prep's finite box axes, 0 without one (rt_hit_error) */
     /* any node */
     double wbox[6]; /* world-space box, slightly padded; valid when wbounded */
     int wbounded;

@@ -232,6 +232,11 @@ int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, 
     }
     n->obounded = shape->bounds ? shape->bounds(n->params, n->obox) : 0;
     ig_shape_prepare(shape, n->params, &n->prep);
+    n->half = 0.0;
+    for (i = 0; i < n->prep.nfinite; ++i) {
+        int a = n->prep.finite[i];
+        n->half = fmax(n->half, 0.5 * (n->prep.hi[a] - n->prep.lo[a]));
+    }
     if (!n->obounded)
         for (i = 0; i < 3; ++i) {
             n->obox[i] = -INFINITY;
