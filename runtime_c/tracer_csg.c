@@ -270,7 +270,7 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
          * ray's own. */
         double oo[3], od[3], u[3], L = ray->len, r[IG_MAX_DEGREE + 2];
         const double *po = ray->o, *pu = ray->u;
-        ig_shape_expansion ex;
+        ig_shape_expansion ex, *exp;
         int nr, i;
         if (n->prep.degree == 1 && !n->prep.bounded) {
             int got = plane_hit(n, k, ray, tmin, tmax, lo, hi, hit);
@@ -292,12 +292,14 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
             return 0;
         }
         /* an opaque shadow ray only asks whether there is a hit: the root need not be refined */
+        /* (nor is its expansion needed: an opaque shadow hit is never finished) */
         if (any && !rt_leaf_opaque(s, n))
             any = 0;
+        exp = any ? NULL : &ex;
         nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO,
-                            any ? IG_ANY_ROOT : IG_FIRST_ROOT, r, &ex);
+                            any ? IG_ANY_ROOT : IG_FIRST_ROOT, r, exp);
         if (nr && (!(r[0] / L > tmin) || (any && !(r[0] / L < tmax)))) /* (an unrefined point at an end) */
-            nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, 0, r, &ex);
+            nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, 0, r, exp);
         for (i = 0; i < nr; ++i) {
             double t = r[i] / L;
             if (t > tmin && t < tmax) {
