@@ -54,11 +54,11 @@ def main() -> int:
     if args.quick:
         args.frames, args.width, args.height, args.runs, args.tasks = 6, 64, 48, 1, 20
 
-    from implgen.scene import cluster
-    from implgen.scene.batch import Runner, render_frames
+    from implgen.animation import cluster
+    from implgen.animation.batch import Runner, render_frames
+    from implgen.animation.frameout import plan_output
+    from implgen.animation.frames import FrameOptions, load_frames, render_frame_png
     from implgen.scene.build import build_scene
-    from implgen.scene.frameout import plan_output
-    from implgen.scene.frames import FrameOptions, load_frames, render_frame_png
 
     t_start = time.perf_counter()
     frames = load_frames(args.scene)

@@ -14,10 +14,10 @@ import os
 import sys
 from pathlib import Path
 
+from implgen.animation.batch import Runner, render_frames
+from implgen.animation.frameout import plan_output
+from implgen.animation.frames import FrameOptions, load_frames
 from implgen.bench.machine import describe as machine
-from implgen.scene.batch import Runner, render_frames
-from implgen.scene.frameout import plan_output
-from implgen.scene.frames import FrameOptions, load_frames
 from implgen.scene.load import load_scene
 from implgen.scene.render import RenderInfo, render, write_png
 

@@ -42,7 +42,7 @@ def _use_runtime(runtime: Path) -> None:
     each side from its own checkout."""
     import os
 
-    import implgen.clib as cbuild
+    import implgen.compile.clib as cbuild
     import implgen.resources as resources
     import implgen.scene.build as build
 

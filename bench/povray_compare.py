@@ -290,11 +290,11 @@ def _box_span(box, oo, dd) -> tuple[Fraction, Fraction | None] | None:
 def degree_family(degrees, rays: int, reps: int) -> list[dict]:
     import ctypes
 
-    from implgen import clib as cbuild
     from implgen.bench.gen import dense_equation
     from implgen.codegen.derive import derive
     from implgen.codegen.emit import derivation_ops, generate
     from implgen.codegen.spec import parse_spec
+    from implgen.compile import clib as cbuild
     from implgen.resources import runtime_dir
 
     rt = runtime_dir()

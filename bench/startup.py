@@ -57,7 +57,7 @@ def heavy_imports(render_args: list[str], env: dict) -> list[str]:
 def runtime_compile_times(tmp: Path) -> list[tuple[str, float]]:
     """Seconds to compile each C runtime source once with the build flags (what the first build of a new
     cache pays, one file per core; afterwards the cache keeps the objects), slowest first."""
-    from implgen.clib import BASE_FLAGS, compiler
+    from implgen.compile.clib import BASE_FLAGS, compiler
     from implgen.resources import runtime_dir
 
     src = runtime_dir()

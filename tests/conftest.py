@@ -33,8 +33,8 @@ C_SANITIZE = ["-O1", "-g", "-fsanitize=address,undefined", "-fno-sanitize-recove
 def compile_c(out: Path, sources, *, include=(), sanitize: bool = True, shared: bool = False, flags=()) -> Path:
     """Compile C sources into `out` (an executable, or a shared library with shared=True) with the project's
     warnings as errors, against the runtime, the generated shapes and tests/c; ASan + UBSan unless told not
-    to (any report aborts). The compiler is $CC, else cc (implgen.clib.compiler)."""
-    from implgen.clib import compiler
+    to (any report aborts). The compiler is $CC, else cc (implgen.compile.clib.compiler)."""
+    from implgen.compile.clib import compiler
 
     cmd = [compiler(), *C_WARNINGS, *(C_SANITIZE if sanitize else ["-O2"]), "-pthread", *flags]
     cmd += ["-shared", "-fPIC"] if shared else []
@@ -71,7 +71,7 @@ class CShapes:
     """Generated C shapes compiled into one shared library (through the package's build cache)."""
 
     def __init__(self, names: list[str], folder: Path = GENERATED, with_runtime: bool = True) -> None:
-        from implgen.clib import build_shared, load
+        from implgen.compile.clib import build_shared, load
 
         sources = [folder / f"{n}.c" for n in names]
         if with_runtime:

@@ -13,9 +13,9 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from implgen.animation.frames import frames_from_data, parse_range
 from implgen.cli import main as cli_main
 from implgen.errors import UserError
-from implgen.scene.frames import frames_from_data, parse_range
 from implgen.scene.keys import Keyed, parse_keyed
 from implgen.scene.load import parse_scene
 

@@ -12,8 +12,8 @@ import pytest
 import yaml
 from PIL import Image
 
+from implgen.animation.frames import frames_from_data
 from implgen.cli import main as cli_main
-from implgen.scene.frames import frames_from_data
 from implgen.scene.render import render, to_uint8
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -144,7 +144,7 @@ def test_a_video_resumes_from_its_sidecar_frames(tmp_path, anim, capsys):
 
 def test_frames_share_one_library(tmp_path, anim, monkeypatch):
     """The scene library is built once for the whole animation, not once per frame."""
-    from implgen.scene import batch
+    from implgen.animation import batch
 
     calls = []
     real = batch.build_scene

@@ -11,6 +11,7 @@ path itself (a folder, a fifo, a device), the output path, and options named as 
 from __future__ import annotations
 
 import pytest
+
 from bad_input_harness import FIFO, FOLDER, SPHERE, Case, Link, check, run_batch
 
 BIG = "9" * 400

@@ -10,6 +10,7 @@ that are not specs, and output paths.
 from __future__ import annotations
 
 import pytest
+
 from bad_input_harness import FIFO, FOLDER, SPHERE, Case, Link, check, run_batch
 from test_generator_bad_input import CASES as IN_PROCESS_CASES
 

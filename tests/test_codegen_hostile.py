@@ -19,12 +19,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import RUNTIME, SHAPE_FILES, compile_c, load_python_shape
-from implgen.clib import compiler
 from implgen.codegen import escape
 from implgen.codegen.emit import generate
 from implgen.codegen.grammar import format_expression, parse_expression
 from implgen.codegen.names import reserved_shape_name
 from implgen.codegen.spec import VARIABLES, exact_polynomial, load_spec, param_symbol, parse_spec
+from implgen.compile.clib import compiler
 from implgen.errors import UserError
 from implgen.outputs import write_text_files
 

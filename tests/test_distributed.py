@@ -13,10 +13,10 @@ import pytest
 import yaml
 from PIL import Image
 
+from implgen.animation.batch import Runner, render_frames
+from implgen.animation.frameout import plan_output
+from implgen.animation.frames import FrameOptions, frames_from_data, render_frame_png
 from implgen.cli import main as cli_main
-from implgen.scene.batch import Runner, render_frames
-from implgen.scene.frameout import plan_output
-from implgen.scene.frames import FrameOptions, frames_from_data, render_frame_png
 from implgen.scene.render import render, to_uint8
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -83,7 +83,7 @@ def _dies_once(marker: str, *args):
     its worker process, once: no cleanup and no exception, as a crash or `kill -9` would."""
     import os
 
-    from implgen.scene.frames import render_frame_png
+    from implgen.animation.frames import render_frame_png
 
     started = Path(marker).with_suffix(".started")
     started.mkdir(exist_ok=True)
@@ -140,7 +140,7 @@ def test_local_workers_command(tmp_path, frames, alone, capsys):
 
 
 def test_an_unreachable_scheduler_is_one_line(tmp_path, frames, capsys, monkeypatch):
-    from implgen.scene import cluster
+    from implgen.animation import cluster
 
     monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", 1)
     scene = Path(frames.source)
@@ -152,7 +152,7 @@ def test_an_unreachable_scheduler_is_one_line(tmp_path, frames, capsys, monkeypa
 
 
 def test_a_tiled_still_equals_the_still_rendered_in_one_piece(tmp_path, client, frames):
-    from implgen.scene.batch import bands
+    from implgen.animation.batch import bands
 
     sc = frames.scene(2)
     opts = FrameOptions(width=48, height=37, spp=3, max_depth=3, threads=1)  # 37 rows: bands of 5 and 4 rows

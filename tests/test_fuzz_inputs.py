@@ -39,11 +39,11 @@ from fuzz_strategies import (
     scenes,
     specs,
 )
+from implgen.animation.frames import load_frames
 from implgen.cli import main
 from implgen.codegen.grammar import ParseError, format_expression, parse_expression, split_equation
 from implgen.codegen.spec import VARIABLES, exact_polynomial, load_spec, param_symbol
 from implgen.errors import UserError
-from implgen.scene.frames import load_frames
 
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS = Path(__file__).resolve().parent / "fuzz_corpus"

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from implgen import clib
 from implgen.cli import main as cli_main
+from implgen.compile import clib
 from implgen.errors import UserError
 from implgen.scene import build
 from implgen.scene.load import load_scene, parse_scene

@@ -220,7 +220,7 @@ def test_output_is_checked_before_any_work(tmp_path, capsys, monkeypatch):
     """The scene is never read when the output cannot be written: a scene that would take long to load
     (a missing file, here) is not even looked at."""
     called = []
-    monkeypatch.setattr("implgen.scene.command.load_frames", lambda p: called.append(p))
+    monkeypatch.setattr("implgen.animation.command.load_frames", lambda p: called.append(p))
     (tmp_path / "afile").write_text("")
     for out, fragment in [
         (tmp_path, "is a folder"),

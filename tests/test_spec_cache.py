@@ -1,4 +1,4 @@
-"""The parsed-spec cache (scene/speccache.py): a cached scene loads and renders without SymPy, gives the same
+"""The parsed-spec cache (codegen/speccache.py): a cached scene loads and renders without SymPy, gives the same
 values and pictures as a full parse, refuses bad specs exactly as before, and survives any damaged entry."""
 
 from __future__ import annotations
@@ -12,13 +12,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from implgen.codegen.spec import Spec, load_spec
+from implgen.codegen import speccache
+from implgen.codegen.spec import load_spec
 from implgen.codegen.spec import parse_spec as parse_full
 from implgen.errors import UserError
-from implgen.scene import build, speccache
+from implgen.scene import build
 from implgen.scene.load import parse_scene
 from implgen.scene.render import render
-from implgen.scene.speccache import CachedSpec
 
 ROOT = Path(__file__).resolve().parent.parent
 SHAPES = ROOT / "examples" / "shapes"
@@ -53,11 +53,11 @@ def entries(cache: Path) -> list[Path]:
 
 def test_second_load_is_cached_and_equal_to_a_full_parse(cache: Path) -> None:
     first = parse_scene(scene_with([TORUS, INLINE]), "s.yaml")
-    assert all(isinstance(leaf.spec, Spec) for leaf in first.leaves())
+    assert all(not leaf.spec.from_cache for leaf in first.leaves())
     assert len(entries(cache)) == 2
     second = parse_scene(scene_with([TORUS, INLINE]), "s.yaml")
     for a, b in zip(first.leaves(), second.leaves()):
-        assert isinstance(b.spec, CachedSpec)
+        assert b.spec.from_cache
         full = a.spec
         assert (b.spec.name, b.spec.equation, b.spec.degree, b.spec.description) == (
             full.name,
@@ -68,7 +68,7 @@ def test_second_load_is_cached_and_equal_to_a_full_parse(cache: Path) -> None:
         assert list(b.spec.params.items()) == list(full.params.items())
         assert [type(v) for v in b.spec.params.values()] == [type(v) for v in full.params.values()]
         assert b.spec.box() == full.box() and b.spec.box(b.params) == full.box(b.params)
-        assert build.spec_key(b.spec) == build.spec_key(full)
+        assert b.spec.spec_key == full.spec_key
         assert b.params == a.params and b.spec.source == full.source
         # what the entry does not hold comes from a full parse of the same content
         assert b.spec.f == full.f and b.spec.bounds == full.bounds
@@ -77,16 +77,16 @@ def test_second_load_is_cached_and_equal_to_a_full_parse(cache: Path) -> None:
     # folding goes through the full spec too
     folded = build.plan_shapes(second, fold=True)[0]
     reference = build.plan_shapes(first, fold=True)[0]
-    assert [build.spec_key(e.spec) for e in folded] == [build.spec_key(e.spec) for e in reference]
+    assert [e.spec.spec_key for e in folded] == [e.spec.spec_key for e in reference]
 
 
 def test_a_spec_file_and_the_same_content_share_one_entry(cache: Path) -> None:
     path = SHAPES / "heart.yaml"
     speccache.load_spec(path)
     cached = speccache.load_spec(path)
-    assert isinstance(cached, CachedSpec) and cached.source == str(path)
+    assert cached.from_cache and cached.source == str(path)
     full = load_spec(path)
-    assert cached.spec_key == build.spec_key(full) and cached.equation == full.equation
+    assert cached.spec_key == full.spec_key and cached.equation == full.equation
 
 
 def test_content_types_are_part_of_the_key(cache: Path) -> None:
@@ -97,15 +97,15 @@ def test_content_types_are_part_of_the_key(cache: Path) -> None:
     for value in (1, 1.0, "1"):
         got = speccache.parse_spec({**base, "params": {"r": value}}, "<a>")
         want = parse_full({**base, "params": {"r": value}}, "<a>")
-        assert isinstance(got, CachedSpec)
+        assert got.from_cache
         assert got.params == want.params and type(got.params["r"]) is type(want.params["r"])
 
 
 def test_a_new_implgen_misses(cache: Path, monkeypatch) -> None:
     speccache.parse_spec({"name": "plane", "equation": "y"}, "<a>")
-    assert isinstance(speccache.parse_spec({"name": "plane", "equation": "y"}, "<a>"), CachedSpec)
+    assert speccache.parse_spec({"name": "plane", "equation": "y"}, "<a>").from_cache
     monkeypatch.setattr(speccache, "implgen_fingerprint", lambda: "another implgen")
-    assert isinstance(speccache.parse_spec({"name": "plane", "equation": "y"}, "<a>"), Spec)
+    assert not speccache.parse_spec({"name": "plane", "equation": "y"}, "<a>").from_cache
 
 
 BAD_SPECS = [
@@ -214,13 +214,13 @@ def test_a_damaged_entry_is_a_miss_and_the_picture_is_unchanged(cache: Path, how
     data = scene_with([TORUS])
     reference = render(parse_scene(data, "s.yaml"))  # full parse; writes the entry
     (entry,) = entries(cache)
-    assert isinstance(parse_scene(data, "s.yaml").leaves()[0].spec, CachedSpec)
+    assert parse_scene(data, "s.yaml").leaves()[0].spec.from_cache
     _damage(entry, how)
     again = parse_scene(data, "s.yaml")
-    assert isinstance(again.leaves()[0].spec, Spec)  # not trusted: parsed in full
+    assert not again.leaves()[0].spec.from_cache  # not trusted: parsed in full
     assert np.array_equal(render(again), reference)
     if how != "folder":  # written again (a fifo is replaced), and good
-        assert isinstance(parse_scene(data, "s.yaml").leaves()[0].spec, CachedSpec)
+        assert parse_scene(data, "s.yaml").leaves()[0].spec.from_cache
 
 
 def test_a_read_only_cache_still_loads(cache: Path) -> None:
@@ -230,7 +230,7 @@ def test_a_read_only_cache_still_loads(cache: Path) -> None:
         if os.access(cache / "spec", os.W_OK):  # root ignores the mode
             pytest.skip("cannot make a read-only folder as this user")
         for _ in range(2):
-            assert isinstance(speccache.parse_spec({"name": "plane", "equation": "y"}, "<a>"), Spec)
+            assert not speccache.parse_spec({"name": "plane", "equation": "y"}, "<a>").from_cache
     finally:
         (cache / "spec").chmod(0o700)
 
@@ -284,7 +284,7 @@ POWER = {
 def test_a_cached_spec_checks_overrides_as_the_full_spec_does(cache: Path, values: dict) -> None:
     full = speccache.parse_spec(POWER, "p.yaml")
     cached = speccache.parse_spec(POWER, "p.yaml")
-    assert isinstance(full, Spec) and isinstance(cached, CachedSpec)
+    assert not full.from_cache and cached.from_cache
 
     def outcome(spec):
         try:
@@ -294,7 +294,7 @@ def test_a_cached_spec_checks_overrides_as_the_full_spec_does(cache: Path, value
         return spec.box(values)
 
     assert outcome(cached) == outcome(full)
-    assert cached._full is None  # decided from the cached terms and bounds trees, without parsing again
+    assert not cached.symbolic_loaded  # decided from the cached terms and bounds trees, without parsing again
 
 
 def test_bounds_trees_evaluate_as_sympy_does() -> None:

@@ -7,16 +7,12 @@ scene/tracer.py (what to hand to the C tracer).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from implgen import abi
+from implgen.codegen.specmodel import Spec
 from implgen.scene.keys import Animation
-
-if TYPE_CHECKING:
-    from implgen.codegen.spec import Spec
-    from implgen.scene.speccache import CachedSpec
 
 
 @dataclass
@@ -52,7 +48,7 @@ class Material:
 
 @dataclass
 class Leaf:
-    spec: Spec | CachedSpec  # a CachedSpec when the spec's content was parsed before (scene/speccache.py)
+    spec: Spec  # its symbolic part deferred when the spec's content was parsed before (codegen/speccache.py)
     params: dict[str, float]  # every param of the spec, in its declared order
     matrix: np.ndarray  # 3x4 object -> world
     material: Material | None
@@ -122,9 +118,9 @@ class Scene:
             walk(o)
         return out
 
-    def specs(self) -> list[Spec | CachedSpec]:
+    def specs(self) -> list[Spec]:
         """The distinct shapes the scene uses (what gets generated and compiled, nothing else)."""
-        seen: dict[int, Spec | CachedSpec] = {}
+        seen: dict[int, Spec] = {}
         for leaf in self.leaves():
             seen.setdefault(id(leaf.spec), leaf.spec)
         return list(seen.values())

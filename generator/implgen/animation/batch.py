@@ -16,10 +16,10 @@ from typing import Any
 
 import numpy as np
 
-from implgen.scene import cluster
+from implgen.animation import cluster
+from implgen.animation.frameout import FrameOutput
+from implgen.animation.frames import FrameOptions, Frames, decode_png, encode_png, render_frame_png
 from implgen.scene.build import build_scene
-from implgen.scene.frameout import FrameOutput
-from implgen.scene.frames import FrameOptions, Frames, decode_png, encode_png, rebind, render_frame_png
 
 WINDOW_PER_WORKER = 3  # tasks in flight per worker: enough to hide the round trip, little memory
 
@@ -108,7 +108,7 @@ def _jobs(
     built = build_scene(frames.first, fold=fold) if runner.client is None else None
     for f in missing:
         scene = frames.scene(f)
-        frame_built = None if built is None else rebind(built, scene, fold)
+        frame_built = None if built is None else built.for_scene(scene, fold)
         for k, band in enumerate(rows):
             yield (f, k), (scene, opts, band, frame_built)
 

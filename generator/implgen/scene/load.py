@@ -10,21 +10,18 @@ from __future__ import annotations
 import heapq
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from implgen import abi, validate
+from implgen.codegen.speccache import load_spec, parse_spec  # codegen.spec's, cached by content
+from implgen.codegen.specmodel import Spec
 from implgen.errors import UserError
 from implgen.scene import keys
 from implgen.scene import transform as tf
 from implgen.scene.model import Camera, Csg, Leaf, Light, Material, Node, Scene, depth
-from implgen.scene.speccache import load_spec, parse_spec  # codegen.spec's, cached by content
 from implgen.yamlfile import read_yaml
-
-if TYPE_CHECKING:
-    from implgen.codegen.spec import Spec
-    from implgen.scene.speccache import CachedSpec
 
 MAX_CSG_DEPTH = abi.value("RT_MAX_CSG_DEPTH")  # depth of the binary tree the tracer takes
 MAX_CSG_NESTING = 32  # CSG operations nested inside each other, as written in the scene
@@ -79,9 +76,9 @@ class _Ctx:
         self.path = path
         self.source = str(path)
         memo = {} if memo is None else memo  # shared by the frames of one animation: specs are read once
-        self.spec_cache: dict[Path, Spec | CachedSpec] = memo.setdefault("specs", {})
+        self.spec_cache: dict[Path, Spec] = memo.setdefault("specs", {})
         self.resolved: dict[str, Path] = memo.setdefault("paths", {})  # `shape:` text -> spec file
-        self.inline_specs: dict[str, Spec | CachedSpec] = memo.setdefault("inline", {})
+        self.inline_specs: dict[str, Spec] = memo.setdefault("inline", {})
         self.inline_count = 0
         self.leaves = 0
         self.frame = frame

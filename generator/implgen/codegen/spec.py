@@ -14,8 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
-from functools import cached_property
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -25,8 +24,10 @@ from sympy.polys.rings import ring
 
 from implgen import abi, validate
 from implgen.codegen import paramvalues
+from implgen.codegen.fingerprint import code_key
 from implgen.codegen.grammar import ParseError, check_terms, format_expression, parse_expression, split_equation
 from implgen.codegen.names import check_identifier, check_shape_name
+from implgen.codegen.specmodel import Spec
 from implgen.errors import UserError
 from implgen.yamlfile import read_yaml
 
@@ -52,78 +53,68 @@ def param_symbol(name: str) -> sympy.Symbol:
 
 
 @dataclass(frozen=True)
-class Spec:
-    name: str
-    equation: str  # f printed back from the parsed tree (never the raw text)
-    params: dict[str, float]  # ordered: the order the generated code takes them in
+class SymbolicForm:
+    """The SymPy side of a `Spec` (codegen/specmodel.py): the expression and the symbolic bounds."""
+
     f: sympy.Expr  # lhs - rhs, structure as written; x, y, z and k_* symbols
-    degree: int  # exact total degree in x, y, z
-    bounds: dict[str, tuple[sympy.Expr, sympy.Expr]] | None = None  # axis -> (lo, hi) in k_* symbols
-    description: str = ""
-    source: str = "<spec>"
-    folded: dict[str, float] = field(default_factory=dict)  # params folded into constants by specialise()
+    bounds: dict[str, tuple[sympy.Expr, sympy.Expr]] | None  # axis -> (lo, hi) in k_* symbols
+    param_symbols: list[sympy.Symbol]
 
-    @property
-    def param_symbols(self) -> list[sympy.Symbol]:
-        return [param_symbol(p) for p in self.params]
-
-    @cached_property
-    def bounds_trees(self) -> paramvalues.Trees | None:
-        """The bounds as expression trees in the param names (codegen/paramvalues.py), which the spec cache
-        keeps: a cached spec's box and checks are computed by the same code."""
-        if self.bounds is None:
-            return None
-        names = {param_symbol(p): p for p in self.params}
-        trees = {
-            a: (paramvalues.tree_of(lo, names), paramvalues.tree_of(hi, names)) for a, (lo, hi) in self.bounds.items()
-        }
-        if any(t is None for pair in trees.values() for t in pair):
-            raise ValueError(f"bounds of {self.name!r} are not polynomials in the params")  # the parser ensures it
-        return trees
-
-    def box(self, values: Mapping[str, float] | None = None) -> list[float] | None:
-        """The numeric box {xmin, ymin, zmin, xmax, ymax, zmax} for these param values (defaults else); an end
-        too large for a double is an infinity."""
-        return paramvalues.box(self.params, self.bounds_trees, values)
-
-    @cached_property
-    def param_terms(self) -> paramvalues.Terms:
-        """(log2 |coefficient|, param exponents) of every term of f in x, y, z and the params."""
-        poly = exact_polynomial(self.f, self.param_symbols)
-        return [
-            (math.log2(abs(c.numerator)) - math.log2(c.denominator), monom[3:]) for monom, c in poly.terms() if c != 0
-        ]
-
-    def check_values(self, values: Mapping[str, float], source: str, key: str) -> None:
-        """With these param values every coefficient stays a finite double and the bounds an ordered box
-        (paramvalues.check)."""
-        paramvalues.check(self.name, self.params, self.param_terms, self.bounds_trees, values, source, key)
-
-    def specialise(self, values: Mapping[str, float], name: str | None = None) -> Spec:
+    def specialise(self, spec: Spec, values: Mapping[str, float], name: str | None = None) -> Spec:
         """The same shape with the given params folded into the equation as constants."""
-        unknown = set(values) - set(self.params)
+        unknown = set(values) - set(spec.params)
         if unknown:
-            raise UserError(self.source, f"unknown params {sorted(unknown)} for shape {self.name!r}")
-        new_name = name or self.name
-        check_shape_name(self.source, "name", new_name)
+            raise UserError(spec.source, f"unknown params {sorted(unknown)} for shape {spec.name!r}")
+        new_name = name or spec.name
+        check_shape_name(spec.source, "name", new_name)
         subs = {
-            param_symbol(k): sympy.nsimplify(validate.number(self.source, f"params.{k}", v), rational=True)
+            param_symbol(k): sympy.nsimplify(validate.number(spec.source, f"params.{k}", v), rational=True)
             for k, v in values.items()
         }
         bounds = None
         if self.bounds is not None:
             bounds = {a: (lo.subs(subs), hi.subs(subs)) for a, (lo, hi) in self.bounds.items()}
-        rest = {k: v for k, v in self.params.items() if k not in values}
-        f = self.f.subs(subs)
-        return replace(
-            self,
-            name=new_name,
-            f=f,
-            equation=canonical_equation(f, rest),
-            params=rest,
-            bounds=bounds,
-            folded={**self.folded, **{k: float(v) for k, v in values.items()}},
-        )
+        rest = {k: v for k, v in spec.params.items() if k not in values}
+        folded = {**spec.folded, **{k: float(v) for k, v in values.items()}}
+        return make_spec(new_name, self.f.subs(subs), rest, spec.degree, bounds, spec.description, spec.source, folded)
+
+
+def make_spec(
+    name: str,
+    f: sympy.Expr,
+    params: dict[str, float],
+    degree: int,
+    bounds: dict[str, tuple[sympy.Expr, sympy.Expr]] | None,
+    description: str,
+    source: str,
+    folded: dict[str, float] | None = None,
+) -> Spec:
+    """A `Spec` with its symbolic part at hand, and the plain data a scene reads computed from it."""
+    symbols = [param_symbol(p) for p in params]
+    names = {param_symbol(p): p for p in params}
+    trees = None
+    if bounds is not None:
+        trees = {a: (paramvalues.tree_of(lo, names), paramvalues.tree_of(hi, names)) for a, (lo, hi) in bounds.items()}
+        if any(t is None for pair in trees.values() for t in pair):
+            raise ValueError(f"bounds of {name!r} are not polynomials in the params")  # the parser ensures it
+    poly = exact_polynomial(f, symbols)
+    terms = [(math.log2(abs(c.numerator)) - math.log2(c.denominator), monom[3:]) for monom, c in poly.terms() if c != 0]
+    folded = folded or {}
+    bounds_text = None if bounds is None else {a: (str(lo), str(hi)) for a, (lo, hi) in bounds.items()}
+    spec = Spec(
+        name=name,
+        equation=canonical_equation(f, params),
+        params=params,
+        degree=degree,
+        param_terms=terms,
+        bounds_trees=trees,
+        spec_key=code_key(name, str(f), params, bounds_text, folded),
+        symbolic_part=Spec.parsed(SymbolicForm(f=f, bounds=bounds, param_symbols=symbols)),
+        description=description,
+        source=source,
+        folded=folded,
+    )
+    return spec
 
 
 def load_spec(path: str | Path) -> Spec:
@@ -251,15 +242,6 @@ def parse_spec(data: Any, source: str = "<spec>") -> Spec:
         raise UserError(source, "description: must be text")
     if len(description) > MAX_DESCRIPTION:
         raise UserError(source, f"description: longer than {MAX_DESCRIPTION} characters")
-    spec = Spec(
-        name=name,
-        equation=canonical_equation(f, params),
-        params=params,
-        f=f,
-        degree=degree,
-        bounds=bounds,
-        description=" ".join(description.split()),
-        source=source,
-    )
+    spec = make_spec(name, f, params, degree, bounds, " ".join(description.split()), source)
     spec.check_values({}, source, "params")  # the defaults
     return spec

@@ -6,7 +6,7 @@
     first_root_batch(coeffs_2d, lo, hi, method) -> (roots, NaN where none; counts 0/1)
 
 Coefficients are lowest power first. The C library is compiled on first use into the content-hash build
-cache (`implgen.clib`), so a plain `pip install` needs no build step.
+cache (`implgen.compile.clib`), so a plain `pip install` needs no build step.
 """
 
 from __future__ import annotations
@@ -17,7 +17,8 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import ArrayLike
 
-from implgen import abi, clib
+from implgen import abi
+from implgen.compile import clib
 from implgen.errors import UserError
 from implgen.resources import BENCH_SOURCES, SOLVER_SOURCES, runtime_dir, runtime_sources
 

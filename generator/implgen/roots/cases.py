@@ -16,9 +16,8 @@ from types import ModuleType
 
 import numpy as np
 
-from implgen import raycast
 from implgen.errors import UserError
-from implgen.roots import raysets_high
+from implgen.roots import raycast, raysets_high
 
 SHAPES_DIR = Path("examples/shapes")
 

@@ -90,7 +90,7 @@ def _batch(rows: list[np.ndarray]) -> list[list[RefRoot]]:
 
 
 def _cache_file(coeffs: np.ndarray) -> Path:
-    from implgen.clib import cache_dir
+    from implgen.cachedir import cache_dir
 
     h = hashlib.sha256(b"ref-v3" + np.ascontiguousarray(coeffs, dtype=np.float64).tobytes()).hexdigest()[:24]
     d = cache_dir() / "roots_reference"

@@ -28,7 +28,7 @@ import numpy as np
 from PIL import Image
 
 from implgen.errors import UserError
-from implgen.scene.build import BuildResult, build_scene, plan_shapes
+from implgen.scene.build import BuildResult, build_scene
 from implgen.scene.model import Scene
 from implgen.scene.render import render, to_uint8, usable_cores, write_png
 from implgen.scene.tracer import CScene
@@ -164,12 +164,10 @@ class Session:
 
     def _library(self, sc: Scene) -> BuildResult:
         """The scene's library: built (or found in the build cache) once per set of shapes, then reused."""
-        entries, leaf_index = plan_shapes(sc, fold=False)
-        key = tuple(id(e.spec) for e in entries)
+        key = tuple(id(spec) for spec in sc.specs())
         if key not in self._libs:
-            built = build_scene(sc)
-            self._libs = {key: (built.library, [e.spec for e in entries])}  # keep the specs alive with the key
-        return BuildResult(library=self._libs[key][0], entries=entries, leaf_index=leaf_index, generated=0)
+            self._libs = {key: (build_scene(sc), sc.specs())}  # keep the specs alive with their ids
+        return self._libs[key][0].for_scene(sc, fold=False)
 
     def request(self, req: protocol.RenderRequest) -> None:
         """The newest request wins: it replaces the waiting one and cancels the running render."""

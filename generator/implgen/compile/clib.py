@@ -22,21 +22,10 @@ from collections.abc import Callable, Sequence
 from functools import cache
 from pathlib import Path
 
+from implgen.cachedir import cache_dir
 from implgen.errors import UserError
 
 BASE_FLAGS: tuple[str, ...] = ("-std=c99", "-O3", "-fPIC", "-Wall", "-Wextra", "-Werror", "-pedantic")
-
-
-def cache_dir() -> Path:
-    """The build cache folder (created on demand)."""
-    env = os.environ.get("IMPLGEN_CACHE")
-    if env:
-        root = Path(env)
-    else:
-        xdg = os.environ.get("XDG_CACHE_HOME")
-        root = (Path(xdg) if xdg else Path.home() / ".cache") / "implgen"
-    root.mkdir(parents=True, exist_ok=True)
-    return root
 
 
 def compiler() -> str:

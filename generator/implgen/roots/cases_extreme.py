@@ -51,7 +51,7 @@ def far_torus_rays(count: int, rng: np.random.Generator, dist: float = 1e4):
     u = raysets_high._unit(rng.normal(size=(count, 3)))
     o = target - dist * u
     d = u
-    from implgen import raycast
+    from implgen.roots import raycast
 
     t0, t1, valid = raycast._clip(box, o, d, np.zeros(count), np.full(count, np.inf))
     o, d, t0, t1 = o[valid], d[valid], t0[valid], t1[valid]

@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 _PACKAGE_DIR = Path(__file__).resolve().parent
+_TREE = _PACKAGE_DIR.parent.parent  # the repository, when run from the source tree (generator/implgen/)
 
 SOLVER_SOURCES = (
     "roots.c",
@@ -28,12 +29,12 @@ TRACER_SOURCES = ("tracer_scene.c", "tracer_hit.c", "tracer_csg.c", "tracer_shad
 
 def templates_dir() -> Path:
     """Folder holding the Jinja2 templates (`c/`, `python/`, `scene/`)."""
-    return _PACKAGE_DIR / "templates" if (_PACKAGE_DIR / "templates").is_dir() else _PACKAGE_DIR.parent / "templates"
+    return _PACKAGE_DIR / "templates" if (_PACKAGE_DIR / "templates").is_dir() else _TREE / "templates"
 
 
 def runtime_dir() -> Path:
     """Folder holding the hand-written C runtime sources (`*.c`, `*.h`)."""
-    return _PACKAGE_DIR / "runtime_c" if (_PACKAGE_DIR / "runtime_c").is_dir() else _PACKAGE_DIR.parent / "runtime_c"
+    return _PACKAGE_DIR / "runtime_c" if (_PACKAGE_DIR / "runtime_c").is_dir() else _TREE / "runtime_c"
 
 
 def runtime_sources(*groups: tuple[str, ...]) -> list[Path]:

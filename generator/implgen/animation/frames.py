@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from implgen.errors import UserError
-from implgen.scene.build import BuildResult, build_scene, plan_shapes
+from implgen.scene.build import BuildResult, build_scene
 from implgen.scene.keys import contains_keyed
 from implgen.scene.load import parse_scene
 from implgen.scene.model import Leaf, Node, Scene
@@ -113,15 +113,6 @@ def parse_range(text: str, count: int, option: str = "--frames") -> range:
     if not 0 <= lo <= hi < count:
         raise UserError(option, f"{text[:40]}: frames must satisfy 0 <= A <= B <= {count - 1} (the last frame)")
     return range(lo, hi + 1)
-
-
-def rebind(built: BuildResult, scene: Scene, fold: bool = False) -> BuildResult:
-    """The library built for one frame, for another frame of the same animation: the same shapes in the same
-    order (checked), this frame's leaves."""
-    entries, leaf_index = plan_shapes(scene, fold)
-    if [e.c_name for e in entries] != [e.c_name for e in built.entries]:
-        raise AssertionError("a frame uses other shapes than the library was built for")
-    return BuildResult(library=built.library, entries=built.entries, leaf_index=leaf_index, generated=0)
 
 
 @dataclass(frozen=True)

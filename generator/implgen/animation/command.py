@@ -13,12 +13,12 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from implgen import validate
+from implgen.animation import cluster
+from implgen.animation.batch import Runner, render_frames
+from implgen.animation.frameout import FrameOutput, plan_output
+from implgen.animation.frames import FrameOptions, Frames, load_frames, parse_range
 from implgen.cli import ArgumentParser
 from implgen.errors import UserError
-from implgen.scene import cluster
-from implgen.scene.batch import Runner, render_frames
-from implgen.scene.frameout import FrameOutput, plan_output
-from implgen.scene.frames import FrameOptions, Frames, load_frames, parse_range
 from implgen.scene.keys import MAX_FRAMES
 from implgen.scene.load import MAX_DEPTH, MAX_SIZE, MAX_SPP
 from implgen.scene.render import DEFAULT_FOLD, MAX_THREADS, RenderInfo, render, write_png

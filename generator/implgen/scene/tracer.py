@@ -12,7 +12,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from implgen import abi, clib
+from implgen import abi
+from implgen.compile import clib
 from implgen.scene.build import BuildResult, leaf_params
 from implgen.scene.model import Leaf, Material, Node, Scene
 

@@ -22,7 +22,7 @@ from implgen.errors import UserError
 
 # Subcommands live in their own modules; imported lazily so `implgen SPEC` stays quick.
 _COMMANDS: dict[str, str] = {
-    "render": "implgen.scene.command:main",
+    "render": "implgen.animation.command:main",
     "demo": "implgen.demo:main",
     "view": "implgen.view.command:main",
 }

@@ -19,7 +19,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.polynomial import chebyshev
 
-from implgen import raycast
+from implgen.roots import raycast
 
 Poly = np.ndarray  # (rays, degree + 1), lowest power first
 

@@ -2,16 +2,16 @@
 
 Parsing a spec (codegen/spec.py) needs SymPy, whose import alone takes a few hundred milliseconds, yet the
 render of a scene whose shapes were built before needs only what the build and the tracer read: the name,
-the params and their defaults, the degree and the key of the generated code (build.spec_key). After a full
-parse those are written to `spec/<key>.json` in the build cache (clib.cache_dir(), beside `gen/`), keyed by
+the params and their defaults, the degree and the key of the generated code (`Spec.spec_key`). After a full
+parse those are written to `spec/<key>.json` in the build cache (cache_dir(), beside `gen/`), keyed by
 the spec's content -- the mapping read from the YAML, every value with its type -- and implgen's own
-fingerprint (the generator's sources and templates, as build.spec_key uses). The next load of the same
-content reads them back as a `CachedSpec`.
+fingerprint (codegen/fingerprint.py). The next load of the same content reads them back as a `Spec` whose
+symbolic part is deferred.
 
 Only a spec that parsed is ever written, so a cache keyed by content holds valid specs only: an invalid one
 misses and is refused by the full parse with exactly its usual message. What is read back is checked (form,
 types, ranges, and that it names the same shape and params as the mapping it was looked up for); anything
-unreadable or out of shape is a miss, parsed in full and written again. Anything a `CachedSpec` does not hold
+unreadable or out of shape is a miss, parsed in full and written again. What a cached spec does not hold
 (the expression, symbolic bounds, `specialise`) is parsed from the same mapping on first use.
 """
 
@@ -23,20 +23,18 @@ import math
 import os
 import re
 import stat
-from functools import cache
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-from implgen import abi, clib
+from implgen import abi
+from implgen.cachedir import cache_dir
 from implgen.codegen import paramvalues
+from implgen.codegen.fingerprint import implgen_fingerprint
 from implgen.codegen.names import check_identifier, check_shape_name
+from implgen.codegen.specmodel import Spec, Symbolic
 from implgen.errors import UserError
 from implgen.outputs import atomic_write
-from implgen.resources import templates_dir
 from implgen.yamlfile import read_yaml
-
-if TYPE_CHECKING:
-    from implgen.codegen.spec import Spec
 
 FORMAT = 2
 MAX_ENTRY_BYTES = 8 << 20  # an entry holds the printed equation of a spec file of at most 1 MiB
@@ -57,81 +55,44 @@ _ENTRY_KEYS = {
 _HEX24 = re.compile(r"[0-9a-f]{24}\Z")
 
 
-@cache
-def implgen_fingerprint() -> str:
-    """Hash of the generator's own sources and templates: generated code and parsed specs depend on them."""
-    h = hashlib.sha256()
-    pkg = Path(__file__).resolve().parent.parent
-    for p in sorted(pkg.rglob("*.py")) + sorted(templates_dir().rglob("*.j2")):
-        h.update(str(p.relative_to(p.parents[1])).encode() + b"\0" + p.read_bytes())
-    return h.hexdigest()
+class _Reparse:
+    """The symbolic part of a cached spec: the full parse of the content the entry was found for (a class, not a
+    closure, so a spec pickles with it to Dask workers)."""
+
+    def __init__(self, content: str, source: str):
+        self.content, self.source = content, source
+
+    def __call__(self) -> Symbolic:
+        return _parse(json.loads(self.content), self.source).symbolic
 
 
-class CachedSpec:
-    """A spec read back from the cache: the fields of `Spec` a scene's build and render use, without SymPy.
+def _cached_spec(entry: dict, content: str, source: str) -> Spec:
+    """A `Spec` from a cache entry: the plain data as stored, the symbolic part parsed from the same content
+    when first asked for."""
 
-    Any other attribute (`f`, `bounds`, `specialise`, `param_symbols`, ...) comes from the full `Spec`, parsed
-    on first use from the same content the entry was found for."""
-
-    def __init__(self, entry: dict, content: str, source: str):
-        self.name: str = entry["name"]
-        self.equation: str = entry["equation"]
-        self.params: dict[str, float] = {k: v for k, v in entry["params"]}
-        self.degree: int = entry["degree"]
-        self.description: str = entry["description"]
-        self.source = source
-        self.folded: dict[str, float] = {}
-        self.spec_key: str = entry["spec_key"]  # build.spec_key of the full spec
-        self._box: list[float] | None = entry["box"]
-        self.param_terms: paramvalues.Terms = [(c, tuple(e)) for c, e in entry["terms"]]
-        self.bounds_trees: paramvalues.Trees | None = (
-            None if entry["bounds"] is None else {a: (lo, hi) for a, (lo, hi) in entry["bounds"].items()}
-        )
-        self._content = content
-        self._full: Spec | None = None
-
-    def full(self) -> Spec:
-        """The full `Spec` (SymPy), parsed once from the cached content."""
-        if self._full is None:
-            from implgen.codegen.spec import parse_spec
-
-            self._full = parse_spec(json.loads(self._content), self.source)
-        return self._full
-
-    def box(self, values: dict[str, float] | None = None) -> list[float] | None:
-        """As Spec.box: the numeric box for these param values; the defaults' box is cached."""
-        if self._box is None:
-            return None
-        if not values or all(k in self.params and self.params[k] == v for k, v in values.items()):
-            return list(self._box)
-        return paramvalues.box(self.params, self.bounds_trees, values)
-
-    def check_values(self, values: dict[str, float], source: str, key: str) -> None:
-        """As Spec.check_values, from the cached terms and bounds trees (the same code)."""
-        paramvalues.check(self.name, self.params, self.param_terms, self.bounds_trees, values, source, key)
-
-    def __getattr__(self, attr: str) -> Any:  # only called for what __init__ did not set
-        if attr.startswith("_"):
-            raise AttributeError(attr)
-        return getattr(self.full(), attr)
-
-    def __repr__(self) -> str:
-        return f"CachedSpec(name={self.name!r}, degree={self.degree}, params={self.params!r})"
+    return Spec(
+        name=entry["name"],
+        equation=entry["equation"],
+        params={k: v for k, v in entry["params"]},
+        degree=entry["degree"],
+        param_terms=[(c, tuple(e)) for c, e in entry["terms"]],
+        bounds_trees=None if entry["bounds"] is None else {a: (lo, hi) for a, (lo, hi) in entry["bounds"].items()},
+        spec_key=entry["spec_key"],
+        symbolic_part=Spec.deferred(_Reparse(content, source)),
+        description=entry["description"],
+        source=source,
+        default_box=entry["box"],
+    )
 
 
-def full_spec(spec: Spec | CachedSpec) -> Spec:
-    """The SymPy-backed `Spec` of either kind."""
-    return spec.full() if isinstance(spec, CachedSpec) else spec
-
-
-def load_spec(path: str | Path) -> Spec | CachedSpec:
+def load_spec(path: str | Path) -> Spec:
     """codegen.spec.load_spec through the cache: the same reading, the same errors, the same values."""
     path = Path(path)
     return parse_spec(read_yaml(path), str(path))
 
 
-def parse_spec(data: Any, source: str = "<spec>") -> Spec | CachedSpec:
-    """codegen.spec.parse_spec through the cache: a `CachedSpec` when this content parsed before."""
+def parse_spec(data: Any, source: str = "<spec>") -> Spec:
+    """codegen.spec.parse_spec through the cache: the symbolic part is deferred when this content parsed before."""
     content = _canonical(data)
     if content is None:
         return _parse(data, source)
@@ -139,7 +100,7 @@ def parse_spec(data: Any, source: str = "<spec>") -> Spec | CachedSpec:
     path = _entry_path(key)
     entry = _read_entry(path, key, data) if path is not None else None
     if entry is not None:
-        return CachedSpec(entry, content, source)
+        return _cached_spec(entry, content, source)
     spec = _parse(data, source)  # raises exactly as without a cache
     if path is not None:
         _write_entry(path, key, spec)
@@ -173,7 +134,7 @@ def _canonical(data: Any) -> str | None:
 
 def _entry_path(key: str) -> Path | None:
     try:
-        return clib.cache_dir() / "spec" / f"{key[:40]}.json"
+        return cache_dir() / "spec" / f"{key[:40]}.json"
     except OSError:  # no usable cache folder: parse every time
         return None
 
@@ -272,8 +233,6 @@ def _trees_ok(trees: Any, params: list[str]) -> bool:
 
 
 def _write_entry(path: Path, key: str, spec: Spec) -> None:
-    from implgen.scene.build import spec_key
-
     box = spec.box()
     entry = {
         "format": FORMAT,
@@ -284,7 +243,7 @@ def _write_entry(path: Path, key: str, spec: Spec) -> None:
         "degree": spec.degree,
         "description": spec.description,
         "box": None if box is None else [float(v) for v in box],
-        "spec_key": spec_key(spec),
+        "spec_key": spec.spec_key,
         "terms": [[c, list(e)] for c, e in spec.param_terms],
         "bounds": None if spec.bounds_trees is None else {a: list(pair) for a, pair in spec.bounds_trees.items()},
     }

@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 
 from implgen.cli import ArgumentParser
-from implgen.clib import build_shared
 from implgen.codegen.derive import derive
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.codegen.spec import load_spec
+from implgen.compile.clib import build_shared
 from implgen.errors import UserError
 from implgen.outputs import write_text_files
 from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, runtime_dir, runtime_sources
@@ -73,7 +73,7 @@ def main(argv: Sequence[str]) -> int:
     print("\nAll generated C compiled with -std=c99 -Wall -Wextra -Werror -pedantic against the runtime.")
     if SHOWCASE.exists():
         try:
-            from implgen.scene.command import main as render_main
+            from implgen.animation.command import main as render_main
         except ImportError:
             return 0
         out = args.output / "glassware.png"
