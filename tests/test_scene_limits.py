@@ -16,8 +16,9 @@ from implgen import validate
 from implgen.cli import main as cli_main
 from implgen.errors import UserError
 from implgen.scene.build import build_scene
-from implgen.scene.load import MAX_CSG_NESTING, load_scene, parse_scene
+from implgen.scene.load import load_scene, parse_scene
 from implgen.scene.model import Csg
+from implgen.scene.objects import MAX_CSG_NESTING
 from implgen.scene.tracer import CScene
 from implgen.yamlfile import MAX_YAML_NODES, read_yaml
 
@@ -325,29 +326,31 @@ def test_a_key_given_twice_is_still_refused_next_to_a_merge(tmp_path):
 def test_ten_thousand_objects_load_and_one_more_is_refused(tmp_path):
     """MAX_OBJECTS leaves (CSG operands count) load, one more is refused naming the object; a spec file used
     by every one of them is looked up once."""
-    from implgen.scene import load
+    from implgen.scene import objects
 
     calls = []
-    real = load._find_spec_file
+    real = objects._find_spec_file
     path = tmp_path / "many.yaml"
-    path.write_text("objects: [" + ", ".join(["&a {shape: " + SPHERE + "}"] + ["*a"] * (load.MAX_OBJECTS - 1)) + "]\n")
+    path.write_text(
+        "objects: [" + ", ".join(["&a {shape: " + SPHERE + "}"] + ["*a"] * (objects.MAX_OBJECTS - 1)) + "]\n"
+    )
     try:
-        load._find_spec_file = lambda *a: calls.append(a) or real(*a)
-        assert len(load_scene(path).leaves()) == load.MAX_OBJECTS
+        objects._find_spec_file = lambda *a: calls.append(a) or real(*a)
+        assert len(load_scene(path).leaves()) == objects.MAX_OBJECTS
     finally:
-        load._find_spec_file = real
+        objects._find_spec_file = real
     assert len(calls) == 1
-    path.write_text("objects: [" + ", ".join(["&a {shape: " + SPHERE + "}"] + ["*a"] * load.MAX_OBJECTS) + "]\n")
-    with pytest.raises(UserError, match=rf"objects\[{load.MAX_OBJECTS}\]: more than {load.MAX_OBJECTS} objects"):
+    path.write_text("objects: [" + ", ".join(["&a {shape: " + SPHERE + "}"] + ["*a"] * objects.MAX_OBJECTS) + "]\n")
+    with pytest.raises(UserError, match=rf"objects\[{objects.MAX_OBJECTS}\]: more than {objects.MAX_OBJECTS} objects"):
         load_scene(path)
 
 
 def test_union_operands_count_as_objects():
-    from implgen.scene import load
+    from implgen.scene import objects
 
     per = 1000
-    objs = [{"union": _spheres(per)} for _ in range(load.MAX_OBJECTS // per)]
-    assert len(parse_scene({"objects": objs}, "<t>").leaves()) == load.MAX_OBJECTS
+    objs = [{"union": _spheres(per)} for _ in range(objects.MAX_OBJECTS // per)]
+    assert len(parse_scene({"objects": objs}, "<t>").leaves()) == objects.MAX_OBJECTS
     with pytest.raises(UserError, match=r"objects\[10\]: more than 10000 objects"):
         parse_scene({"objects": [*objs, {"shape": SPHERE}]}, "<t>")
 

@@ -9,7 +9,7 @@ the value holds. At a key frame the value is the key's number itself (not recomp
 exact at its keys. Both eases stay between their two keys, so a value whose keys are inside a range stays
 inside it on every frame.
 
-The range of each number is checked where it is used (scene/load.py), on every frame; this module only
+The range of each number is checked where it is used (scene/reader.py), on every frame; this module only
 checks the shape of a keyed mapping. The format is documented in docs/formats.md#keyed-values.
 """
 
@@ -18,7 +18,7 @@ from __future__ import annotations
 import bisect
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from implgen import validate
@@ -32,6 +32,19 @@ KEYED_KEYS = ("keys", "ease")
 ANIMATION_KEYS = ("frames", "fps")
 ORBIT_KEYS = ("center", "radius", "height", "turns")
 MAX_TURNS = 1000
+
+
+@dataclass
+class FrameKeys:
+    """What reading keyed values needs: the file, the frame being read, the animation's frame count (None
+    without an `animation` block), the key paths of the keyed values met so far, and the parsed keyed
+    mappings of a load (shared by its frames). The scene reader is one (scene/reader.py)."""
+
+    source: str
+    frame: int = 0
+    frames: int | None = None
+    keyed: list[str] = field(default_factory=list)
+    keyed_cache: dict | None = None
 
 
 @dataclass(frozen=True)
@@ -107,65 +120,53 @@ def parse_keyed(source: str, key: str, raw: dict, frames: int | None) -> Keyed:
     return Keyed(frames=tuple(f for f, _ in items), values=tuple(v for _, v in items), ease=ease)
 
 
-def _cached(source: str, key: str, raw: dict, frames: int | None, cache: dict | None) -> Keyed:
-    """parse_keyed once per key path and keyed mapping for all frames of a load (`cache` lives that long and
+def _cached(ctx: FrameKeys, key: str, raw: dict) -> Keyed:
+    """parse_keyed once per key path and keyed mapping for all frames of a load (the cache lives that long and
     holds `raw`, so its id stays its own): checking 5,000 keys again on each of 10,000 frames took minutes."""
+    cache = ctx.keyed_cache
     if cache is None:
-        return parse_keyed(source, key, raw, frames)
+        return parse_keyed(ctx.source, key, raw, ctx.frames)
     entry = cache.get((key, id(raw)))
     if entry is None or entry[0] is not raw:
-        entry = cache[(key, id(raw))] = (raw, parse_keyed(source, key, raw, frames), [])
+        entry = cache[(key, id(raw))] = (raw, parse_keyed(ctx.source, key, raw, ctx.frames), [])
     return entry[1]
 
 
-def resolve(
-    source: str, key: str, raw: Any, frame: int, frames: int | None, seen: list[str], cache: dict | None = None
-) -> Any:
-    """`raw` with every keyed value inside it replaced by its value at `frame` (for parts of a scene where
-    every leaf is a number, such as a transform). The key paths of the keyed values found go to `seen`."""
+def resolve(ctx: FrameKeys, key: str, raw: Any) -> Any:
+    """`raw` with every keyed value inside it replaced by its value at this frame (for parts of a scene where
+    every leaf is a number, such as a transform). The key paths of the keyed values found go to `ctx.keyed`."""
     if is_keyed(raw):
-        seen.append(key)
-        return _cached(source, key, raw, frames, cache).at(frame)
+        ctx.keyed.append(key)
+        return _cached(ctx, key, raw).at(ctx.frame)
     if isinstance(raw, dict):
-        return {
-            k: resolve(source, f"{key}.{validate.key_name(k)}", v, frame, frames, seen, cache) for k, v in raw.items()
-        }
+        return {k: resolve(ctx, f"{key}.{validate.key_name(k)}", v) for k, v in raw.items()}
     if isinstance(raw, list):
-        return [resolve(source, f"{key}[{i}]", v, frame, frames, seen, cache) for i, v in enumerate(raw)]
+        return [resolve(ctx, f"{key}[{i}]", v) for i, v in enumerate(raw)]
     return raw
 
 
-def number_at(
-    source: str,
-    key: str,
-    raw: Any,
-    frame: int,
-    frames: int | None,
-    check: Callable[[str, Any], float],
-    seen: list[str],
-    cache: dict | None = None,
-) -> float:
-    """A number that may be keyed, at `frame`, through `check(key, value)` (its range): each key's value is
+def number_at(ctx: FrameKeys, key: str, raw: Any, check: Callable[[str, Any], float]) -> float:
+    """A number that may be keyed, at this frame, through `check(key, value)` (its range): each key's value is
     checked under its own name (`camera.fov.keys.47`), then the value at this frame."""
     if not is_keyed(raw):
         return check(key, raw)
-    seen.append(key)
-    keyed = _cached(source, key, raw, frames, cache)
-    checked = cache[(key, id(raw))][2] if cache is not None else []
+    ctx.keyed.append(key)
+    keyed = _cached(ctx, key, raw)
+    checked = ctx.keyed_cache[(key, id(raw))][2] if ctx.keyed_cache is not None else []
     if not checked:  # the keys are the same on every frame: checked against this key's range once
         for f, v in zip(keyed.frames, keyed.values):
             check(f"{key}.keys.{f}", v)
         checked.append(True)
-    return check(key, keyed.at(frame))
+    return check(key, keyed.at(ctx.frame))
 
 
-def inline_params(source: str, key: str, raw: Any, frames: int | None, cache: dict | None = None) -> tuple[Any, dict]:
+def inline_params(ctx: FrameKeys, key: str, raw: Any) -> tuple[Any, dict]:
     """An inline equation's `params` as (the shape's defaults, the keyed ones to pass per frame): a keyed
     param's default is its first key, so the shape is the same on every frame and only the value moves."""
     if not isinstance(raw, dict):
         return raw, {}  # the spec parser says what is wrong with it
     keyed = {k: v for k, v in raw.items() if is_keyed(v)}
-    first = {k: _cached(source, f"{key}.{validate.key_name(k)}", v, frames, cache).values[0] for k, v in keyed.items()}
+    first = {k: _cached(ctx, f"{key}.{validate.key_name(k)}", v).values[0] for k, v in keyed.items()}
     return {**raw, **first}, keyed
 
 
@@ -180,10 +181,9 @@ def contains_keyed(raw: Any) -> bool:
     return False
 
 
-def orbit_camera(
-    source: str, cam: dict, frame: int, frames: int | None, seen: list[str], cache: dict | None = None
-) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-    """`camera.orbit` at `frame`: (position, look_at). Its numbers may be keyed too."""
+def orbit_camera(ctx: FrameKeys, cam: dict) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """`camera.orbit` at this frame: (position, look_at). Its numbers may be keyed too."""
+    source, frames = ctx.source, ctx.frames
     for k in ("position", "look_at"):
         if k in cam:
             raise UserError(source, f"camera.{k}: not with camera.orbit (the orbit sets it)")
@@ -194,7 +194,7 @@ def orbit_camera(
         def check(k: str, v: Any) -> float:
             return validate.number(source, k, v, lo, hi, lo_open=lo_open)
 
-        return number_at(source, f"camera.orbit.{key}", value, frame, frames, check, seen, cache)
+        return number_at(ctx, f"camera.orbit.{key}", value, check)
 
     big = validate.MAX_COORDINATE
     center = raw.get("center", [0, 0, 0])
@@ -205,8 +205,8 @@ def orbit_camera(
     height = num("height", raw.get("height", 0.0), -big, big)
     turns = num("turns", raw.get("turns", 1.0), -MAX_TURNS, MAX_TURNS)
     if turns and frames is not None and frames > 1:
-        seen.append("camera.orbit")
-    return orbit(c, radius, height, turns, frame, frames or 1), c
+        ctx.keyed.append("camera.orbit")
+    return orbit(c, radius, height, turns, ctx.frame, frames or 1), c
 
 
 def orbit(
