@@ -289,39 +289,18 @@ def _box_span(box, oo, dd) -> tuple[Fraction, Fraction | None] | None:
 
 
 def degree_family(degrees, rays: int, reps: int) -> list[dict]:
+    """For each degree n, the dense degree-n surface's generated C timed by bench/c/degree_cost.c (rays rays,
+    reps passes): ns per ray for coefficients, solve and total, and the generated code's operation counts."""
     import ctypes
 
-    from implgen import clib as cbuild
-    from implgen.bench.gen import dense_equation
-    from implgen.codegen.derive import derive
-    from implgen.codegen.emit import derivation_ops, generate
-    from implgen.codegen.spec import parse_spec
+    from implgen.codegen.emit import derivation_ops
     from implgen.resources import runtime_dir
 
     rt = runtime_dir()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for n in degrees:
-            k = n // 2
-            name = f"dense{n}"
-            bounds = {"x": [-1.2, 0.3 * (k - 1) + 1.2], "y": [-1.2, 0.1 * (k - 1) + 1.2], "z": [-1.2, 1.2]}
-            spec = parse_spec({"name": name, "equation": dense_equation(n), "bounds": bounds}, "<bench>")
-            der = derive(spec)
-            files = generate(spec, ("c",), der)
-            for fname, text in files.items():
-                (Path(tmp) / fname).write_text(text)
-            sources = [
-                *sorted(
-                    p for p in rt.glob("*.c") if p.name.startswith(("roots", "shape")) and p.name != "roots_bench.c"
-                ),
-                Path(tmp) / f"{name}.c",
-                ROOT / "bench" / "c" / "degree_cost.c",
-            ]
-            lib = cbuild.load(
-                cbuild.build_shared(
-                    sources, include_dirs=[rt, Path(tmp)], extra_flags=[f"-DSHAPE_SYM={name}_shape"], tag=f"deg{n}"
-                )
-            )
+            spec, der, lib = build_degree_cost(n, rt, Path(tmp))
             out = (ctypes.c_double * 5)()
             lib.degree_cost.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_ulonglong, ctypes.POINTER(ctypes.c_double)]
             if lib.degree_cost(rays, reps, 12345, out) != 0:
@@ -345,6 +324,34 @@ def degree_family(degrees, rays: int, reps: int) -> list[dict]:
                 f"total {r['total_ns']:9.1f} ns  ops {r['ops_coeffs']}"
             )
     return rows
+
+
+def build_degree_cost(n: int, rt: Path, tmp: Path):
+    """The dense degree-n surface (n/2 offset unit spheres) as a spec, its derivation, and its generated C
+    (written into tmp) built with the runtime's roots and shape code and bench/c/degree_cost.c, loaded."""
+    from implgen import clib as cbuild
+    from implgen.bench.gen import dense_equation
+    from implgen.codegen.derive import derive
+    from implgen.codegen.emit import generate
+    from implgen.codegen.spec import parse_spec
+
+    k = n // 2
+    name = f"dense{n}"
+    bounds = {"x": [-1.2, 0.3 * (k - 1) + 1.2], "y": [-1.2, 0.1 * (k - 1) + 1.2], "z": [-1.2, 1.2]}
+    spec = parse_spec({"name": name, "equation": dense_equation(n), "bounds": bounds}, "<bench>")
+    der = derive(spec)
+    files = generate(spec, ("c",), der)
+    for fname, text in files.items():
+        (tmp / fname).write_text(text)
+    sources = [
+        *sorted(p for p in rt.glob("*.c") if p.name.startswith(("roots", "shape")) and p.name != "roots_bench.c"),
+        tmp / f"{name}.c",
+        ROOT / "bench" / "c" / "degree_cost.c",
+    ]
+    lib = cbuild.load(
+        cbuild.build_shared(sources, include_dirs=[rt, tmp], extra_flags=[f"-DSHAPE_SYM={name}_shape"], tag=f"deg{n}")
+    )
+    return spec, der, lib
 
 
 # -------------------------------------------------------------------------------------------- images
