@@ -1,9 +1,10 @@
 """bench/povray_compare.py: the .pov text of a scene (camera, plane, polynomial, transform), the exact verdict on
 a known hit, a known miss and a tangent ray, the options, report.md from a hand-made results dict; and, where
-POV-Ray is installed, its renders of exported scenes."""
+POV-Ray is installed, its renders of exported scenes and a --quick run end to end on one scene."""
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 import sys
@@ -304,3 +305,32 @@ def test_options_quick_defaults_and_unknown_scene(capsys):
     with pytest.raises(SystemExit) as exit_info:
         pc.parse_options(["--scenes", "torus,nope"])
     assert exit_info.value.code == 2 and "unknown scene(s) nope" in capsys.readouterr().err
+
+
+@pytest.mark.skipif(
+    shutil.which("povray") is None, reason="POV-Ray is not installed (bench/povray_compare.py installs it)"
+)
+def test_quick_run_end_to_end(tmp_path, monkeypatch):
+    """main --quick on the torus, the degree family cut to degrees 2 and 4: every step runs and the outputs
+    agree with each other (the coverage counts add up, the report has the measured rows)."""
+    real_family = pc.degree_family
+    monkeypatch.setattr(pc, "degree_family", lambda degrees, rays, reps: real_family(degrees[:2], rays, reps))
+    argv = ["--quick", "--scenes", "torus", "-o", str(tmp_path), "--max-verdicts", "40", "--edge-checks", "20"]
+    assert pc.main(argv) == 0
+    r = json.loads((tmp_path / "results.json").read_text())
+    assert (r["width"], r["height"], r["runs"], list(r["scenes"])) == (400, 300, 1, ["torus"])
+    torus = r["scenes"]["torus"]
+    assert torus["degree"] == 4 and list(torus["timing"]) == [str(t) for t in r["threads"]]
+    for t in torus["timing"].values():
+        assert t["ours_wall"] > 0 and t["pov_wall"] > 0 and t["ratio_wall"] == t["pov_wall"] / t["ours_wall"]
+    c = torus["coverage"]
+    assert c["pixels"] == 400 * 300 and c["disputed"] == c["only_implgen"] + c["only_povray"]
+    assert c["implgen_hits"] - c["only_implgen"] == c["povray_hits"] - c["only_povray"] > 1000
+    assert c["checked"] == min(c["disputed"], 40) == c["implgen_right"] + c["povray_right"]
+    assert c["edge_checked"] == 20 and c["edge_pixels"] > 20
+    assert [d["degree"] for d in r["degree"]] == [2, 4] and all(d["ops_coeffs"] > 0 for d in r["degree"])
+    report = (tmp_path / "report.md").read_text()
+    assert f"| torus | 4 | 1 | {torus['timing']['1']['ours_wall']:.3f} |" in report
+    assert f"| torus | {c['implgen_hits']} | {c['povray_hits']} | {c['disputed']} |" in report
+    for name in ("torus_side_by_side.png", "torus_disagreement.png", "degree_cost.png", "pov/torus.pov"):
+        assert (tmp_path / name).stat().st_size > 0, name
