@@ -34,6 +34,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 
@@ -288,39 +289,18 @@ def _box_span(box, oo, dd) -> tuple[Fraction, Fraction | None] | None:
 
 
 def degree_family(degrees, rays: int, reps: int) -> list[dict]:
+    """For each degree n, the dense degree-n surface's generated C timed by bench/c/degree_cost.c (rays rays,
+    reps passes): ns per ray for coefficients, solve and total, and the generated code's operation counts."""
     import ctypes
 
-    from implgen.bench.gen import dense_equation
-    from implgen.codegen.derive import derive
-    from implgen.codegen.emit import derivation_ops, generate
-    from implgen.codegen.spec import parse_spec
-    from implgen.compile import clib as cbuild
+    from implgen.codegen.emit import derivation_ops
     from implgen.resources import runtime_dir
 
     rt = runtime_dir()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for n in degrees:
-            k = n // 2
-            name = f"dense{n}"
-            bounds = {"x": [-1.2, 0.3 * (k - 1) + 1.2], "y": [-1.2, 0.1 * (k - 1) + 1.2], "z": [-1.2, 1.2]}
-            spec = parse_spec({"name": name, "equation": dense_equation(n), "bounds": bounds}, "<bench>")
-            der = derive(spec)
-            files = generate(spec, ("c",), der)
-            for fname, text in files.items():
-                (Path(tmp) / fname).write_text(text)
-            sources = [
-                *sorted(
-                    p for p in rt.glob("*.c") if p.name.startswith(("roots", "shape")) and p.name != "roots_bench.c"
-                ),
-                Path(tmp) / f"{name}.c",
-                ROOT / "bench" / "c" / "degree_cost.c",
-            ]
-            lib = cbuild.load(
-                cbuild.build_shared(
-                    sources, include_dirs=[rt, Path(tmp)], extra_flags=[f"-DSHAPE_SYM={name}_shape"], tag=f"deg{n}"
-                )
-            )
+            spec, der, lib = build_degree_cost(n, rt, Path(tmp))
             out = (ctypes.c_double * 5)()
             lib.degree_cost.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_ulonglong, ctypes.POINTER(ctypes.c_double)]
             if lib.degree_cost(rays, reps, 12345, out) != 0:
@@ -344,6 +324,34 @@ def degree_family(degrees, rays: int, reps: int) -> list[dict]:
                 f"total {r['total_ns']:9.1f} ns  ops {r['ops_coeffs']}"
             )
     return rows
+
+
+def build_degree_cost(n: int, rt: Path, tmp: Path):
+    """The dense degree-n surface (n/2 offset unit spheres) as a spec, its derivation, and its generated C
+    (written into tmp) built with the runtime's roots and shape code and bench/c/degree_cost.c, loaded."""
+    from implgen.bench.gen import dense_equation
+    from implgen.codegen.derive import derive
+    from implgen.codegen.emit import generate
+    from implgen.codegen.spec import parse_spec
+    from implgen.compile import clib as cbuild
+
+    k = n // 2
+    name = f"dense{n}"
+    bounds = {"x": [-1.2, 0.3 * (k - 1) + 1.2], "y": [-1.2, 0.1 * (k - 1) + 1.2], "z": [-1.2, 1.2]}
+    spec = parse_spec({"name": name, "equation": dense_equation(n), "bounds": bounds}, "<bench>")
+    der = derive(spec)
+    files = generate(spec, ("c",), der)
+    for fname, text in files.items():
+        (tmp / fname).write_text(text)
+    sources = [
+        *sorted(p for p in rt.glob("*.c") if p.name.startswith(("roots", "shape")) and p.name != "roots_bench.c"),
+        tmp / f"{name}.c",
+        ROOT / "bench" / "c" / "degree_cost.c",
+    ]
+    lib = cbuild.load(
+        cbuild.build_shared(sources, include_dirs=[rt, tmp], extra_flags=[f"-DSHAPE_SYM={name}_shape"], tag=f"deg{n}")
+    )
+    return spec, der, lib
 
 
 # -------------------------------------------------------------------------------------------- images
@@ -410,7 +418,45 @@ def degree_plot(rows: list[dict], out: Path) -> None:
 # ---------------------------------------------------------------------------------------------- main
 
 
+@dataclass(frozen=True)
+class Options:
+    """The command line as the run uses it: --runs and the image size settled by --quick, the scenes a list."""
+
+    quick: bool
+    out: Path
+    runs: int
+    w: int
+    h: int
+    scenes: list[str]
+    max_verdicts: int
+    edge_checks: int
+
+
+@dataclass(frozen=True)
+class Setup:
+    """What every scene shares once the run starts: POV-Ray's executable, where the .pov files go, the thread
+    counts timed, and the core count the untimed renders (warm-ups, masks) use."""
+
+    exe: str
+    povdir: Path
+    ncpu: int
+    threads: list[int]
+
+
 def main(argv=None) -> int:
+    """The module docstring's steps: 1-3 for each scene in turn, then 4 and 5."""
+    opt = parse_options(argv)
+    setup = prepare(opt)
+    results = results_header(opt, setup)
+    rng = np.random.default_rng(2024)  # which disputed and silhouette pixels are checked exactly
+    for name in opt.scenes:
+        results["scenes"][name] = compare_scene(name, opt, setup, rng)  # steps 1-3
+    results["degree"] = cost_against_degree(opt)  # step 4
+    write_outputs(results, opt.out)  # step 5
+    return 0
+
+
+def parse_options(argv) -> Options:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="1 run per timing, 400x300, fewer rays (a smoke test)")
     ap.add_argument("-o", "--out", type=Path, default=ROOT / "bench" / "results" / "povray")
@@ -428,136 +474,212 @@ def main(argv=None) -> int:
     unknown = sorted(set(scenes) - set(SCENES))
     if unknown:
         ap.error(f"--scenes: unknown scene(s) {', '.join(unknown)}; choose from {', '.join(SCENES)}")
-    runs = args.runs or (1 if args.quick else 3)
     w, h = (400, 300) if args.quick else (800, 600)
-    out = args.out.resolve()
-    (out / "full").mkdir(parents=True, exist_ok=True)
-    povdir = out / "pov"
+    return Options(
+        quick=args.quick,
+        out=args.out.resolve(),
+        runs=args.runs or (1 if args.quick else 3),
+        w=w,
+        h=h,
+        scenes=scenes,
+        max_verdicts=args.max_verdicts,
+        edge_checks=args.edge_checks,
+    )
+
+
+def prepare(opt: Options) -> Setup:
+    """The output folders (full-size renders in full/, the exported scenes in pov/), POV-Ray (installed if
+    missing), and the thread counts: 1 and all cores."""
+    (opt.out / "full").mkdir(parents=True, exist_ok=True)
+    povdir = opt.out / "pov"
     povdir.mkdir(exist_ok=True)
     exe = ensure_povray()
     ncpu = os.cpu_count() or 1
-    thread_counts = [1] if ncpu == 1 else [1, ncpu]
+    return Setup(exe=exe, povdir=povdir, ncpu=ncpu, threads=[1] if ncpu == 1 else [1, ncpu])
+
+
+def results_header(opt: Options, setup: Setup) -> dict:
+    """results.json before any measurement: the machine, POV-Ray's version and the settings; printed too."""
     results: dict = {
         "machine": machine_info(),
-        "povray": povray_version(exe),
-        "width": w,
-        "height": h,
-        "runs": runs,
-        "threads": thread_counts,
+        "povray": povray_version(setup.exe),
+        "width": opt.w,
+        "height": opt.h,
+        "runs": opt.runs,
+        "threads": setup.threads,
         "scenes": {},
     }
-    print(f"POV-Ray {results['povray']}; {results['machine']['cpu']} x{ncpu}; {w}x{h}, {runs} run(s) each")
-    rng = np.random.default_rng(2024)
+    print(
+        f"POV-Ray {results['povray']}; {results['machine']['cpu']} x{setup.ncpu}; {opt.w}x{opt.h}, "
+        f"{opt.runs} run(s) each"
+    )
+    return results
 
-    for name in scenes:
-        path = ROOT / "bench" / "scenes" / f"{name}.yaml"
-        scene = load_scene(path)
-        pov, povc = povdir / f"{name}.pov", povdir / f"{name}_coverage.pov"
-        pov.write_text(pv.scene_pov(scene, w, h))
-        povc.write_text(pv.scene_pov(scene, w, h, coverage=True))
-        ours_png, pov_png = out / "full" / f"{name}_implgen.png", out / "full" / f"{name}_povray.png"
-        run_ours(path, ours_png, w, h, ncpu)  # warm-up: builds and caches the tracer
-        run_povray(exe, pov, pov_png, w, h, ncpu)  # warm-up: file cache
-        rec: dict = {"degree": max(leaf.spec.degree for leaf in scene.leaves()), "timing": {}}
-        for th in thread_counts:
-            o_wall, o_own, p_wall, p_own = [], [], [], []
-            for _ in range(runs):  # interleaved so both see the same machine load
-                a, b = run_ours(path, ours_png, w, h, th)
-                o_wall.append(a)
-                o_own.append(b)  # noqa: E702
-                a, b = run_povray(exe, pov, pov_png, w, h, th)
-                p_wall.append(a)
-                p_own.append(b)  # noqa: E702
-            t = {
-                "ours_wall": statistics.median(o_wall),
-                "ours_render": statistics.median(o_own),
-                "pov_wall": statistics.median(p_wall),
-                "pov_trace": statistics.median(p_own),
-                "ours_wall_all": o_wall,
-                "pov_wall_all": p_wall,
-            }
-            t["ratio_wall"] = t["pov_wall"] / t["ours_wall"]
-            t["ratio_render"] = t["pov_trace"] / t["ours_render"]
-            rec["timing"][str(th)] = t
-            print(
-                f"{name:9s} {th} thread(s): implgen {t['ours_wall']:.3f} s (render {t['ours_render']:.3f}), "
-                f"POV-Ray {t['pov_wall']:.3f} s (trace {t['pov_trace']:.3f}) -> POV/implgen "
-                f"{t['ratio_wall']:.2f}x wall, {t['ratio_render']:.2f}x render"
-            )
-        side_by_side(ours_png, pov_png, out / f"{name}_side_by_side.png")
 
-        # coverage
-        mo = our_mask(path, w, h, ncpu)
-        mask_png = out / "full" / f"{name}_povray_mask.png"
-        run_povray(exe, povc, mask_png, w, h, ncpu)
-        mp = pov_mask(mask_png)
-        dis = np.argwhere(mo != mp)
-        disagreement_image(mo, mp, out / f"{name}_disagreement.png")
-        sample = dis if len(dis) <= args.max_verdicts else dis[rng.choice(len(dis), args.max_verdicts, replace=False)]
-        judge = ExactJudge(scene, w, h)
-        t0 = time.perf_counter()
-        ours_right = pov_right = 0
-        examples = []
-        for yy, xx in sample:
-            truth = judge.hits(int(xx), int(yy))
-            if truth == bool(mo[yy, xx]):
-                ours_right += 1
-            else:
-                pov_right += 1
-            if len(examples) < 5:
-                examples.append(
-                    {
-                        "x": int(xx),
-                        "y": int(yy),
-                        "exact_hit": truth,
-                        "implgen": bool(mo[yy, xx]),
-                        "povray": bool(mp[yy, xx]),
-                    }
-                )
-        # silhouette pixels both programs agree on: are both right there? (a check on the agreement itself)
-        edge = np.zeros_like(mo)
-        edge[1:] |= mo[1:] != mo[:-1]
-        edge[:-1] |= mo[1:] != mo[:-1]  # noqa: E702
-        edge[:, 1:] |= mo[:, 1:] != mo[:, :-1]
-        edge[:, :-1] |= mo[:, 1:] != mo[:, :-1]  # noqa: E702
-        agreed_edge = np.argwhere(edge & (mo == mp))
-        nedge = min(len(agreed_edge), args.edge_checks)
-        esample = agreed_edge[rng.choice(len(agreed_edge), nedge, replace=False)] if nedge else agreed_edge[:0]
-        both_wrong = sum(judge.hits(int(xx), int(yy)) != bool(mo[yy, xx]) for yy, xx in esample)
-        rec["coverage"] = {
-            "edge_checked": int(nedge),
-            "edge_both_wrong": int(both_wrong),
-            "edge_pixels": int(edge.sum()),
-            "pixels": w * h,
-            "implgen_hits": int(mo.sum()),
-            "povray_hits": int(mp.sum()),
-            "disputed": int(len(dis)),
-            "disputed_fraction": len(dis) / (w * h),
-            "only_implgen": int((mo & ~mp).sum()),
-            "only_povray": int((mp & ~mo).sum()),
-            "checked": int(len(sample)),
-            "implgen_right": ours_right,
-            "povray_right": pov_right,
-            "check_seconds": time.perf_counter() - t0,
-            "examples": examples,
-        }
-        c = rec["coverage"]
+def compare_scene(name: str, opt: Options, setup: Setup, rng: np.random.Generator) -> dict:
+    """Steps 1-3 on one scene: export it to POV-Ray, time both programs, compare their coverage masks."""
+    path = ROOT / "bench" / "scenes" / f"{name}.yaml"
+    scene = load_scene(path)
+    pov, povc = export_scene(scene, name, opt, setup)
+    ours_png, pov_png = opt.out / "full" / f"{name}_implgen.png", opt.out / "full" / f"{name}_povray.png"
+    timing = time_scene(name, path, pov, ours_png, pov_png, opt, setup)
+    side_by_side(ours_png, pov_png, opt.out / f"{name}_side_by_side.png")
+    rec: dict = {"degree": max(leaf.spec.degree for leaf in scene.leaves()), "timing": timing}
+    rec["coverage"] = compare_coverage(name, path, scene, povc, opt, setup, rng)
+    return rec
+
+
+def export_scene(scene, name: str, opt: Options, setup: Setup) -> tuple[Path, Path]:
+    """Step 1: the scene as POV-Ray text, shaded and as a coverage scene (flat white, no plane, no light)."""
+    pov, povc = setup.povdir / f"{name}.pov", setup.povdir / f"{name}_coverage.pov"
+    pov.write_text(pv.scene_pov(scene, opt.w, opt.h))
+    povc.write_text(pv.scene_pov(scene, opt.w, opt.h, coverage=True))
+    return pov, povc
+
+
+def time_scene(name: str, path: Path, pov: Path, ours_png: Path, pov_png: Path, opt: Options, setup: Setup) -> dict:
+    """Step 2: one warm-up render each, then both programs timed on each thread count; printed as it goes."""
+    run_ours(path, ours_png, opt.w, opt.h, setup.ncpu)  # warm-up: builds and caches the tracer
+    run_povray(setup.exe, pov, pov_png, opt.w, opt.h, setup.ncpu)  # warm-up: file cache
+    timing = {}
+    for th in setup.threads:
+        t = time_both(path, pov, ours_png, pov_png, th, opt, setup.exe)
+        timing[str(th)] = t
         print(
-            f"{name:9s} coverage: {c['disputed']} disputed pixels ({100 * c['disputed_fraction']:.3f} %), "
-            f"checked {c['checked']}: implgen right on {ours_right}, POV-Ray right on {pov_right} "
-            f"({c['check_seconds']:.1f} s); agreed silhouette pixels checked {c['edge_checked']}, "
-            f"both wrong on {c['edge_both_wrong']}"
+            f"{name:9s} {th} thread(s): implgen {t['ours_wall']:.3f} s (render {t['ours_render']:.3f}), "
+            f"POV-Ray {t['pov_wall']:.3f} s (trace {t['pov_trace']:.3f}) -> POV/implgen "
+            f"{t['ratio_wall']:.2f}x wall, {t['ratio_render']:.2f}x render"
         )
-        results["scenes"][name] = rec
+    return timing
 
+
+def time_both(path: Path, pov: Path, ours_png: Path, pov_png: Path, th: int, opt: Options, exe: str) -> dict:
+    """--runs runs of each program on `th` threads, interleaved so both see the same machine load: the
+    medians of wall clock and of each program's own figure, and POV-Ray / implgen ratios of both."""
+    o_wall, o_own, p_wall, p_own = [], [], [], []
+    for _ in range(opt.runs):
+        a, b = run_ours(path, ours_png, opt.w, opt.h, th)
+        o_wall.append(a)
+        o_own.append(b)
+        a, b = run_povray(exe, pov, pov_png, opt.w, opt.h, th)
+        p_wall.append(a)
+        p_own.append(b)
+    t = {
+        "ours_wall": statistics.median(o_wall),
+        "ours_render": statistics.median(o_own),
+        "pov_wall": statistics.median(p_wall),
+        "pov_trace": statistics.median(p_own),
+        "ours_wall_all": o_wall,
+        "pov_wall_all": p_wall,
+    }
+    t["ratio_wall"] = t["pov_wall"] / t["ours_wall"]
+    t["ratio_render"] = t["pov_trace"] / t["ours_render"]
+    return t
+
+
+def compare_coverage(
+    name: str, path: Path, scene, povc: Path, opt: Options, setup: Setup, rng: np.random.Generator
+) -> dict:
+    """Step 3: both coverage masks, the disagreement image, a sample of the disputed pixels decided exactly,
+    and a sample of the silhouette pixels both agree on checked the same way; printed too."""
+    mo = our_mask(path, opt.w, opt.h, setup.ncpu)
+    mask_png = opt.out / "full" / f"{name}_povray_mask.png"
+    run_povray(setup.exe, povc, mask_png, opt.w, opt.h, setup.ncpu)
+    mp = pov_mask(mask_png)
+    dis = np.argwhere(mo != mp)
+    disagreement_image(mo, mp, opt.out / f"{name}_disagreement.png")
+    sample = dis if len(dis) <= opt.max_verdicts else dis[rng.choice(len(dis), opt.max_verdicts, replace=False)]
+    judge = ExactJudge(scene, opt.w, opt.h)
+    t0 = time.perf_counter()
+    ours_right, pov_right, examples = decide_disputed(judge, sample, mo, mp)
+    edge = silhouette(mo)
+    nedge, both_wrong = check_agreed_silhouette(judge, edge & (mo == mp), mo, opt.edge_checks, rng)
+    c = {
+        "edge_checked": int(nedge),
+        "edge_both_wrong": int(both_wrong),
+        "edge_pixels": int(edge.sum()),
+        "pixels": opt.w * opt.h,
+        "implgen_hits": int(mo.sum()),
+        "povray_hits": int(mp.sum()),
+        "disputed": int(len(dis)),
+        "disputed_fraction": len(dis) / (opt.w * opt.h),
+        "only_implgen": int((mo & ~mp).sum()),
+        "only_povray": int((mp & ~mo).sum()),
+        "checked": int(len(sample)),
+        "implgen_right": ours_right,
+        "povray_right": pov_right,
+        "check_seconds": time.perf_counter() - t0,  # the disputed and the silhouette checks
+        "examples": examples,
+    }
+    print(
+        f"{name:9s} coverage: {c['disputed']} disputed pixels ({100 * c['disputed_fraction']:.3f} %), "
+        f"checked {c['checked']}: implgen right on {ours_right}, POV-Ray right on {pov_right} "
+        f"({c['check_seconds']:.1f} s); agreed silhouette pixels checked {c['edge_checked']}, "
+        f"both wrong on {c['edge_both_wrong']}"
+    )
+    return c
+
+
+def decide_disputed(judge: ExactJudge, sample: np.ndarray, mo: np.ndarray, mp: np.ndarray) -> tuple[int, int, list]:
+    """Each sampled disputed pixel (row, column) decided exactly: how many implgen's mask has right, how many
+    POV-Ray's, and the first five as examples."""
+    ours_right = pov_right = 0
+    examples = []
+    for yy, xx in sample:
+        truth = judge.hits(int(xx), int(yy))
+        if truth == bool(mo[yy, xx]):
+            ours_right += 1
+        else:
+            pov_right += 1
+        if len(examples) < 5:
+            examples.append(
+                {
+                    "x": int(xx),
+                    "y": int(yy),
+                    "exact_hit": truth,
+                    "implgen": bool(mo[yy, xx]),
+                    "povray": bool(mp[yy, xx]),
+                }
+            )
+    return ours_right, pov_right, examples
+
+
+def silhouette(mo: np.ndarray) -> np.ndarray:
+    """The pixels of a mask next to (4-neighbours) a pixel of the other value: a hit beside a miss."""
+    edge = np.zeros_like(mo)
+    edge[1:] |= mo[1:] != mo[:-1]
+    edge[:-1] |= mo[1:] != mo[:-1]
+    edge[:, 1:] |= mo[:, 1:] != mo[:, :-1]
+    edge[:, :-1] |= mo[:, 1:] != mo[:, :-1]
+    return edge
+
+
+def check_agreed_silhouette(
+    judge: ExactJudge, agreed: np.ndarray, mo: np.ndarray, n: int, rng: np.random.Generator
+) -> tuple[int, int]:
+    """A check on the agreement itself: up to n silhouette pixels both programs agree on (mask `agreed`),
+    decided exactly; (how many checked, on how many both are wrong)."""
+    agreed_edge = np.argwhere(agreed)
+    nedge = min(len(agreed_edge), n)
+    esample = agreed_edge[rng.choice(len(agreed_edge), nedge, replace=False)] if nedge else agreed_edge[:0]
+    both_wrong = sum(judge.hits(int(xx), int(yy)) != bool(mo[yy, xx]) for yy, xx in esample)
+    return nedge, both_wrong
+
+
+def cost_against_degree(opt: Options) -> list[dict]:
+    """Step 4: the generated C intersectors of the dense degree-n family timed (n = 2, 4, .., 20), and plotted."""
     print("cost against degree (generated C, dense family):")
     degrees = list(range(2, 21, 2))
-    results["degree"] = degree_family(degrees, rays=2000 if args.quick else 20000, reps=3 if args.quick else 7)
-    degree_plot(results["degree"], out / "degree_cost.png")
+    rows = degree_family(degrees, rays=2000 if opt.quick else 20000, reps=3 if opt.quick else 7)
+    degree_plot(rows, opt.out / "degree_cost.png")
+    return rows
+
+
+def write_outputs(results: dict, out: Path) -> None:
+    """Step 5 (the images are already there): results.json and report.md."""
     (out / "results.json").write_text(json.dumps(results, indent=1))
     write_report(results, out)
     print("wrote", out / "report.md")
-    return 0
 
 
 def machine_info() -> dict:
@@ -571,16 +693,35 @@ def machine_info() -> dict:
 
 
 def write_report(r: dict, out: Path) -> None:
-    th = r["threads"]
-    one, allc = str(th[0]), str(th[-1])
-    L = [
+    """report.md from results.json's dict, section by section; each but the last ends with the blank line before
+    the next."""
+    lines = [
+        *report_title(r),
+        *render_time_section(r),
+        *speedup_section(r),
+        *coverage_section(r),
+        *images_section(r),
+        *degree_section(r),
+        *targets_section(r),
+    ]
+    (out / "report.md").write_text("\n".join(lines) + "\n")
+
+
+def report_title(r: dict) -> list[str]:
+    m = r["machine"]
+    return [
         f"# implgen against POV-Ray {r['povray']}",
         "",
-        f"Generated by `bench/povray_compare.py` on {r['machine']['date']}: {r['machine']['cpu']}, "
-        f"{r['machine']['cores']} cores, {r['machine']['system']}. {r['width']}x{r['height']}, 1 sample, "
+        f"Generated by `bench/povray_compare.py` on {m['date']}: {m['cpu']}, "
+        f"{m['cores']} cores, {m['system']}. {r['width']}x{r['height']}, 1 sample, "
         f"median of {r['runs']} interleaved run(s). Load average before the run: "
-        f"{r['machine']['load_before']:.2f} (other jobs may have shared the CPU).",
+        f"{m['load_before']:.2f} (other jobs may have shared the CPU).",
         "",
+    ]
+
+
+def render_time_section(r: dict) -> list[str]:
+    L = [
         "## Render time",
         "",
         "Wall = the whole subprocess (`implgen render` includes Python start-up and the cached-build lookup; "
@@ -592,14 +733,19 @@ def write_report(r: dict, out: Path) -> None:
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for name, s in r["scenes"].items():
-        for t in th:
+        for t in r["threads"]:
             x = s["timing"][str(t)]
             L.append(
                 f"| {name} | {s['degree']} | {t} | {x['ours_wall']:.3f} | {x['pov_wall']:.3f} | "
                 f"{x['ratio_wall']:.2f}x | {x['ours_render']:.3f} | {x['pov_trace']:.3f} | {x['ratio_render']:.2f}x |"
             )
-    L += [
-        "",
+    return [*L, ""]
+
+
+def speedup_section(r: dict) -> list[str]:
+    """All cores against one (the first and last thread counts), wall clock and each program's own figure."""
+    one, allc = str(r["threads"][0]), str(r["threads"][-1])
+    L = [
         "## Multi-core speed-up (all cores against one, wall clock)",
         "",
         "| scene | implgen | POV-Ray |",
@@ -611,8 +757,11 @@ def write_report(r: dict, out: Path) -> None:
             f"| {name} | {a['ours_wall'] / b['ours_wall']:.2f}x (render {a['ours_render'] / b['ours_render']:.2f}x) | "
             f"{a['pov_wall'] / b['pov_wall']:.2f}x (trace {a['pov_trace'] / b['pov_trace']:.2f}x) |"
         )
-    L += [
-        "",
+    return [*L, ""]
+
+
+def coverage_section(r: dict) -> list[str]:
+    L = [
         "## Coverage (object hit or not, per pixel)",
         "",
         "Disputed = pixels where one program sees the object and the other does not. Each checked disputed "
@@ -634,16 +783,22 @@ def write_report(r: dict, out: Path) -> None:
             f"{100 * c['disputed_fraction']:.3f} | {c['only_implgen']} | {c['only_povray']} | {c['checked']} | "
             f"{c['implgen_right']} | {c['povray_right']} | {c['edge_checked']} | {c['edge_both_wrong']} |"
         )
-    L += [
-        "",
+    return [*L, ""]
+
+
+def images_section(r: dict) -> list[str]:
+    L = [
         "Images (left implgen, right POV-Ray) and disagreement maps (red: only implgen hits, blue: only "
         "POV-Ray hits, dilated by one pixel to be visible):",
         "",
     ]
     for name in r["scenes"]:
-        L.append(f"![{name}]({name}_side_by_side.png) ![{name} disagreement]({name}_disagreement.png)")
-        L.append("")
-    L += [
+        L += [f"![{name}]({name}_side_by_side.png) ![{name} disagreement]({name}_disagreement.png)", ""]
+    return L
+
+
+def degree_section(r: dict) -> list[str]:
+    L = [
         "## Cost against degree",
         "",
         "Generated C for a dense family (product of n/2 offset unit spheres minus 0.01, every monomial present), "
@@ -660,10 +815,11 @@ def write_report(r: dict, out: Path) -> None:
             f"| {d['degree']} | {d['coeffs_ns']:.1f} | {d['solve_ns']:.1f} | {d['total_ns']:.1f} | "
             f"{d['roots_per_ray']:.2f} | {d['ops_coeffs']} | {d['ops_value']} | {d['ops_gradient']} |"
         )
-    L += ["", "![cost against degree](degree_cost.png)", "", "## Targets", ""]
-    for line in targets(r):
-        L.append(f"- {line}")
-    (out / "report.md").write_text("\n".join(L) + "\n")
+    return [*L, "", "![cost against degree](degree_cost.png)", ""]
+
+
+def targets_section(r: dict) -> list[str]:
+    return ["## Targets", "", *(f"- {line}" for line in targets(r))]
 
 
 def targets(r: dict) -> list[str]:

@@ -1,8 +1,10 @@
-"""bench/povray_compare.py pieces, fast and without POV-Ray: the .pov text of a scene (camera, plane,
-polynomial, transform), and the exact verdict on a known hit, a known miss and a tangent ray."""
+"""bench/povray_compare.py: the .pov text of a scene (camera, plane, polynomial, transform), the exact verdict on
+a known hit, a known miss and a tangent ray, the options, report.md from a hand-made results dict; and, where
+POV-Ray is installed, its renders of exported scenes and a --quick run end to end on one scene."""
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 import sys
@@ -185,3 +187,150 @@ def test_integer_ray_polynomial_is_a_positive_multiple_of_the_exact_one():
     got = judge.ray_poly(obj, o, d)
     ratio = Fraction(got[-1]) / want[-1]
     assert ratio > 0 and all(Fraction(g) == ratio * w for g, w in zip(got, want))
+
+
+def _timing(ours_wall: float, ours_render: float, pov_wall: float, pov_trace: float) -> dict:
+    return {
+        "ours_wall": ours_wall,
+        "ours_render": ours_render,
+        "pov_wall": pov_wall,
+        "pov_trace": pov_trace,
+        "ours_wall_all": [ours_wall],
+        "pov_wall_all": [pov_wall],
+        "ratio_wall": pov_wall / ours_wall,
+        "ratio_render": pov_trace / ours_render,
+    }
+
+
+def _coverage(implgen_right: int, povray_right: int) -> dict:
+    return {
+        "edge_checked": 20,
+        "edge_both_wrong": 1,
+        "edge_pixels": 900,
+        "pixels": 120000,
+        "implgen_hits": 30000,
+        "povray_hits": 29000,
+        "disputed": 1500,
+        "disputed_fraction": 1500 / 120000,
+        "only_implgen": 1250,
+        "only_povray": 250,
+        "checked": implgen_right + povray_right,
+        "implgen_right": implgen_right,
+        "povray_right": povray_right,
+        "check_seconds": 1.5,
+        "examples": [],
+    }
+
+
+def test_report_states_the_measurements(tmp_path):
+    """write_report on a hand-made results dict: every table row, the speed-ups worked out from the 1- and
+    4-thread timings, the images, and the targets' verdicts (degree >= 6 needs 5x on 1 thread, else 2x)."""
+    results = {
+        "machine": {"cpu": "Test CPU", "cores": 4, "system": "TestOS", "date": "2000-01-02", "load_before": 0.25},
+        "povray": "3.7.0.10",
+        "width": 400,
+        "height": 300,
+        "runs": 3,
+        "threads": [1, 4],
+        "scenes": {
+            "torus": {
+                "degree": 4,
+                "timing": {"1": _timing(2.0, 1.0, 6.0, 5.0), "4": _timing(0.5, 0.25, 2.0, 2.5)},
+                "coverage": _coverage(10, 2),
+            },
+            "chmutov": {
+                "degree": 8,
+                "timing": {"1": _timing(1.0, 0.5, 4.0, 3.0), "4": _timing(0.5, 0.25, 1.0, 1.0)},
+                "coverage": _coverage(3, 3),
+            },
+        },
+        "degree": [
+            {
+                "degree": 2,
+                "coeffs_ns": 2.34,
+                "solve_ns": 20.5,
+                "total_ns": 80.0,
+                "roots_per_ray": 1.5,
+                "hit_fraction": 0.5,
+                "ops_coeffs": 20,
+                "ops_value": 11,
+                "ops_gradient": 30,
+            }
+        ],
+    }
+    pc.write_report(results, tmp_path)
+    text = (tmp_path / "report.md").read_text()
+    lines = text.splitlines()
+    assert lines[0] == "# implgen against POV-Ray 3.7.0.10" and text.endswith("\n")
+    assert "on 2000-01-02: Test CPU, 4 cores, TestOS. 400x300, 1 sample, median of 3 interleaved run(s)" in text
+    assert "Load average before the run: 0.25" in text
+    headings = [line for line in lines if line.startswith("## ")]
+    assert [h.split(" (")[0] for h in headings] == [
+        "## Render time",
+        "## Multi-core speed-up",
+        "## Coverage",
+        "## Cost against degree",
+        "## Targets",
+    ]
+    # render time: one row per scene and thread count, ratio = POV-Ray / implgen
+    assert "| torus | 4 | 1 | 2.000 | 6.000 | 3.00x | 1.000 | 5.000 | 5.00x |" in lines
+    assert "| torus | 4 | 4 | 0.500 | 2.000 | 4.00x | 0.250 | 2.500 | 10.00x |" in lines
+    assert "| chmutov | 8 | 1 | 1.000 | 4.000 | 4.00x | 0.500 | 3.000 | 6.00x |" in lines
+    # speed-up: 1 thread against all (the last thread count)
+    assert "| torus | 4.00x (render 4.00x) | 3.00x (trace 2.00x) |" in lines
+    assert "| chmutov | 2.00x (render 2.00x) | 4.00x (trace 3.00x) |" in lines
+    assert "| torus | 30000 | 29000 | 1500 | 1.250 | 1250 | 250 | 12 | 10 | 2 | 20 | 1 |" in lines
+    assert "| chmutov | 30000 | 29000 | 1500 | 1.250 | 1250 | 250 | 6 | 3 | 3 | 20 | 1 |" in lines
+    for name in ("torus", "chmutov"):
+        assert f"![{name}]({name}_side_by_side.png) ![{name} disagreement]({name}_disagreement.png)" in lines
+    assert "| 2 | 2.3 | 20.5 | 80.0 | 1.50 | 20 | 11 | 30 |" in lines
+    assert "![cost against degree](degree_cost.png)" in lines
+    targets = lines[lines.index("## Targets") + 2 :]
+    assert targets == [
+        "- torus (degree 4), 1 thread, at least 2x faster: wall 3.00x MET; render-only 5.00x MET",
+        "- chmutov (degree 8), 1 thread, at least 5x faster: wall 4.00x MISSED; render-only 6.00x MET",
+        "- torus: disputed pixels checked 12; implgen wrong on 2, POV-Ray wrong on 10: fewer disagreements with "
+        "the exact reference MET",
+        "- chmutov: disputed pixels checked 6; implgen wrong on 3, POV-Ray wrong on 3: fewer disagreements with "
+        "the exact reference TIE (not strictly met)",
+    ]
+
+
+def test_options_quick_defaults_and_unknown_scene(capsys):
+    quick = pc.parse_options(["--quick", "-o", "out"])
+    assert (quick.runs, quick.w, quick.h, quick.scenes) == (1, 400, 300, list(pc.SCENES))
+    assert quick.out == Path("out").resolve() and (quick.max_verdicts, quick.edge_checks) == (1500, 300)
+    full = pc.parse_options(["--runs", "5", "--scenes", "heart,,torus"])
+    assert (full.runs, full.w, full.h, full.scenes, full.quick) == (5, 800, 600, ["heart", "torus"], False)
+    with pytest.raises(SystemExit) as exit_info:
+        pc.parse_options(["--scenes", "torus,nope"])
+    assert exit_info.value.code == 2 and "unknown scene(s) nope" in capsys.readouterr().err
+
+
+@pytest.mark.skipif(
+    shutil.which("povray") is None, reason="POV-Ray is not installed (bench/povray_compare.py installs it)"
+)
+def test_quick_run_end_to_end(tmp_path, monkeypatch):
+    """main --quick on the torus, the degree family cut to degrees 2 and 4: every step runs and the outputs
+    agree with each other (the coverage counts add up, the report has the measured rows)."""
+    real_family = pc.degree_family
+    monkeypatch.setattr(pc, "degree_family", lambda degrees, rays, reps: real_family(degrees[:2], rays, reps))
+    argv = ["--quick", "--scenes", "torus", "-o", str(tmp_path), "--max-verdicts", "40", "--edge-checks", "20"]
+    assert pc.main(argv) == 0
+    r = json.loads((tmp_path / "results.json").read_text())
+    assert (r["width"], r["height"], r["runs"], list(r["scenes"])) == (400, 300, 1, ["torus"])
+    torus = r["scenes"]["torus"]
+    assert torus["degree"] == 4 and list(torus["timing"]) == [str(t) for t in r["threads"]]
+    for t in torus["timing"].values():
+        assert t["ours_wall"] > 0 and t["pov_wall"] > 0 and t["ratio_wall"] == t["pov_wall"] / t["ours_wall"]
+    c = torus["coverage"]
+    assert c["pixels"] == 400 * 300 and c["disputed"] == c["only_implgen"] + c["only_povray"]
+    assert c["implgen_hits"] - c["only_implgen"] == c["povray_hits"] - c["only_povray"] > 1000
+    assert c["checked"] == min(c["disputed"], 40) == c["implgen_right"] + c["povray_right"]
+    assert c["edge_checked"] == 20 and c["edge_pixels"] > 20
+    assert [d["degree"] for d in r["degree"]] == [2, 4] and all(d["ops_coeffs"] > 0 for d in r["degree"])
+    report = (tmp_path / "report.md").read_text()
+    assert f"| torus | 4 | 1 | {torus['timing']['1']['ours_wall']:.3f} |" in report
+    assert f"| torus | {c['implgen_hits']} | {c['povray_hits']} | {c['disputed']} |" in report
+    for name in ("torus_side_by_side.png", "torus_disagreement.png", "degree_cost.png", "pov/torus.pov"):
+        assert (tmp_path / name).stat().st_size > 0, name
