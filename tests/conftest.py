@@ -26,7 +26,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
 CDIR = ROOT / "tests" / "c"
-C_WARNINGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 C_SANITIZE = ["-O1", "-g", "-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer"]
 
 
@@ -34,9 +33,9 @@ def compile_c(out: Path, sources, *, include=(), sanitize: bool = True, shared: 
     """Compile C sources into `out` (an executable, or a shared library with shared=True) with the project's
     warnings as errors, against the runtime, the generated shapes and tests/c; ASan + UBSan unless told not
     to (any report aborts). The compiler is $CC, else cc (implgen.compile.clib.compiler)."""
-    from implgen.compile.clib import compiler
+    from implgen.compile.clib import WARNING_FLAGS, compiler
 
-    cmd = [compiler(), *C_WARNINGS, *(C_SANITIZE if sanitize else ["-O2"]), "-pthread", *flags]
+    cmd = [compiler(), *WARNING_FLAGS, *(C_SANITIZE if sanitize else ["-O2"]), "-pthread", *flags]
     cmd += ["-shared", "-fPIC"] if shared else []
     cmd += [f"-I{d}" for d in (*include, RUNTIME, GENERATED, CDIR)]
     cmd += ["-o", str(out), *map(str, sources), "-lm"]

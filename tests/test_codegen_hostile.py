@@ -24,7 +24,7 @@ from implgen.codegen.emit import generate
 from implgen.codegen.grammar import format_expression, parse_expression
 from implgen.codegen.names import reserved_shape_name
 from implgen.codegen.spec import VARIABLES, exact_polynomial, load_spec, param_symbol, parse_spec
-from implgen.compile.clib import compiler
+from implgen.compile.clib import WARNING_FLAGS, compiler
 from implgen.errors import UserError
 from implgen.outputs import write_text_files
 
@@ -131,11 +131,7 @@ def test_hostile_file_name_and_description_stay_text(tmp_path, monkeypatch):
     proc = subprocess.run(
         [
             compiler(),
-            "-std=c99",
-            "-Wall",
-            "-Wextra",
-            "-Werror",
-            "-pedantic",
+            *WARNING_FLAGS,
             "-c",
             f"-I{RUNTIME}",
             f"-I{out}",

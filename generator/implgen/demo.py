@@ -14,7 +14,7 @@ from implgen.cli import ArgumentParser
 from implgen.codegen.derive import derive
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.codegen.spec import load_spec
-from implgen.compile.clib import build_shared
+from implgen.compile.clib import WARNING_FLAGS, build_shared
 from implgen.errors import UserError
 from implgen.outputs import write_text_files
 from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, runtime_dir, runtime_sources
@@ -70,7 +70,7 @@ def main(argv: Sequence[str]) -> int:
         hits, total = _ray_fan(module, module.bounds())
         params = ", ".join(f"{k}={v:g}" for k, v in spec.params.items()) or "-"
         print(f"{spec.name:<10} {spec.degree:>6} {params:<18} {ops:>9} {ms:>7.0f} {hits:>4}/{total}")
-    print("\nAll generated C compiled with -std=c99 -Wall -Wextra -Werror -pedantic against the runtime.")
+    print(f"\nAll generated C compiled with {' '.join(WARNING_FLAGS)} against the runtime.")
     if SHOWCASE.exists():
         try:
             from implgen.animation.command import main as render_main

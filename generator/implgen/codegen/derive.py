@@ -119,10 +119,6 @@ class Block:
     outputs: list[sympy.Expr]
     inputs: list[sympy.Symbol]  # the ray/point/param symbols the block reads
 
-    @property
-    def op_count(self) -> int:
-        return int(sum(sympy.count_ops(e) for _, e in self.temps) + sum(sympy.count_ops(e) for e in self.outputs))
-
 
 @dataclass(frozen=True)
 class Derivation:
@@ -131,10 +127,6 @@ class Derivation:
     value: Block
     gradient: Block
     bounds: Block | None
-
-    @property
-    def op_count(self) -> int:
-        return sum(b.op_count for b in (self.coeffs, self.value, self.gradient))
 
 
 def _split(

@@ -45,7 +45,6 @@ def bind(lib: ctypes.CDLL) -> ctypes.CDLL:
         "rt_scene_set_background": (None, [vp, _pd]),
         "rt_scene_commit": (ctypes.c_int, [vp]),
         "rt_scene_error": (ctypes.c_char_p, [vp]),
-        "rt_scene_count": (ctypes.c_int, [vp, ctypes.c_int]),
         "rt_scene_shape": (vp, [ctypes.c_int]),
         "rt_scene_nshapes": (ctypes.c_int, []),
         "rt_render_new": (

@@ -161,10 +161,7 @@ class Document:
         if self.base is None:
             sc = Scene(source="view", width=width, height=height, spp=spp, max_depth=4)
             node = self._shape_node()
-            if isinstance(node, Csg):
-                node.material = self.material()
-            else:
-                node.material = self.material()
+            node.material = self.material()  # the shape's, or the clip's intersection's (its cut faces keep theirs)
             sc.objects = [node]
         else:
             sc = replace(self.base, width=width, height=height, spp=spp)
