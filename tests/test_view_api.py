@@ -77,7 +77,7 @@ def test_only_the_pages_files_are_served(client) -> None:
         r = client.get(path)
         assert r.status_code == 200 and r.headers["content-type"].startswith(kind)
         assert "default-src 'self'" in r.headers["content-security-policy"]
-    for path in ("/static/app.js", "/index.html", "/../pyproject.toml", "/%2e%2e/generator/cli.py", "/ws/x"):
+    for path in ("/static/app.js", "/index.html", "/../pyproject.toml", "/%2e%2e/generator/implgen/cli.py", "/ws/x"):
         assert client.get(path).status_code == 404
     assert 'src="/app.js"' in client.get("/").text
 
