@@ -6,17 +6,16 @@
     implgen bench solvers|gen|render [...]                           measure
     implgen demo                                                     the main job of `make demo`
 
-Bad input (UserError) becomes one line on stderr and exit status 2, never a traceback.
+Bad input (UserError) becomes one line on stderr and exit status 2, never a traceback. This is the roof: it
+imports the commands, and nothing imports it back (the parser they share is implgen.args).
 """
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import os
 import sys
 from collections.abc import Callable, Sequence
-from typing import Any
 
 from implgen.errors import UserError
 
@@ -31,18 +30,6 @@ _BENCHES: dict[str, str] = {
     "gen": "implgen.bench.gen:main",
     "render": "implgen.bench.render:main",
 }
-
-
-class ArgumentParser(argparse.ArgumentParser):
-    """argparse for every implgen command: a bad option is a UserError (one line naming `label`, or the
-    command, and exit status 2), never argparse's usage text and its own exit."""
-
-    def __init__(self, *args: Any, label: str | None = None, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
-        self.label = label or self.prog
-
-    def error(self, message: str) -> Any:
-        raise UserError(self.label, message)
 
 
 def _resolve(target: str) -> Callable[[Sequence[str]], int]:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from implgen.cli import ArgumentParser
+from implgen.args import ArgumentParser
 from implgen.codegen.derive import derive
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.codegen.spec import load_spec

@@ -17,7 +17,7 @@ from implgen.animation import cluster
 from implgen.animation.batch import Runner, render_frames
 from implgen.animation.frameout import FrameOutput, plan_output
 from implgen.animation.frames import FrameOptions, Frames, load_frames, parse_range
-from implgen.cli import ArgumentParser
+from implgen.args import ArgumentParser
 from implgen.errors import UserError
 from implgen.scene.keys import MAX_FRAMES
 from implgen.scene.load import MAX_DEPTH, MAX_SIZE, MAX_SPP

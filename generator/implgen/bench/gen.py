@@ -17,8 +17,8 @@ from pathlib import Path
 
 import sympy
 
+from implgen.args import ArgumentParser
 from implgen.bench.machine import describe, load_average, write_results
-from implgen.cli import ArgumentParser
 from implgen.codegen.derive import derive, exact_ray_coefficients
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.codegen.spec import MAX_DEGREE, parse_spec

@@ -32,8 +32,8 @@ from pathlib import Path
 import numpy as np
 
 from implgen import validate
+from implgen.args import ArgumentParser
 from implgen.bench.machine import cpu_model, load_average
-from implgen.cli import ArgumentParser
 from implgen.errors import UserError
 from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.build import build_scene

@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
+from implgen.args import ArgumentParser
 from implgen.bench.machine import describe as machine
 from implgen.bench.solvers_high import degree_table, high_targets
-from implgen.cli import ArgumentParser
 from implgen.errors import UserError
 from implgen.roots.cases import CASE_SETS, HIGH_CASE_SETS, HIGH_RAYS, CaseSet, find_shapes_dir
 from implgen.roots.reference import Score, reference, score_first, score_one

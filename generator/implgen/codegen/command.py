@@ -12,7 +12,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from implgen.cli import ArgumentParser
+from implgen.args import ArgumentParser
 from implgen.codegen.emit import LANGS, generate
 from implgen.codegen.spec import load_spec
 from implgen.errors import UserError

@@ -13,7 +13,7 @@ import webbrowser
 from collections.abc import Sequence
 from pathlib import Path
 
-from implgen.cli import ArgumentParser
+from implgen.args import ArgumentParser
 from implgen.codegen.spec import parse_spec
 from implgen.errors import UserError
 from implgen.view.document import STARTER, Document
