@@ -59,8 +59,14 @@ def _expanded_ops(equation: str) -> tuple[float, int]:
     return time.perf_counter() - start, ops
 
 
+EXAMPLES = (
+    ("the table of bench/results/gen.md", "implgen bench gen"),
+    ("a quick run: three degrees, no expanded form", "implgen bench gen --degrees 2 4 8 --compare 0 -o out/gen.md"),
+)
+
+
 def main(argv: Sequence[str]) -> int:
-    parser = ArgumentParser(prog="implgen bench gen", description=__doc__.splitlines()[0])
+    parser = ArgumentParser(prog="implgen bench gen", description=__doc__.splitlines()[0], examples=EXAMPLES)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument(
         "--compare",

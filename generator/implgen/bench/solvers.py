@@ -314,8 +314,14 @@ def plot(rows: list[Row], path: Path) -> None:
     plt.close(fig)
 
 
+EXAMPLES = (
+    ("the report of bench/results/solvers.md and solvers.png", "implgen bench solvers"),
+    ("a quick run (small sizes) into out/bench/", "implgen bench solvers --quick -o out/bench"),
+)
+
+
 def main(argv: list[str] | None = None) -> int:
-    ap = ArgumentParser(prog="implgen bench solvers", description=__doc__.splitlines()[0])
+    ap = ArgumentParser(prog="implgen bench solvers", description=__doc__.splitlines()[0], examples=EXAMPLES)
     ap.add_argument("-o", "--out", default="bench/results", help="output folder (default bench/results)")
     ap.add_argument("--timed", type=int, default=100_000, help="polynomials timed per case set (default 1e5)")
     ap.add_argument("--ref", type=int, default=400, help="polynomials per set checked against the exact reference")
