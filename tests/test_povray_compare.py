@@ -1,5 +1,6 @@
 """bench/povray_compare.py pieces, fast and without POV-Ray: the .pov text of a scene (camera, plane,
-polynomial, transform), and the exact verdict on a known hit, a known miss and a tangent ray."""
+polynomial, transform), and the exact verdict on a known hit, a known miss and a tangent ray. Two tests run
+POV-Ray itself (Debian's povray): skipped when it is missing, failed with IMPLGEN_REQUIRE_ALL set."""
 
 from __future__ import annotations
 
@@ -87,10 +88,9 @@ def test_camera_ray_matches_the_tracer_convention():
     assert d[1] / -d[2] == pytest.approx(math.tan(math.radians(20)))  # vertical half-fov
 
 
+@pytest.mark.needs_program("povray")
 def test_povray_renders_the_exported_ball(tmp_path):
     exe = shutil.which("povray")
-    if not exe:
-        pytest.skip("povray is not installed")
     scene = _sphere_scene()
     pov = tmp_path / "ball.pov"
     pov.write_text(povray.scene_pov(scene, 80, 60, coverage=True))
@@ -138,9 +138,7 @@ def test_exact_verdict_clips_to_the_box():
     assert full.ray_hits(full.objects[0], eye, target - eye)
 
 
-@pytest.mark.skipif(
-    shutil.which("povray") is None, reason="POV-Ray is not installed (bench/povray_compare.py installs it)"
-)
+@pytest.mark.needs_program("povray")
 def test_povray_renders_the_clipped_ball_like_the_exact_verdict(tmp_path):
     """POV-Ray itself, on the exported coverage scene: the ball cut to |x| <= 0.5 covers the pixels whose rays
     the exact verdict says hit inside the box, and not the cut-away sides."""
