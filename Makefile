@@ -29,14 +29,23 @@ demo: install
 test: install browser povray
 	$(BIN)/python -m pytest -q tests
 
-# Headless Chromium and its driver for the viewer's browser test (Debian packages; run as root, as CI does).
-browser:
-	@command -v chromium >/dev/null && command -v chromedriver >/dev/null || \
-	  { apt-get update -qq && apt-get install -y -qq chromium chromium-driver >/dev/null; }
+# $(call debian,PROGRAMS,PACKAGES,WHAT IS SKIPPED): when a program is missing, install the Debian packages as
+# root (CI runs as root); as anyone else say in one line what is skipped and how to install it, and go on --
+# unless IMPLGEN_REQUIRE_ALL is set (CI sets it): then stop. The tests skip or fail alike (tests/needs_program.py).
+debian = missing=; for p in $(1); do command -v $$p >/dev/null || missing="$$missing $$p"; done; \
+  if [ -z "$$missing" ]; then :; \
+  elif [ "$$(id -u)" = 0 ]; then apt-get update -qq && apt-get install -y -qq $(2) >/dev/null; \
+  elif [ -n "$$IMPLGEN_REQUIRE_ALL" ]; then \
+    echo "make:$$missing not installed and IMPLGEN_REQUIRE_ALL is set (as root: apt-get install $(2))" >&2; exit 1; \
+  else echo "make:$$missing not installed: $(3) (as root: apt-get install $(2))"; fi
 
-# POV-Ray for the exporter's tests that render with it (Debian package; run as root, as CI does).
+# Headless Chromium and its driver for the viewer's browser test.
+browser:
+	@$(call debian,chromium chromedriver,chromium chromium-driver,the browser tests will be skipped)
+
+# POV-Ray for the exporter's tests that render with it.
 povray:
-	@command -v povray >/dev/null || { apt-get update -qq && apt-get install -y -qq povray >/dev/null; }
+	@$(call debian,povray,povray,the POV-Ray render tests will be skipped)
 
 # The README's picture of `implgen view`, taken by the browser test.
 screenshot: install browser
@@ -47,13 +56,13 @@ lint: install
 	$(BIN)/ruff check generator tests bench
 	$(BIN)/ruff format --check generator tests bench
 	@if [ -f .clang-format ]; then \
-	  command -v clang-format >/dev/null || $(MAKE) --no-print-directory tools; \
-	  clang-format --dry-run --Werror $(C_FILES); \
+	  $(MAKE) --no-print-directory tools || exit 1; \
+	  if command -v clang-format >/dev/null; then clang-format --dry-run --Werror $(C_FILES); fi; \
 	fi
 
-# Debian packages the checks need (run as root, as CI does).
+# The programs the checks need.
 tools:
-	apt-get update -qq && apt-get install -y -qq clang-format >/dev/null
+	@$(call debian,clang-format,clang-format,the C style check will be skipped)
 
 # Regenerate the checked-in generated/ folder from examples/shapes/.
 regen: install

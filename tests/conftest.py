@@ -24,6 +24,10 @@ SHAPE_NAMES = [p.stem for p in SHAPE_FILES]
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+# @pytest.mark.needs_program(...): skipped when a Debian package's program is missing, failed instead when
+# IMPLGEN_REQUIRE_ALL is set (CI)
+pytest_plugins = ["needs_program"]
+
 
 CDIR = ROOT / "tests" / "c"
 C_SANITIZE = ["-O1", "-g", "-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer"]

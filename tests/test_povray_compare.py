@@ -1,6 +1,7 @@
 """bench/povray_compare.py: the .pov text of a scene (camera, plane, polynomial, transform), the exact verdict on
-a known hit, a known miss and a tangent ray, the options, report.md from a hand-made results dict; and, where
-POV-Ray is installed, its renders of exported scenes and a --quick run end to end on one scene."""
+a known hit, a known miss and a tangent ray, the options, report.md from a hand-made results dict; and the tests
+that run POV-Ray itself (Debian's povray: its renders of exported scenes, a --quick run end to end on one
+scene), skipped when it is missing, failed with IMPLGEN_REQUIRE_ALL set."""
 
 from __future__ import annotations
 
@@ -89,10 +90,9 @@ def test_camera_ray_matches_the_tracer_convention():
     assert d[1] / -d[2] == pytest.approx(math.tan(math.radians(20)))  # vertical half-fov
 
 
+@pytest.mark.needs_program("povray")
 def test_povray_renders_the_exported_ball(tmp_path):
     exe = shutil.which("povray")
-    if not exe:
-        pytest.skip("povray is not installed")
     scene = _sphere_scene()
     pov = tmp_path / "ball.pov"
     pov.write_text(povray.scene_pov(scene, 80, 60, coverage=True))
@@ -140,9 +140,7 @@ def test_exact_verdict_clips_to_the_box():
     assert full.ray_hits(full.objects[0], eye, target - eye)
 
 
-@pytest.mark.skipif(
-    shutil.which("povray") is None, reason="POV-Ray is not installed (bench/povray_compare.py installs it)"
-)
+@pytest.mark.needs_program("povray")
 def test_povray_renders_the_clipped_ball_like_the_exact_verdict(tmp_path):
     """POV-Ray itself, on the exported coverage scene: the ball cut to |x| <= 0.5 covers the pixels whose rays
     the exact verdict says hit inside the box, and not the cut-away sides."""
@@ -307,9 +305,7 @@ def test_options_quick_defaults_and_unknown_scene(capsys):
     assert exit_info.value.code == 2 and "unknown scene(s) nope" in capsys.readouterr().err
 
 
-@pytest.mark.skipif(
-    shutil.which("povray") is None, reason="POV-Ray is not installed (bench/povray_compare.py installs it)"
-)
+@pytest.mark.needs_program("povray")
 def test_quick_run_end_to_end(tmp_path, monkeypatch):
     """main --quick on the torus, the degree family cut to degrees 2 and 4: every step runs and the outputs
     agree with each other (the coverage counts add up, the report has the measured rows)."""

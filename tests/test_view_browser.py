@@ -1,5 +1,6 @@
 """`implgen view` in a real browser: headless Debian Chromium driven by Selenium against the real server (uvicorn
-on 127.0.0.1, a free port). `make test` installs chromium and chromium-driver when they are missing.
+on 127.0.0.1, a free port). Needs Debian's chromium and chromium-driver: `make test` installs them when it runs
+as root; otherwise these tests are skipped, or fail with IMPLGEN_REQUIRE_ALL set (tests/needs_program.py).
 
 The page is used as a person would: type an equation, wait for the picture, drag a slider, type a bad
 equation, orbit with the mouse. The picture on the canvas is compared with render() of the same view.
@@ -24,8 +25,7 @@ from implgen.scene.render import render, to_uint8
 from implgen.view import protocol
 from implgen.view.command import bind, document_factory, serve
 
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-CHROMEDRIVER = shutil.which("chromedriver") or "/usr/bin/chromedriver"
+pytestmark = pytest.mark.needs_program("chromium", "chromedriver")
 EQUATION = "x^4 - 5*x^2 + y^4 - 5*y^2 + z^4 - 5*z^2 + c"  # a tanglecube; c = 11.8 is the classic one
 PARAMS = "c = 11.8"
 WAIT = 120  # seconds: generous, the machine may be busy; nothing here is a timing
@@ -52,13 +52,12 @@ def driver():
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
 
-    assert os.path.exists(CHROMIUM) and os.path.exists(CHROMEDRIVER), "run `make browser` (chromium, chromium-driver)"
     opts = webdriver.ChromeOptions()
-    opts.binary_location = CHROMIUM
+    opts.binary_location = shutil.which("chromium")
     for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1100,640"):
         opts.add_argument(arg)
     opts.add_argument("--force-device-scale-factor=1")
-    d = webdriver.Chrome(service=Service(CHROMEDRIVER), options=opts)
+    d = webdriver.Chrome(service=Service(shutil.which("chromedriver")), options=opts)
     yield d
     d.quit()
 

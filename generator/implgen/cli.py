@@ -1,64 +1,162 @@
-"""Command line: only orchestrates the modules that do the work.
+"""The `implgen` command, the roof of the package: it only dispatches to the commands, each in a module of its
+own, imported when it runs (so `implgen SPEC` stays quick). Nothing imports this module but the console script.
 
-    implgen SPEC.yaml [SPEC.yaml ...] --lang c|python|all [-o DIR]   generate intersectors
-    implgen render SCENE.yaml -o OUT.png [...]                       render a scene
-    implgen view [SPEC.yaml | SCENE.yaml] [--port --host --no-browser]  the interactive viewer
-    implgen bench solvers|gen|render [...]                           measure
-    implgen demo                                                     the main job of `make demo`
+One table, COMMANDS (with GENERATE, the command that needs no name), says which commands there are; the
+dispatcher reads it and `implgen --help` is written from it, so a command cannot be left out of the help.
+
+    implgen --help, -h     the list of commands on stdout, exit status 0
+    implgen                the same list on stderr, exit status 2 (nothing to do: a usage error)
+    implgen --version      `implgen <version>`, exit status 0
+    implgen COMMAND --help a command's options and examples (`implgen SPEC.yaml --help` for generating)
 
 Bad input (UserError) becomes one line on stderr and exit status 2, never a traceback.
 """
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import os
 import sys
 from collections.abc import Callable, Sequence
-from typing import Any
+from dataclasses import dataclass, field
 
+from implgen import __version__
+from implgen.args import examples_text
 from implgen.errors import UserError
 
-# Subcommands live in their own modules; imported lazily so `implgen SPEC` stays quick.
-_COMMANDS: dict[str, str] = {
-    "render": "implgen.animation.command:main",
-    "demo": "implgen.demo:main",
-    "view": "implgen.view.command:main",
+HELP = ("--help", "-h")
+
+
+@dataclass(frozen=True)
+class Command:
+    """One line of the help: `synopsis` (what follows `implgen`) and a one-line `summary`. What runs is
+    `target` ("module:function" or a function, called with the arguments after the command's words), or, for
+    a group such as `bench`, one of its `sub` commands, chosen by the next word."""
+
+    synopsis: str
+    summary: str
+    target: str | Callable[[Sequence[str]], int] = ""
+    sub: dict[str, Command] = field(default_factory=dict)
+    examples: tuple[tuple[str, str], ...] = ()  # a group's own --help; a command's are in its parser
+
+
+def _version(argv: Sequence[str]) -> int:
+    if argv:
+        raise UserError("--version", f"takes no arguments (got {argv[0]!r})")
+    print(f"implgen {__version__}")
+    return 0
+
+
+GENERATE = Command(
+    "SPEC.yaml ... [--lang c|python|all] [-o DIR]",
+    "generate C and Python ray intersectors",
+    "implgen.codegen.command:main",
+)
+COMMANDS: dict[str, Command] = {
+    "render": Command(
+        "render SCENE.yaml -o OUT [options]",
+        "render a still or an animation (also on Dask)",
+        "implgen.animation.command:main",
+    ),
+    "view": Command(
+        "view [SPEC.yaml | SCENE.yaml] [options]", "the interactive viewer, in the browser", "implgen.view.command:main"
+    ),
+    "bench": Command(
+        "bench COMMAND [options]",
+        "measurements: each prints a table and writes it, with the machine, to a results file (bench/README.md).",
+        sub={
+            "solvers": Command(
+                "bench solvers [options]", "measure root solvers: speed against error", "implgen.bench.solvers:main"
+            ),
+            "gen": Command("bench gen [options]", "measure code generation against degree", "implgen.bench.gen:main"),
+            "render": Command(
+                "bench render [SCENE.yaml ...] [options]",
+                "measure render speed and thread scaling",
+                "implgen.bench.render:main",
+            ),
+        },
+        examples=(
+            ("the root solvers, small sizes, into out/bench/", "implgen bench solvers --quick -o out/bench"),
+            ("a bench's options and examples", "implgen bench render --help"),
+        ),
+    ),
+    "demo": Command(
+        "demo [--shapes DIR] [-o DIR]",
+        "what `make demo` runs: the example shapes, end to end",
+        "implgen.demo:main",
+    ),
+    "--version": Command("--version", "print the version", _version),
 }
-_BENCHES: dict[str, str] = {
-    "solvers": "implgen.bench.solvers:main",
-    "gen": "implgen.bench.gen:main",
-    "render": "implgen.bench.render:main",
-}
+ROOT = Command(
+    "SPEC.yaml ... [options] | implgen COMMAND [options]",
+    "Implicit surfaces f(x, y, z) = 0 turned into C and Python ray intersectors, and a C ray tracer.",
+    sub=COMMANDS,
+    examples=(
+        ("the torus as C and Python, into out/", "implgen examples/shapes/torus_z.yaml -o out"),
+        ("a picture", "implgen render examples/scenes/glassware.yaml -o glass.png"),
+        ("a command's options and examples", "implgen render --help"),
+    ),
+)
 
 
-class ArgumentParser(argparse.ArgumentParser):
-    """argparse for every implgen command: a bad option is a UserError (one line naming `label`, or the
-    command, and exit status 2), never argparse's usage text and its own exit."""
-
-    def __init__(self, *args: Any, label: str | None = None, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
-        self.label = label or self.prog
-
-    def error(self, message: str) -> Any:
-        raise UserError(self.label, message)
+def rows(group: Command) -> list[Command]:
+    """The commands a group's help lists, in order: groups inside it are spelled out, one line per command."""
+    out = [GENERATE] if group is ROOT else []
+    for cmd in group.sub.values():
+        out += rows(cmd) if cmd.sub else [cmd]
+    return out
 
 
-def _resolve(target: str) -> Callable[[Sequence[str]], int]:
-    module, func = target.split(":")
-    return getattr(importlib.import_module(module), func)
+def listing(words: tuple[str, ...], group: Command) -> str:
+    """The help of the whole command (words == ()) or of a group such as ("bench",)."""
+    name = " ".join(("implgen", *words))
+    lines = [f"usage: implgen {group.synopsis}", "", group.summary[:1].upper() + group.summary[1:], ""]
+    lines.append("commands:")
+    table = [(f"implgen {cmd.synopsis}", cmd.summary) for cmd in rows(group)] + [(f"{name} --help, -h", "this list")]
+    width = max(len(left) for left, _ in table) + 2
+    lines += [f"  {left:<{width}}{right}" for left, right in table]
+    lines += ["", f"Options and examples of each: {name} COMMAND --help"]
+    if group is ROOT:
+        lines[-1] += f" ({name} SPEC.yaml --help for generating)"
+    return "\n".join([*lines, "", examples_text(group.examples)])
+
+
+def _call(target: str | Callable[[Sequence[str]], int], argv: Sequence[str]) -> int:
+    if isinstance(target, str):
+        module, func = target.split(":")
+        target = getattr(importlib.import_module(module), func)
+    return target(argv)
+
+
+def _not_a_typo(word: str) -> None:
+    """`implgen rendr ...` would be read as a spec file named rendr: say that there is no such command."""
+    if not word.startswith("-") and "." not in word and "/" not in word and not os.path.lexists(word):
+        names = ", ".join(n for n in COMMANDS if not n.startswith("-"))
+        raise UserError(word, f"no such command or file (the commands: {names}; implgen --help)")
+
+
+def dispatch(words: tuple[str, ...], group: Command, argv: Sequence[str]) -> int:
+    """Run the command `argv` names in `group` (words: the group's own words, () for the whole command)."""
+    if not argv:
+        print(listing(words, group), file=sys.stderr)
+        return 2
+    name = argv[0]
+    if name in HELP:
+        print(listing(words, group))
+        return 0
+    cmd = group.sub.get(name)
+    if cmd is None and group is ROOT:
+        _not_a_typo(name)
+        return _call(GENERATE.target, argv)
+    if cmd is None:
+        raise UserError(" ".join((*words, name)), f"no such command; choose one of: {', '.join(group.sub)}")
+    if cmd.sub:
+        return dispatch((*words, name), cmd, argv[1:])
+    return _call(cmd.target, argv[1:])
 
 
 def run(argv: Sequence[str]) -> int:
-    argv = list(argv)
-    if argv and argv[0] in _COMMANDS:
-        return _resolve(_COMMANDS[argv[0]])(argv[1:])
-    if argv and argv[0] == "bench":
-        if len(argv) < 2 or argv[1] not in _BENCHES:
-            raise UserError("bench", f"choose one of: {', '.join(_BENCHES)}")
-        return _resolve(_BENCHES[argv[1]])(argv[2:])
-    return _resolve("implgen.codegen.command:main")(argv)
+    return dispatch((), ROOT, list(argv))
 
 
 def quiet_blas() -> None:

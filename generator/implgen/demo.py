@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from implgen.cli import ArgumentParser
+from implgen.args import ArgumentParser
 from implgen.codegen.derive import derive
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.codegen.spec import load_spec
@@ -41,10 +41,18 @@ def _ray_fan(module, box) -> tuple[int, int]:
     return int(np.count_nonzero(np.isfinite(t))), len(targets)
 
 
+EXAMPLES = (
+    ("what `make demo` runs, from the repository's root", "implgen demo"),
+    ("your own shapes, into another folder", "implgen demo --shapes my_shapes -o out/mine"),
+)
+
+
 def main(argv: Sequence[str]) -> int:
-    parser = ArgumentParser(prog="implgen demo")
-    parser.add_argument("--shapes", type=Path, default=Path("examples/shapes"))
-    parser.add_argument("-o", "--output", type=Path, default=Path("out"))
+    parser = ArgumentParser(prog="implgen demo", description=__doc__, examples=EXAMPLES)
+    parser.add_argument(
+        "--shapes", type=Path, default=Path("examples/shapes"), help="folder of shape specs (default: examples/shapes)"
+    )
+    parser.add_argument("-o", "--output", type=Path, default=Path("out"), help="output folder (default: out)")
     args = parser.parse_args(list(argv))
     specs = sorted(args.shapes.glob("*.yaml"))
     if not specs:

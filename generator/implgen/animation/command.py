@@ -17,7 +17,7 @@ from implgen.animation import cluster
 from implgen.animation.batch import Runner, render_frames
 from implgen.animation.frameout import FrameOutput, plan_output
 from implgen.animation.frames import FrameOptions, Frames, load_frames, parse_range
-from implgen.cli import ArgumentParser
+from implgen.args import ArgumentParser
 from implgen.errors import UserError
 from implgen.scene.keys import MAX_FRAMES
 from implgen.scene.load import MAX_DEPTH, MAX_SIZE, MAX_SPP
@@ -36,9 +36,32 @@ def _positive(text: str) -> int:
     return v
 
 
+EXAMPLES = (
+    ("a still at the scene's own size", "implgen render examples/scenes/glassware.yaml -o glass.png"),
+    (
+        "a quick look: 400x300, 1 sample per pixel",
+        "implgen render examples/scenes/glassware.yaml -o look.png --width 400 --height 300 --spp 1",
+    ),
+    ("an animation as a video", "implgen render examples/scenes/torus_opening.yaml -o opening.mp4"),
+    ("frames 0 to 9 as PNGs", "implgen render examples/scenes/torus_opening.yaml -o frames/f_%04d.png --frames 0:9"),
+    (
+        "on a Dask LocalCluster of 4 processes",
+        "implgen render examples/scenes/torus_opening.yaml -o opening.gif --local-workers 4",
+    ),
+    (
+        "on a running Dask scheduler, each frame in 8 bands",
+        "implgen render examples/scenes/torus_opening.yaml -o opening.webm --cluster tcp://HOST:8786 --tiles 8",
+    ),
+)
+
+
 def _parser() -> ArgumentParser:
     ap = ArgumentParser(
-        label="render", prog="implgen render", description="Render a scene file: a still or an animation's frames."
+        label="render",
+        prog="implgen render",
+        description="Render a scene file: a still to a PNG, or an animation's frames to PNGs, a video or a GIF; "
+        "here, or on Dask (docs/animation.md).",
+        examples=EXAMPLES,
     )
     ap.add_argument("scene", type=Path)
     ap.add_argument(

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import sympy
 
+from implgen.args import ArgumentParser
 from implgen.bench.machine import describe, load_average, write_results
-from implgen.cli import ArgumentParser
 from implgen.codegen.derive import derive, exact_ray_coefficients
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.codegen.spec import MAX_DEGREE, parse_spec
@@ -59,8 +59,14 @@ def _expanded_ops(equation: str) -> tuple[float, int]:
     return time.perf_counter() - start, ops
 
 
+EXAMPLES = (
+    ("the table of bench/results/gen.md", "implgen bench gen"),
+    ("a quick run: three degrees, no expanded form", "implgen bench gen --degrees 2 4 8 --compare 0 -o out/gen.md"),
+)
+
+
 def main(argv: Sequence[str]) -> int:
-    parser = ArgumentParser(prog="implgen bench gen", description=__doc__.splitlines()[0])
+    parser = ArgumentParser(prog="implgen bench gen", description=__doc__.splitlines()[0], examples=EXAMPLES)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument(
         "--compare",

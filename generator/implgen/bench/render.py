@@ -32,8 +32,8 @@ from pathlib import Path
 import numpy as np
 
 from implgen import validate
+from implgen.args import ArgumentParser
 from implgen.bench.machine import cpu_model, load_average
-from implgen.cli import ArgumentParser
 from implgen.errors import UserError
 from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.build import build_scene
@@ -159,8 +159,21 @@ def _fold(scenes: list[Path], args, out: _Report) -> None:
     out.add(*(f"| {n} | {a:.3f} | {b:.3f} | {100 * (b - a) / a:+.1f}% |" for n, a, b in rows))
 
 
+EXAMPLES = (
+    ("the table of bench/results/render.md, from the repository's root", "implgen bench render --fold-compare"),
+    (
+        "one scene on 1, 2 and 4 threads, 3 rounds",
+        "implgen bench render bench/scenes/heart.yaml --threads 1,2,4 --runs 3 -o out/render.md",
+    ),
+)
+
+
 def main(argv: Sequence[str]) -> int:
-    ap = ArgumentParser(prog="implgen bench render")
+    ap = ArgumentParser(
+        prog="implgen bench render",
+        description="Render speed by ray kind, and how it scales from the first thread count to the last.",
+        examples=EXAMPLES,
+    )
     ap.add_argument("scenes", nargs="*", type=Path)
     ap.add_argument("--width", type=int, default=800)
     ap.add_argument("--height", type=int, default=600)

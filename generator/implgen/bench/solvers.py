@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
+from implgen.args import ArgumentParser
 from implgen.bench.machine import describe as machine
 from implgen.bench.solvers_high import degree_table, high_targets
-from implgen.cli import ArgumentParser
 from implgen.errors import UserError
 from implgen.roots.cases import CASE_SETS, HIGH_CASE_SETS, HIGH_RAYS, CaseSet, find_shapes_dir
 from implgen.roots.reference import Score, reference, score_first, score_one
@@ -314,8 +314,14 @@ def plot(rows: list[Row], path: Path) -> None:
     plt.close(fig)
 
 
+EXAMPLES = (
+    ("the report of bench/results/solvers.md and solvers.png", "implgen bench solvers"),
+    ("a quick run (small sizes) into out/bench/", "implgen bench solvers --quick -o out/bench"),
+)
+
+
 def main(argv: list[str] | None = None) -> int:
-    ap = ArgumentParser(prog="implgen bench solvers", description=__doc__.splitlines()[0])
+    ap = ArgumentParser(prog="implgen bench solvers", description=__doc__.splitlines()[0], examples=EXAMPLES)
     ap.add_argument("-o", "--out", default="bench/results", help="output folder (default bench/results)")
     ap.add_argument("--timed", type=int, default=100_000, help="polynomials timed per case set (default 1e5)")
     ap.add_argument("--ref", type=int, default=400, help="polynomials per set checked against the exact reference")

@@ -12,24 +12,31 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from implgen.cli import ArgumentParser
+from implgen.args import ArgumentParser
 from implgen.codegen.emit import LANGS, generate
 from implgen.codegen.spec import load_spec
 from implgen.errors import UserError
 from implgen.outputs import check_output_folder, write_text_files
+
+EXAMPLES = (
+    ("the torus as C (torus_z.h, torus_z.c) into out/", "implgen examples/shapes/torus_z.yaml --lang c -o out"),
+    ("every example shape, C and Python, into out/generated/", "implgen examples/shapes/*.yaml -o out/generated"),
+)
 
 
 def _parser() -> argparse.ArgumentParser:
     p = ArgumentParser(
         label="command line",
         prog="implgen",
-        description="Generate C and Python ray intersectors from implicit surface specs. "
-        "Other commands: implgen render SCENE.yaml -o OUT.png | implgen bench solvers|gen|render | "
-        "implgen demo",
+        description="Generate C and Python ray intersectors from implicit surface specs. Every spec is checked "
+        "and every file made before anything is written. The other commands: implgen --help.",
+        examples=EXAMPLES,
     )
-    p.add_argument("specs", nargs="+", type=Path, metavar="SPEC.yaml")
-    p.add_argument("--lang", choices=["c", "python", "all"], default="all")
-    p.add_argument("-o", "--output", type=Path, default=Path("generated"), metavar="DIR")
+    p.add_argument("specs", nargs="+", type=Path, metavar="SPEC.yaml", help="shape specs (docs/formats.md)")
+    p.add_argument("--lang", choices=["c", "python", "all"], default="all", help="what to write (default: all)")
+    p.add_argument(
+        "-o", "--output", type=Path, default=Path("generated"), metavar="DIR", help="output folder (default: generated)"
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     return p
 

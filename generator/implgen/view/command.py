@@ -13,7 +13,7 @@ import webbrowser
 from collections.abc import Sequence
 from pathlib import Path
 
-from implgen.cli import ArgumentParser
+from implgen.args import ArgumentParser
 from implgen.codegen.spec import parse_spec
 from implgen.errors import UserError
 from implgen.view.document import STARTER, Document
@@ -69,9 +69,23 @@ def serve(sock: socket.socket, make_document, threads: int | None = None, on_rea
     server.run(sockets=[sock])
 
 
+EXAMPLES = (
+    ("start from a torus, and open the page in the browser", "implgen view"),
+    ("a shape spec", "implgen view examples/shapes/heart.yaml"),
+    (
+        "a scene, on a free port, without opening a browser",
+        "implgen view examples/scenes/csg_trio.yaml --port 0 --no-browser",
+    ),
+)
+
+
 def main(argv: Sequence[str]) -> int:
     ap = ArgumentParser(
-        label="view", prog="implgen view", description="Type an equation, turn it, drag its params: in the browser."
+        label="view",
+        prog="implgen view",
+        description="Type an equation, turn it, drag its params: in the browser (docs/viewer.md). The server runs "
+        "until Ctrl-C.",
+        examples=EXAMPLES,
     )
     ap.add_argument("file", type=Path, nargs="?", help="a spec or a scene (default: a torus)")
     ap.add_argument("--port", type=int, default=8765, help="0 picks a free port (default 8765)")
