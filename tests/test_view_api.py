@@ -17,9 +17,10 @@ from starlette.testclient import TestClient
 from conftest import ROOT
 from implgen.cli import main as cli_main
 from implgen.codegen.spec import parse_spec
+from implgen.imagefile import to_uint8
 from implgen.scene import build
 from implgen.scene.load import parse_scene
-from implgen.scene.render import render, to_uint8
+from implgen.scene.render import render
 from implgen.scene.tracer import CScene
 from implgen.view import session as session_mod
 from implgen.view.command import document_factory

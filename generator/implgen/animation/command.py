@@ -19,9 +19,10 @@ from implgen.animation.frameout import FrameOutput, plan_output
 from implgen.animation.frames import FrameOptions, Frames, load_frames, parse_range
 from implgen.cli import ArgumentParser
 from implgen.errors import UserError
+from implgen.imagefile import write_png
 from implgen.scene.keys import MAX_FRAMES
 from implgen.scene.load import MAX_DEPTH, MAX_SIZE, MAX_SPP
-from implgen.scene.render import DEFAULT_FOLD, MAX_THREADS, RenderInfo, render, write_png
+from implgen.scene.render import DEFAULT_FOLD, MAX_THREADS, RenderInfo, render
 
 MAX_RETRIES = 100
 

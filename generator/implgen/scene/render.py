@@ -1,4 +1,4 @@
-"""`render(scene)`: a scene to a float image, and the PNG writer.
+"""`render(scene)`: a scene to a float image (imagefile.py writes it as PNG).
 
 The scene is validated (scene/load.py), its shapes generated and compiled into a cached library (build.py), the
 scene handed to the C tracer through ctypes, and the image rendered on all cores: the C code runs on its own
@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 
 from implgen import validate
-from implgen.outputs import atomic_write
 from implgen.scene.build import BuildResult, build_scene
 from implgen.scene.load import MAX_DEPTH, MAX_SIZE, MAX_SPP, load_scene, parse_scene
 from implgen.scene.model import Scene
@@ -154,15 +153,3 @@ def render(
         return out
     finally:
         cs.close()
-
-
-def to_uint8(img: np.ndarray) -> np.ndarray:
-    return (np.clip(np.nan_to_num(img, nan=0.0), 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-
-
-def write_png(img: np.ndarray, path: Path) -> None:
-    """Write atomically (outputs.atomic_write): a failure leaves nothing half-written."""
-    from PIL import Image
-
-    picture = Image.fromarray(to_uint8(img), mode="RGB")
-    atomic_write(Path(path), lambda fh: picture.save(fh, format="PNG"))

@@ -15,22 +15,19 @@ from __future__ import annotations
 
 import asyncio
 import ctypes
-import io
 import logging
 import struct
-import tempfile
 import time
 from collections.abc import Awaitable, Callable
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
-from PIL import Image
 
 from implgen.errors import UserError
+from implgen.imagefile import encode_jpeg, encode_png, to_uint8
 from implgen.scene.build import BuildResult, build_scene
 from implgen.scene.model import Scene
-from implgen.scene.render import render, to_uint8, usable_cores, write_png
+from implgen.scene.render import render, usable_cores
 from implgen.scene.tracer import CScene
 from implgen.view import dump, protocol
 from implgen.view.document import Document
@@ -40,20 +37,20 @@ FULL_SPP = 4
 MAX_RENDERS_PER_SECOND = 60  # per page: requests beyond this wait (and are overtaken by newer ones)
 KIND_COARSE, KIND_FULL, KIND_SAVE = 0, 1, 2
 HEADER = struct.Struct(">IBxxxHH")  # seq, kind, width, height; the image bytes follow
+LIVE_JPEG_QUALITY = 88  # the coarse frame: small and soon replaced
+LIVE_PNG_LEVEL = 1  # the full frame: speed over size (zlib level 1)
 
 log = logging.getLogger("implgen.view")
 
 Send = Callable[[dict | bytes], Awaitable[None]]
 
 
-def encode(img: np.ndarray, fmt: str) -> bytes:
-    buf = io.BytesIO()
-    picture = Image.fromarray(to_uint8(img), mode="RGB")
-    if fmt == "JPEG":
-        picture.save(buf, format="JPEG", quality=88)
-    else:
-        picture.save(buf, format="PNG", compress_level=1)
-    return buf.getvalue()
+def _live_jpeg(img: np.ndarray) -> bytes:
+    return encode_jpeg(to_uint8(img), LIVE_JPEG_QUALITY)
+
+
+def _live_png(img: np.ndarray) -> bytes:
+    return encode_png(to_uint8(img), LIVE_PNG_LEVEL)
 
 
 class Session:
@@ -210,14 +207,14 @@ class Session:
         img = await self._render(cw, ch, 1)
         if img is None:
             return
-        await self._send_frame(req.seq, KIND_COARSE, img, "JPEG")
+        await self._send_frame(req.seq, KIND_COARSE, img, _live_jpeg)
         if req.refine and self._pending is None:
             img = await self._render(req.width, req.height, FULL_SPP)
             if img is not None:
-                await self._send_frame(req.seq, KIND_FULL, img, "PNG")
+                await self._send_frame(req.seq, KIND_FULL, img, _live_png)
 
-    async def _send_frame(self, seq: int, kind: int, img: np.ndarray, fmt: str) -> None:
-        data = await asyncio.to_thread(encode, img, fmt)
+    async def _send_frame(self, seq: int, kind: int, img: np.ndarray, encode: Callable[[np.ndarray], bytes]) -> None:
+        data = await asyncio.to_thread(encode, img)
         await self.send(HEADER.pack(seq, kind, img.shape[1], img.shape[0]) + data)
         self.frames += 1
 
@@ -255,15 +252,12 @@ class Session:
             cs.close()
 
     async def _save_png(self, width: int, height: int, spp: int) -> None:
-        """The current view at any size through the normal path: render() and write_png()."""
+        """The current view at any size through the normal path: render(), and the PNG encoder write_png uses
+        (the same bytes as `implgen render` writes for this scene)."""
         sc = self.doc.scene(width, height, spp)
 
         def work() -> bytes:
-            img = render(sc, threads=self.threads)
-            with tempfile.TemporaryDirectory(prefix="implgen-view-") as tmp:
-                path = Path(tmp) / "view.png"
-                write_png(img, path)
-                return path.read_bytes()
+            return encode_png(to_uint8(render(sc, threads=self.threads)))
 
         try:
             data = await asyncio.to_thread(work)
