@@ -31,15 +31,14 @@ from pathlib import Path
 
 import numpy as np
 
-from implgen import validate
 from implgen.bench.machine import cpu_model, load_average
 from implgen.cli import ArgumentParser
 from implgen.errors import UserError
 from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.build import build_scene
-from implgen.scene.load import MAX_SIZE, MAX_SPP, load_scene
+from implgen.scene.load import load_scene
 from implgen.scene.model import Scene
-from implgen.scene.render import RAY_KINDS
+from implgen.scene.render import MAX_THREADS, RAY_KINDS, check_options
 from implgen.scene.tracer import CScene
 
 TARGET_SPEEDUP = 1.85
@@ -61,8 +60,8 @@ def _thread_counts(text: str) -> list[int]:
         counts = [int(v) for v in text.split(",")]
     except ValueError:
         raise UserError("--threads", f"{text!r} is not a list of whole numbers such as 1,2") from None
-    if not counts or any(not 1 <= c <= 1024 for c in counts):
-        raise UserError("--threads", "thread counts must be 1 to 1024")
+    if not counts or any(not 1 <= c <= MAX_THREADS for c in counts):
+        raise UserError("--threads", f"thread counts must be 1 to {MAX_THREADS}")
     return counts
 
 
@@ -89,8 +88,7 @@ def _measure(cs: CScene, sc: Scene, args, threads: int) -> tuple[float, float, d
 
 
 def _prepared(path: Path, args, fold: bool = False) -> tuple[CScene, Scene]:
-    for option, v in (("--width", args.width), ("--height", args.height), ("--spp", args.spp)):
-        validate.whole(option, "", v, 1, MAX_SPP if option == "--spp" else MAX_SIZE)
+    check_options(width=args.width, height=args.height, spp=args.spp)
     sc = load_scene(path)
     return CScene(sc, build_scene(sc, fold=fold)), sc
 

@@ -24,6 +24,15 @@ from implgen.scene.tracer import CScene
 
 RAY_KINDS = ("primary", "shadow", "secondary")  # the first three stats slots (RT_RAYS_*)
 MAX_THREADS = 1024
+# The render options a caller may set, as the command line names them, each with its range: render() and
+# `implgen render` (animation/command.py) check them through check_options, so both say the same.
+OPTION_RANGES = (
+    ("width", "--width", 1, MAX_SIZE),
+    ("height", "--height", 1, MAX_SIZE),
+    ("spp", "--spp", 1, MAX_SPP),
+    ("threads", "--threads", 1, MAX_THREADS),
+    ("max_depth", "--max-depth", 0, MAX_DEPTH),
+)
 # Folding constant params into the generated code measured within a few per cent either way
 # (docs/tracer.md#folding-constant-params): off.
 DEFAULT_FOLD = False
@@ -47,6 +56,22 @@ def usable_cores() -> int:
         return len(os.sched_getaffinity(0)) or 1
     except (AttributeError, OSError):
         return os.cpu_count() or 1
+
+
+def check_options(
+    *,
+    width: int | None = None,
+    height: int | None = None,
+    spp: int | None = None,
+    threads: int | None = None,
+    max_depth: int | None = None,
+) -> None:
+    """Each option given (None: not set) in its range (OPTION_RANGES), in the table's order; a UserError
+    names the option."""
+    given = {"width": width, "height": height, "spp": spp, "threads": threads, "max_depth": max_depth}
+    for name, option, lo, hi in OPTION_RANGES:
+        if given[name] is not None:
+            validate.whole(option, "", given[name], lo, hi)
 
 
 def _as_scene(scene: Scene | str | Path | dict) -> Scene:
@@ -82,14 +107,7 @@ def render(
     n = spp or sc.spp
     depth = sc.max_depth if max_depth is None else max_depth
     nthreads = threads or usable_cores()
-    for option, v, lo, hi in (
-        ("--width", w, 1, MAX_SIZE),
-        ("--height", h, 1, MAX_SIZE),
-        ("--spp", n, 1, MAX_SPP),
-        ("--threads", nthreads, 1, MAX_THREADS),
-        ("--max-depth", depth, 0, MAX_DEPTH),
-    ):
-        validate.whole(option, "", v, lo, hi)
+    check_options(width=w, height=h, spp=n, threads=nthreads, max_depth=depth)
     y0, y1 = (0, h) if rows is None else rows
     if not 0 <= y0 < y1 <= h:
         raise ValueError(f"rows {rows} outside the image's {h} rows")
