@@ -21,15 +21,11 @@ is printed and written, with the machine and the load average, to the output fil
 
 from __future__ import annotations
 
-import ctypes
 import os
 import resource
 import statistics
-import time
 from collections.abc import Sequence
 from pathlib import Path
-
-import numpy as np
 
 from implgen.bench.machine import cpu_model, load_average
 from implgen.cli import ArgumentParser
@@ -38,7 +34,8 @@ from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.build import build_scene
 from implgen.scene.load import load_scene
 from implgen.scene.model import Scene
-from implgen.scene.render import MAX_THREADS, RAY_KINDS, check_options
+from implgen.scene.render import MAX_THREADS, check_options
+from implgen.scene.renderjob import RenderJob
 from implgen.scene.tracer import CScene
 
 TARGET_SPEEDUP = 1.85
@@ -67,24 +64,15 @@ def _thread_counts(text: str) -> list[int]:
 
 def _measure(cs: CScene, sc: Scene, args, threads: int) -> tuple[float, float, dict[str, float]]:
     """(wall seconds, CPU seconds of the process, rays by kind) of one run of the C render loop, timed around
-    rt_render_run alone (scene/render.py's render() adds its progress polling and the Python thread)."""
-    lib = cs.lib
-    ctx = lib.rt_render_new(cs.ptr, args.width, args.height, args.spp, sc.max_depth, threads, 0)
-    if not ctx:
-        raise RuntimeError("rt_render_new failed")
-    try:
-        out = np.zeros((args.height, args.width, 3), dtype=np.float32)
-        ptr = out.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
-        c0, t0 = _cpu_seconds(), time.perf_counter()
-        code = lib.rt_render_run(ctx, ptr)
-        wall, cpu = time.perf_counter() - t0, _cpu_seconds() - c0
-        if code != 0:
-            raise RuntimeError(f"render failed (code {code})")
-        stats = (ctypes.c_double * 4)()
-        lib.rt_render_stats(ctx, stats)
-    finally:
-        lib.rt_render_free(ctx)
-    return wall, cpu, dict(zip(RAY_KINDS, stats[:3]))
+    rt_render_run alone: the render context and its image are made before (RenderJob's entry), and render()'s
+    progress polling and Python thread are not there."""
+    with RenderJob(cs, args.width, args.height, args.spp, sc.max_depth, threads) as job:
+        c0 = _cpu_seconds()
+        img = job.run()
+        cpu = _cpu_seconds() - c0
+        if img is None:
+            raise RuntimeError("render failed (cancelled)")
+        return job.seconds, cpu, job.stats().rays
 
 
 def _prepared(path: Path, args, fold: bool = False) -> tuple[CScene, Scene]:

@@ -14,7 +14,6 @@ only its own .c and the glue are compiled, the runtime's objects are cached).
 from __future__ import annotations
 
 import asyncio
-import ctypes
 import logging
 import struct
 import time
@@ -28,6 +27,7 @@ from implgen.imagefile import encode_jpeg, encode_png, to_uint8
 from implgen.scene.build import BuildResult, build_scene
 from implgen.scene.model import Scene
 from implgen.scene.render import render, usable_cores
+from implgen.scene.renderjob import RenderJob
 from implgen.scene.tracer import CScene
 from implgen.view import dump, protocol
 from implgen.view.document import Document
@@ -61,7 +61,7 @@ class Session:
         self._libs: dict[tuple, object] = {}  # spec ids of a scene's shapes -> built library path
         self._pending: protocol.RenderRequest | None = None
         self._wake = asyncio.Event()
-        self._running = None  # (lib, rt_render*) of the render in progress
+        self._running: RenderJob | None = None  # the render in progress
         self._last_start = 0.0
         self._task: asyncio.Task | None = None
         self._saving: asyncio.Task | None = None
@@ -170,8 +170,7 @@ class Session:
         """The newest request wins: it replaces the waiting one and cancels the running render."""
         self._pending = req
         if self._running is not None:
-            lib, ctx = self._running
-            lib.rt_render_cancel(ctx)
+            self._running.cancel()
         self._wake.set()
         if self._task is None or self._task.done():
             self._task = asyncio.get_running_loop().create_task(self._loop())
@@ -224,30 +223,20 @@ class Session:
         built = await asyncio.to_thread(self._library, sc)
         cs = CScene(sc, built)
         try:
-            ctx = cs.lib.rt_render_new(cs.ptr, width, height, spp, sc.max_depth, self.threads, 0)
-            if not ctx:
-                raise RuntimeError("rt_render_new failed")
-            out = np.zeros((height, width, 3), dtype=np.float32)
-            ptr = out.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
-            self._running = (cs.lib, ctx)
-            if self._pending is not None:  # overtaken while the scene was being built
-                cs.lib.rt_render_cancel(ctx)
-            run = asyncio.ensure_future(asyncio.to_thread(cs.lib.rt_render_run, ctx, ptr))
-            try:
-                code = await asyncio.shield(run)
-            except asyncio.CancelledError:  # the page went away: stop the C threads before freeing what they use
-                cs.lib.rt_render_cancel(ctx)
-                await run
-                raise
-            finally:
-                self._running = None
-                if run.done():
-                    cs.lib.rt_render_free(ctx)
-            if code == 1:
-                return None
-            if code != 0:
-                raise RuntimeError(f"render failed (code {code})")
-            return out
+            with RenderJob(cs, width, height, spp, sc.max_depth, self.threads) as job:
+                self._running = job
+                try:
+                    if self._pending is not None:  # overtaken while the scene was being built
+                        job.cancel()
+                    run = asyncio.ensure_future(asyncio.to_thread(job.run))
+                    try:
+                        return await asyncio.shield(run)
+                    except asyncio.CancelledError:  # the page went away: stop the C threads, wait for them
+                        job.cancel()
+                        await run
+                        raise
+                finally:
+                    self._running = None
         finally:
             cs.close()
 
@@ -275,8 +264,7 @@ class Session:
         if self._saving is not None and not self._saving.done():
             await asyncio.wait([self._saving])  # render() cannot be cancelled from here; it ends on its own
         if self._running is not None:
-            lib, ctx = self._running
-            lib.rt_render_cancel(ctx)
+            self._running.cancel()
         if self._task is not None:
             self._task.cancel()
             try:
