@@ -118,10 +118,7 @@ class Session:
             elif kind == "show_c":
                 await self.send({"type": "c", "text": self.c_text()})
         except UserError as err:
-            if err.source == "equation":  # the parser's line, beside the field
-                await self.send({"type": "error", "field": "equation", "message": err.message})
-            else:
-                await self.send({"type": "error", "field": "message", "message": str(err)})
+            await self.send(protocol.error_for(err))
 
     def _mode(self) -> str:
         return "spec" if self.doc.base is None else "scene"
@@ -192,14 +189,8 @@ class Session:
             self.doc.values, self.doc.orbit, self.doc.options = req.values, req.orbit, req.options
             try:
                 await self._frames(req)
-            except UserError as err:
-                await self.send({"type": "error", "field": "message", "message": str(err)})
-            except asyncio.CancelledError:
-                raise
-            except Exception as err:  # a bug, not bad input: say so and keep serving the next request
-                log.exception("viewer render failed")
-                text = f"internal error: {type(err).__name__}"
-                await self.send({"type": "error", "field": "message", "message": text})
+            except Exception as err:  # (not a cancel: that is a BaseException) say so, serve the next request
+                await self._failed(err, "viewer render failed")
 
     async def _frames(self, req: protocol.RenderRequest) -> None:
         cw, ch = max(1, req.width // COARSE_DIVISOR), max(1, req.height // COARSE_DIVISOR)
@@ -250,14 +241,16 @@ class Session:
 
         try:
             data = await asyncio.to_thread(work)
-        except UserError as err:
-            await self.send({"type": "error", "field": "message", "message": str(err)})
-            return
-        except Exception as err:  # a bug: say so, keep serving
-            log.exception("viewer save failed")
-            await self.send({"type": "error", "field": "message", "message": f"internal error: {type(err).__name__}"})
+        except Exception as err:  # say so, keep serving
+            await self._failed(err, "viewer save failed")
             return
         await self.send(HEADER.pack(0, KIND_SAVE, width, height) + data)
+
+    async def _failed(self, err: Exception, what: str) -> None:
+        """Tell the page what failed; a bug (not bad input) also goes to the log with its traceback."""
+        if not isinstance(err, UserError):
+            log.error(what, exc_info=err)
+        await self.send(protocol.error_for(err))
 
     async def close(self) -> None:
         self._pending = None
