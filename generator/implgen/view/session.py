@@ -144,10 +144,6 @@ class Session:
             return dump.to_yaml(dump.spec_mapping(self.doc.spec, self.doc.values))
         return dump.to_yaml(dump.scene_mapping(self.doc.scene(spp=FULL_SPP)))
 
-    def scene_yaml(self, width: int, height: int, spp: int) -> str:
-        """The exact scene the session renders, as a scene file (the browser test renders it independently)."""
-        return dump.to_yaml(dump.scene_mapping(self.doc.scene(width, height, spp)))
-
     def c_text(self) -> str:
         from implgen.codegen.emit import generate
 
