@@ -18,8 +18,9 @@ from implgen.animation.batch import Runner, render_frames
 from implgen.animation.frameout import plan_output
 from implgen.animation.frames import FrameOptions, load_frames
 from implgen.bench.machine import describe as machine
+from implgen.imagefile import write_png
 from implgen.scene.load import load_scene
-from implgen.scene.render import RenderInfo, render, write_png
+from implgen.scene.render import RenderInfo, render
 
 GIF_SCALE = 2  # an animation's GIF is its image size divided by this
 

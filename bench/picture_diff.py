@@ -65,7 +65,7 @@ def _render_one(scene: Path, runtime: Path, width: int | None, height: int | Non
 
 
 def cmd_render(args: argparse.Namespace) -> int:
-    from implgen.scene.render import write_png
+    from implgen.imagefile import write_png
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -79,7 +79,7 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
-    from implgen.scene.render import to_uint8
+    from implgen.imagefile import to_uint8
 
     a_dir, b_dir = Path(args.a), Path(args.b)
     bad = 0

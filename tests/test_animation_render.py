@@ -14,7 +14,8 @@ from PIL import Image
 
 from implgen.animation.frames import frames_from_data
 from implgen.cli import main as cli_main
-from implgen.scene.render import render, to_uint8
+from implgen.imagefile import to_uint8
+from implgen.scene.render import render
 
 ROOT = Path(__file__).resolve().parent.parent
 SPHERE = str(ROOT / "examples" / "shapes" / "sphere.yaml")

@@ -17,7 +17,8 @@ from implgen.animation.batch import Runner, render_frames
 from implgen.animation.frameout import plan_output
 from implgen.animation.frames import FrameOptions, frames_from_data, render_frame_png
 from implgen.cli import main as cli_main
-from implgen.scene.render import render, to_uint8
+from implgen.imagefile import to_uint8
+from implgen.scene.render import render
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_animation_render import FRAMES, anim_scene  # noqa: E402

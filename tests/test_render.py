@@ -358,3 +358,26 @@ def test_progress_bar_reaches_every_row(capsys) -> None:
     render(SCENES / "torus_shadow.yaml", width=40, height=30, spp=1, threads=2, progress=True)
     err = capsys.readouterr().err
     assert "30/30" in err
+
+
+@pytest.mark.parametrize(
+    "option, value, line",
+    [
+        ("width", 16385, "--width: 16385 is outside [1, 16384]"),
+        ("height", 16385, "--height: 16385 is outside [1, 16384]"),
+        ("spp", 4097, "--spp: 4097 is outside [1, 4096]"),
+        ("threads", 1025, "--threads: 1025 is outside [1, 1024]"),
+        ("max_depth", 65, "--max-depth: 65 is outside [0, 64]"),
+        ("max_depth", -1, "--max-depth: -1 is outside [0, 64]"),
+    ],
+)
+def test_render_and_the_command_check_options_alike(tmp_path: Path, capsys, option: str, value: int, line: str):
+    """One table of option ranges (scene/render.py's OPTION_RANGES): render() and `implgen render` reject a
+    value out of range with the same line, before building anything."""
+    with pytest.raises(UserError) as err:
+        render(SCENES / "csg_trio.yaml", **{option: value})
+    assert str(err.value) == line
+    out = tmp_path / "x.png"
+    argv = ["render", str(SCENES / "csg_trio.yaml"), "-o", str(out), f"--{option.replace('_', '-')}", str(value)]
+    assert cli_main(argv) == 2
+    assert capsys.readouterr().err.strip().endswith(line) and not out.exists()

@@ -17,9 +17,11 @@ from starlette.testclient import TestClient
 from conftest import ROOT
 from implgen.cli import main as cli_main
 from implgen.codegen.spec import parse_spec
+from implgen.errors import UserError
+from implgen.imagefile import to_uint8
 from implgen.scene import build
 from implgen.scene.load import parse_scene
-from implgen.scene.render import render, to_uint8
+from implgen.scene.render import render
 from implgen.scene.tracer import CScene
 from implgen.view import session as session_mod
 from implgen.view.command import document_factory
@@ -199,6 +201,42 @@ def test_scene_file_mode(tmp_path) -> None:
         saved = yaml.safe_load(ws.receive_json()["text"])
     sc = parse_scene(saved, tmp_path / "saved.yaml")  # a scene file implgen render takes
     assert len(sc.objects) == 2 and len(sc.lights) == 1
+
+
+def test_failures_are_one_error_reply_and_the_page_keeps_going(client, monkeypatch, caplog) -> None:
+    """Bad input is its line; a bug is 'internal error: <kind>' on the page and a traceback in the log; either
+    way the next request is served (protocol.error_for builds every reply)."""
+
+    def bug(*a, **k):
+        raise ZeroDivisionError("not for the page")
+
+    def bad(*a, **k):
+        raise UserError("save_png", "too big for today")
+
+    with client.websocket_connect("/ws") as ws:
+        hello = ws.receive_json()
+        monkeypatch.setattr(session_mod, "RenderJob", bug)
+        ws.send_text(render_msg(hello, seq=1, refine=False))
+        assert ws.receive_json() == {
+            "type": "error",
+            "field": "message",
+            "message": "internal error: ZeroDivisionError",
+        }
+        monkeypatch.undo()
+        for raise_, reply in ((bug, "internal error: ZeroDivisionError"), (bad, "save_png: too big for today")):
+            monkeypatch.setattr(session_mod, "render", raise_)
+            ws.send_text(json.dumps({"type": "save_png", "width": 32, "height": 32, "spp": 1}))
+            assert ws.receive_json() == {"type": "error", "field": "message", "message": reply}
+        ws.send_text(json.dumps({"type": "shape", "equation": "x^2 +"}))
+        err = ws.receive_json()
+        assert err["field"] == "equation" and "syntax error in 'x^2 +'" in err["message"], err
+        ws.send_bytes(b"{}")
+        assert ws.receive_json() == {"type": "error", "field": "message", "message": "message: expected text (JSON)"}
+        ws.send_text(render_msg(hello, seq=2, refine=False))
+        assert frame(ws.receive_bytes())[:2] == (2, KIND_COARSE)
+    failed = [r for r in caplog.records if r.name == "implgen.view"]
+    assert [r.getMessage() for r in failed] == ["viewer render failed", "viewer save failed"]
+    assert all(r.exc_info and r.exc_info[0] is ZeroDivisionError for r in failed)
 
 
 # ------------------------------------------------------------------------------------- clip: exact hits

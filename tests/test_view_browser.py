@@ -21,7 +21,8 @@ import pytest
 from PIL import Image
 
 from implgen.codegen.spec import parse_spec
-from implgen.scene.render import render, to_uint8
+from implgen.imagefile import to_uint8
+from implgen.scene.render import render
 from implgen.view import protocol
 from implgen.view.command import bind, document_factory, serve
 

@@ -31,7 +31,7 @@ _API: dict[str, str] = {
     "parse_scene": "implgen.scene.load",
     "render": "implgen.scene.render",
     "RenderInfo": "implgen.scene.render",
-    "write_png": "implgen.scene.render",
+    "write_png": "implgen.imagefile",
     "UserError": "implgen.errors",
 }
 __all__ = sorted(_API)

@@ -18,7 +18,8 @@ import numpy as np
 
 from implgen.animation import cluster
 from implgen.animation.frameout import FrameOutput
-from implgen.animation.frames import FrameOptions, Frames, decode_png, encode_png, render_frame_png
+from implgen.animation.frames import FrameOptions, Frames, render_frame_png
+from implgen.imagefile import decode_png, encode_png
 from implgen.scene.build import build_scene
 
 WINDOW_PER_WORKER = 3  # tasks in flight per worker: enough to hide the round trip, little memory

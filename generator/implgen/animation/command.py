@@ -19,9 +19,9 @@ from implgen.animation.frameout import FrameOutput, plan_output
 from implgen.animation.frames import FrameOptions, Frames, load_frames, parse_range
 from implgen.args import ArgumentParser
 from implgen.errors import UserError
+from implgen.imagefile import write_png
 from implgen.scene.keys import MAX_FRAMES
-from implgen.scene.load import MAX_DEPTH, MAX_SIZE, MAX_SPP
-from implgen.scene.render import DEFAULT_FOLD, MAX_THREADS, RenderInfo, render, write_png
+from implgen.scene.render import DEFAULT_FOLD, RenderInfo, check_options, render
 
 MAX_RETRIES = 100
 
@@ -119,14 +119,7 @@ def _options(args: argparse.Namespace, frames: Frames) -> FrameOptions:
         max_depth=sc.max_depth if args.max_depth is None else args.max_depth,
         threads=args.threads,
     )
-    for option, v, lo, hi in (
-        ("--width", opts.width, 1, MAX_SIZE),
-        ("--height", opts.height, 1, MAX_SIZE),
-        ("--spp", opts.spp, 1, MAX_SPP),
-        ("--threads", opts.threads or 1, 1, MAX_THREADS),
-        ("--max-depth", opts.max_depth, 0, MAX_DEPTH),
-    ):
-        validate.whole(option, "", v, lo, hi)
+    check_options(width=opts.width, height=opts.height, spp=opts.spp, threads=opts.threads, max_depth=opts.max_depth)
     return opts
 
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from implgen.errors import UserError
+from implgen.imagefile import decode_png
 from implgen.outputs import atomic_write, check_output_file, check_output_folder
 
 VIDEO = (".mp4", ".webm")
@@ -84,14 +85,6 @@ def _umask() -> int:
     return mask
 
 
-def _read_png(path: Path):
-    import numpy as np
-    from PIL import Image
-
-    with Image.open(path) as im:
-        return np.asarray(im.convert("RGB"))
-
-
 def _gif_delay(fps: float) -> int:
     """Milliseconds a GIF frame shows: GIF counts hundredths of a second, and browsers show delays under
     20 ms as 100 ms, so 20 ms (50 fps) is the fastest that plays as written."""
@@ -124,7 +117,7 @@ def _write_video(path: Path, frames: list[Path], fps: float, codec: str) -> None
         ffmpeg_log_level="error",
     ) as writer:
         for p in frames:
-            writer.append_data(_read_png(p))
+            writer.append_data(decode_png(p.read_bytes()))
 
 
 def plan_output(target: Path, nframes: int, last: int, width: int, height: int, option: str = "-o") -> FrameOutput:

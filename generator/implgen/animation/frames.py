@@ -12,18 +12,16 @@ unit of work of a frame or tile, run in this process or on a Dask worker (scene/
 
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from implgen.errors import UserError
+from implgen.imagefile import encode_png, to_uint8
 from implgen.scene.build import BuildResult, build_scene
 from implgen.scene.keys import contains_keyed
 from implgen.scene.load import parse_scene
 from implgen.scene.model import Leaf, Node, Scene
-from implgen.scene.render import render, to_uint8
+from implgen.scene.render import render
 from implgen.yamlfile import read_yaml
 
 # Checked up front: objects x frames (an object with no keyed value is parsed once and looked up on later
@@ -125,21 +123,6 @@ class FrameOptions:
     max_depth: int
     threads: int | None = None  # None: all cores of the machine that renders
     seed: int = 0
-
-
-def encode_png(rgb8: np.ndarray) -> bytes:
-    from PIL import Image
-
-    buf = io.BytesIO()
-    Image.fromarray(rgb8, mode="RGB").save(buf, format="PNG")
-    return buf.getvalue()
-
-
-def decode_png(data: bytes) -> np.ndarray:
-    from PIL import Image
-
-    with Image.open(io.BytesIO(data)) as im:
-        return np.asarray(im.convert("RGB"))
 
 
 def render_frame_png(

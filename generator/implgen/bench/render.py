@@ -21,25 +21,21 @@ is printed and written, with the machine and the load average, to the output fil
 
 from __future__ import annotations
 
-import ctypes
 import os
 import resource
 import statistics
-import time
 from collections.abc import Sequence
 from pathlib import Path
 
-import numpy as np
-
-from implgen import validate
 from implgen.args import ArgumentParser
 from implgen.bench.machine import cpu_model, load_average
 from implgen.errors import UserError
 from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.build import build_scene
-from implgen.scene.load import MAX_SIZE, MAX_SPP, load_scene
+from implgen.scene.load import load_scene
 from implgen.scene.model import Scene
-from implgen.scene.render import RAY_KINDS
+from implgen.scene.render import MAX_THREADS, check_options
+from implgen.scene.renderjob import RenderJob
 from implgen.scene.tracer import CScene
 
 TARGET_SPEEDUP = 1.85
@@ -61,36 +57,26 @@ def _thread_counts(text: str) -> list[int]:
         counts = [int(v) for v in text.split(",")]
     except ValueError:
         raise UserError("--threads", f"{text!r} is not a list of whole numbers such as 1,2") from None
-    if not counts or any(not 1 <= c <= 1024 for c in counts):
-        raise UserError("--threads", "thread counts must be 1 to 1024")
+    if not counts or any(not 1 <= c <= MAX_THREADS for c in counts):
+        raise UserError("--threads", f"thread counts must be 1 to {MAX_THREADS}")
     return counts
 
 
 def _measure(cs: CScene, sc: Scene, args, threads: int) -> tuple[float, float, dict[str, float]]:
     """(wall seconds, CPU seconds of the process, rays by kind) of one run of the C render loop, timed around
-    rt_render_run alone (scene/render.py's render() adds its progress polling and the Python thread)."""
-    lib = cs.lib
-    ctx = lib.rt_render_new(cs.ptr, args.width, args.height, args.spp, sc.max_depth, threads, 0)
-    if not ctx:
-        raise RuntimeError("rt_render_new failed")
-    try:
-        out = np.zeros((args.height, args.width, 3), dtype=np.float32)
-        ptr = out.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
-        c0, t0 = _cpu_seconds(), time.perf_counter()
-        code = lib.rt_render_run(ctx, ptr)
-        wall, cpu = time.perf_counter() - t0, _cpu_seconds() - c0
-        if code != 0:
-            raise RuntimeError(f"render failed (code {code})")
-        stats = (ctypes.c_double * 4)()
-        lib.rt_render_stats(ctx, stats)
-    finally:
-        lib.rt_render_free(ctx)
-    return wall, cpu, dict(zip(RAY_KINDS, stats[:3]))
+    rt_render_run alone: the render context and its image are made before (RenderJob's entry), and render()'s
+    progress polling and Python thread are not there."""
+    with RenderJob(cs, args.width, args.height, args.spp, sc.max_depth, threads) as job:
+        c0 = _cpu_seconds()
+        img = job.run()
+        cpu = _cpu_seconds() - c0
+        if img is None:
+            raise RuntimeError("render failed (cancelled)")
+        return job.seconds, cpu, job.stats().rays
 
 
 def _prepared(path: Path, args, fold: bool = False) -> tuple[CScene, Scene]:
-    for option, v in (("--width", args.width), ("--height", args.height), ("--spp", args.spp)):
-        validate.whole(option, "", v, 1, MAX_SPP if option == "--spp" else MAX_SIZE)
+    check_options(width=args.width, height=args.height, spp=args.spp)
     sc = load_scene(path)
     return CScene(sc, build_scene(sc, fold=fold)), sc
 

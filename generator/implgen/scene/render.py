@@ -1,30 +1,38 @@
-"""`render(scene)`: a scene to a float image, and the PNG writer.
+"""`render(scene)`: a scene to a float image (imagefile.py writes it as PNG).
 
-The scene is validated (scene/load.py), its shapes generated and compiled into a cached library (build.py), the
-scene handed to the C tracer through ctypes, and the image rendered on all cores: the C code runs on its own
-pthreads while Python, with the GIL released by ctypes, polls a progress counter for the progress bar.
+The steps: the options over the scene's image settings, checked (`_settings`, one table of ranges for this
+and `implgen render`); the shapes generated and compiled into a cached library (build.py); the scene handed to
+the C tracer through ctypes (tracer.py); the image rendered on all cores in one render context (renderjob.py):
+the C code runs on its own pthreads while Python, with the GIL released by ctypes, polls the progress counter
+for the progress bar (`_run_polled`); what the render did, recorded (`_record`).
 """
 
 from __future__ import annotations
 
-import ctypes
 import os
 import threading
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from implgen import validate
-from implgen.outputs import atomic_write
 from implgen.scene.build import BuildResult, build_scene
 from implgen.scene.load import MAX_DEPTH, MAX_SIZE, MAX_SPP, load_scene, parse_scene
 from implgen.scene.model import Scene
+from implgen.scene.renderjob import RenderJob
 from implgen.scene.tracer import CScene
 
-RAY_KINDS = ("primary", "shadow", "secondary")  # the first three stats slots (RT_RAYS_*)
 MAX_THREADS = 1024
+# The render options a caller may set, as the command line names them, each with its range: render() and
+# `implgen render` (animation/command.py) check them through check_options, so both say the same.
+OPTION_RANGES = (
+    ("width", "--width", 1, MAX_SIZE),
+    ("height", "--height", 1, MAX_SIZE),
+    ("spp", "--spp", 1, MAX_SPP),
+    ("threads", "--threads", 1, MAX_THREADS),
+    ("max_depth", "--max-depth", 0, MAX_DEPTH),
+)
 # Folding constant params into the generated code measured within a few per cent either way
 # (docs/tracer.md#folding-constant-params): off.
 DEFAULT_FOLD = False
@@ -50,12 +58,58 @@ def usable_cores() -> int:
         return os.cpu_count() or 1
 
 
+def check_options(
+    *,
+    width: int | None = None,
+    height: int | None = None,
+    spp: int | None = None,
+    threads: int | None = None,
+    max_depth: int | None = None,
+) -> None:
+    """Each option given (None: not set) in its range (OPTION_RANGES), in the table's order; a UserError
+    names the option."""
+    given = {"width": width, "height": height, "spp": spp, "threads": threads, "max_depth": max_depth}
+    for name, option, lo, hi in OPTION_RANGES:
+        if given[name] is not None:
+            validate.whole(option, "", given[name], lo, hi)
+
+
 def _as_scene(scene: Scene | str | Path | dict) -> Scene:
     if isinstance(scene, Scene):
         return scene
     if isinstance(scene, dict):
         return parse_scene(scene, "<scene>")
     return load_scene(scene)
+
+
+@dataclass(frozen=True)
+class _Settings:
+    """What one render() call renders: the scene's image settings with the options over them, checked."""
+
+    width: int
+    height: int
+    spp: int
+    max_depth: int
+    threads: int
+    seed: int
+    rows: tuple[int, int] | None  # None: the whole image
+
+
+def _settings(sc: Scene, width, height, spp, threads, max_depth, seed, rows) -> _Settings:
+    s = _Settings(
+        width=width or sc.width,
+        height=height or sc.height,
+        spp=spp or sc.spp,
+        max_depth=sc.max_depth if max_depth is None else max_depth,
+        threads=threads or usable_cores(),
+        seed=seed,
+        rows=rows,
+    )
+    check_options(width=s.width, height=s.height, spp=s.spp, threads=s.threads, max_depth=s.max_depth)
+    y0, y1 = (0, s.height) if rows is None else rows
+    if not 0 <= y0 < y1 <= s.height:
+        raise ValueError(f"rows {rows} outside the image's {s.height} rows")
+    return s
 
 
 def render(
@@ -78,91 +132,72 @@ def render(
     the scene library when the caller has it already (the frames of one animation share one). `rows`: only
     the band of rows [y0, y1) of the image (a tile), exactly as those rows of the whole image."""
     sc = _as_scene(scene)
-    w = width or sc.width
-    h = height or sc.height
-    n = spp or sc.spp
-    depth = sc.max_depth if max_depth is None else max_depth
-    nthreads = threads or usable_cores()
-    for option, v, lo, hi in (
-        ("--width", w, 1, MAX_SIZE),
-        ("--height", h, 1, MAX_SIZE),
-        ("--spp", n, 1, MAX_SPP),
-        ("--threads", nthreads, 1, MAX_THREADS),
-        ("--max-depth", depth, 0, MAX_DEPTH),
-    ):
-        validate.whole(option, "", v, lo, hi)
-    y0, y1 = (0, h) if rows is None else rows
-    if not 0 <= y0 < y1 <= h:
-        raise ValueError(f"rows {rows} outside the image's {h} rows")
+    s = _settings(sc, width, height, spp, threads, max_depth, seed, rows)
     if built is None:
         built = build_scene(sc, fold=fold)
     cs = CScene(sc, built)
     try:
-        ctx = cs.lib.rt_render_new(cs.ptr, w, h, n, depth, nthreads, seed)
-        if not ctx:
-            raise RuntimeError("rt_render_new failed")
-        if rows is not None and cs.lib.rt_render_set_rows(ctx, y0, y1) != 0:
-            cs.lib.rt_render_free(ctx)
-            raise RuntimeError("rt_render_set_rows failed")
-        out = np.zeros((y1 - y0, w, 3), dtype=np.float32)
-        result: dict[str, int] = {}
-        ptr = out.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
-
-        ends: list[float] = []
-
-        def work() -> None:
-            result["code"] = cs.lib.rt_render_run(ctx, ptr)
-            ends.append(time.perf_counter())  # here, not after the polling loop: that wakes every 0.1 s
-
-        bar = None
-        if progress:  # imported and drawn before the render starts: not beside it, competing for a core
-            from tqdm import tqdm
-
-            bar = tqdm(total=y1 - y0, unit="row", desc=Path(sc.source).name, leave=True)
-        t0 = time.perf_counter()
-        worker = threading.Thread(target=work, name="implgen-render", daemon=True)
-        worker.start()
-        try:
-            done = 0
-            while True:
-                worker.join(0.1)
+        with RenderJob(cs, s.width, s.height, s.spp, s.max_depth, s.threads, s.seed, rows=s.rows) as job:
+            bar = _progress_bar(job, Path(sc.source).name) if progress else None
+            try:
+                img = _run_polled(job, bar)
+            finally:
                 if bar is not None:
-                    now = cs.lib.rt_render_progress(ctx)
-                    bar.update(now - done)
-                    done = now
-                if not worker.is_alive():
-                    break
-        except KeyboardInterrupt:
-            cs.lib.rt_render_cancel(ctx)
-            worker.join()
-            raise
-        finally:
-            if bar is not None:
-                bar.close()
-        seconds = (ends[0] if ends else time.perf_counter()) - t0
-        if result.get("code", -1) != 0:
-            raise RuntimeError(f"render failed (code {result.get('code')})")
-        stats = (ctypes.c_double * 4)()
-        cs.lib.rt_render_stats(ctx, stats)
-        cs.lib.rt_render_free(ctx)
-        if info is not None:
-            info.seconds = seconds
-            info.rays = dict(zip(RAY_KINDS, stats[:3]))
-            info.nonfinite = int(stats[3])
-            info.library = built.library
-            info.threads = nthreads
-        return out
+                    bar.close()
+            if info is not None:
+                _record(info, job, built, s.threads)
+            return img
     finally:
         cs.close()
 
 
-def to_uint8(img: np.ndarray) -> np.ndarray:
-    return (np.clip(np.nan_to_num(img, nan=0.0), 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+def _progress_bar(job: RenderJob, name: str):
+    """A bar over the job's rows, imported and drawn before the render starts: not beside it, competing for
+    a core."""
+    from tqdm import tqdm
+
+    y0, y1 = job.rows
+    return tqdm(total=y1 - y0, unit="row", desc=name, leave=True)
 
 
-def write_png(img: np.ndarray, path: Path) -> None:
-    """Write atomically (outputs.atomic_write): a failure leaves nothing half-written."""
-    from PIL import Image
+def _run_polled(job: RenderJob, bar) -> np.ndarray:
+    """job.run() on a worker thread while this one wakes every 0.1 s to move the bar; Ctrl-C cancels the
+    render (the C threads stop after their current row) and is raised again once they have."""
+    outcome: dict = {}
 
-    picture = Image.fromarray(to_uint8(img), mode="RGB")
-    atomic_write(Path(path), lambda fh: picture.save(fh, format="PNG"))
+    def work() -> None:
+        try:
+            outcome["image"] = job.run()
+        except BaseException as err:  # raised again in the caller's thread
+            outcome["error"] = err
+
+    worker = threading.Thread(target=work, name="implgen-render", daemon=True)
+    worker.start()
+    try:
+        done = 0
+        while True:
+            worker.join(0.1)
+            if bar is not None:
+                now = job.progress()
+                bar.update(now - done)
+                done = now
+            if not worker.is_alive():
+                break
+    except KeyboardInterrupt:
+        job.cancel()
+        worker.join()
+        raise
+    if "error" in outcome:
+        raise outcome["error"]
+    if outcome["image"] is None:
+        raise RuntimeError("render failed (cancelled)")
+    return outcome["image"]
+
+
+def _record(info: RenderInfo, job: RenderJob, built: BuildResult, threads: int) -> None:
+    stats = job.stats()
+    info.seconds = job.seconds
+    info.rays = stats.rays
+    info.nonfinite = stats.nonfinite
+    info.library = built.library
+    info.threads = threads

@@ -9,7 +9,10 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
     {"type": "save_png", "width": 1920, "height": 1080, "spp": 16}    the current view through render()
     {"type": "save_yaml"} / {"type": "show_c"}                        the spec or scene / the generated C
 
-Bad values raise UserError naming the message field; the session sends the line back to the page.
+Bad values raise UserError naming the message field; the session sends the line back to the page. Every
+error reply, whatever failed, is built here (`error`, `error_for`):
+
+    {"type": "error", "field": "equation" | "message", "message": "..."}
 """
 
 from __future__ import annotations
@@ -54,6 +57,22 @@ def decode(text: str | bytes) -> dict[str, Any]:
     if not isinstance(data, dict) or data.get("type") not in TYPES:
         raise UserError("message", f"expected an object with type one of: {', '.join(TYPES)}")
     return data
+
+
+def error(field: str, message: str) -> dict:
+    """The one error reply: `field` says where the page shows it ("equation": beside the equation box;
+    "message": the status line)."""
+    return {"type": "error", "field": field, "message": message}
+
+
+def error_for(err: Exception) -> dict:
+    """The reply to a failure: bad input (UserError) as its line, the equation parser's beside the equation;
+    anything else is a bug, named by its kind only (the server's log has the traceback)."""
+    if not isinstance(err, UserError):
+        return error("message", f"internal error: {type(err).__name__}")
+    if err.source == "equation":
+        return error("equation", err.message)
+    return error("message", str(err))
 
 
 def _mapping(key: str, value: Any) -> dict:

@@ -20,6 +20,7 @@ from starlette.responses import Response
 from starlette.routing import Route, WebSocketRoute
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
+from implgen.view import protocol
 from implgen.view.document import Document
 from implgen.view.session import Session
 
@@ -97,14 +98,13 @@ def create_app(
                     break
                 text = msg.get("text")
                 if text is None:
-                    await send({"type": "error", "field": "message", "message": "message: expected text (JSON)"})
+                    await send(protocol.error("message", "message: expected text (JSON)"))
                     continue
                 try:
                     await session.handle(text)
                 except Exception as err:  # a bug, not bad input: tell the page, keep serving
                     log.exception("viewer message failed")
-                    text = f"internal error: {type(err).__name__}"
-                    await send({"type": "error", "field": "message", "message": text})
+                    await send(protocol.error_for(err))
         except WebSocketDisconnect:
             pass
         finally:

@@ -14,23 +14,20 @@ only its own .c and the glue are compiled, the runtime's objects are cached).
 from __future__ import annotations
 
 import asyncio
-import ctypes
-import io
 import logging
 import struct
-import tempfile
 import time
 from collections.abc import Awaitable, Callable
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
-from PIL import Image
 
 from implgen.errors import UserError
+from implgen.imagefile import encode_jpeg, encode_png, to_uint8
 from implgen.scene.build import BuildResult, build_scene
 from implgen.scene.model import Scene
-from implgen.scene.render import render, to_uint8, usable_cores, write_png
+from implgen.scene.render import render, usable_cores
+from implgen.scene.renderjob import RenderJob
 from implgen.scene.tracer import CScene
 from implgen.view import dump, protocol
 from implgen.view.document import Document
@@ -40,20 +37,20 @@ FULL_SPP = 4
 MAX_RENDERS_PER_SECOND = 60  # per page: requests beyond this wait (and are overtaken by newer ones)
 KIND_COARSE, KIND_FULL, KIND_SAVE = 0, 1, 2
 HEADER = struct.Struct(">IBxxxHH")  # seq, kind, width, height; the image bytes follow
+LIVE_JPEG_QUALITY = 88  # the coarse frame: small and soon replaced
+LIVE_PNG_LEVEL = 1  # the full frame: speed over size (zlib level 1)
 
 log = logging.getLogger("implgen.view")
 
 Send = Callable[[dict | bytes], Awaitable[None]]
 
 
-def encode(img: np.ndarray, fmt: str) -> bytes:
-    buf = io.BytesIO()
-    picture = Image.fromarray(to_uint8(img), mode="RGB")
-    if fmt == "JPEG":
-        picture.save(buf, format="JPEG", quality=88)
-    else:
-        picture.save(buf, format="PNG", compress_level=1)
-    return buf.getvalue()
+def _live_jpeg(img: np.ndarray) -> bytes:
+    return encode_jpeg(to_uint8(img), LIVE_JPEG_QUALITY)
+
+
+def _live_png(img: np.ndarray) -> bytes:
+    return encode_png(to_uint8(img), LIVE_PNG_LEVEL)
 
 
 class Session:
@@ -64,7 +61,7 @@ class Session:
         self._libs: dict[tuple, object] = {}  # spec ids of a scene's shapes -> built library path
         self._pending: protocol.RenderRequest | None = None
         self._wake = asyncio.Event()
-        self._running = None  # (lib, rt_render*) of the render in progress
+        self._running: RenderJob | None = None  # the render in progress
         self._last_start = 0.0
         self._task: asyncio.Task | None = None
         self._saving: asyncio.Task | None = None
@@ -121,10 +118,7 @@ class Session:
             elif kind == "show_c":
                 await self.send({"type": "c", "text": self.c_text()})
         except UserError as err:
-            if err.source == "equation":  # the parser's line, beside the field
-                await self.send({"type": "error", "field": "equation", "message": err.message})
-            else:
-                await self.send({"type": "error", "field": "message", "message": str(err)})
+            await self.send(protocol.error_for(err))
 
     def _mode(self) -> str:
         return "spec" if self.doc.base is None else "scene"
@@ -150,10 +144,6 @@ class Session:
             return dump.to_yaml(dump.spec_mapping(self.doc.spec, self.doc.values))
         return dump.to_yaml(dump.scene_mapping(self.doc.scene(spp=FULL_SPP)))
 
-    def scene_yaml(self, width: int, height: int, spp: int) -> str:
-        """The exact scene the session renders, as a scene file (the browser test renders it independently)."""
-        return dump.to_yaml(dump.scene_mapping(self.doc.scene(width, height, spp)))
-
     def c_text(self) -> str:
         from implgen.codegen.emit import generate
 
@@ -173,8 +163,7 @@ class Session:
         """The newest request wins: it replaces the waiting one and cancels the running render."""
         self._pending = req
         if self._running is not None:
-            lib, ctx = self._running
-            lib.rt_render_cancel(ctx)
+            self._running.cancel()
         self._wake.set()
         if self._task is None or self._task.done():
             self._task = asyncio.get_running_loop().create_task(self._loop())
@@ -196,28 +185,22 @@ class Session:
             self.doc.values, self.doc.orbit, self.doc.options = req.values, req.orbit, req.options
             try:
                 await self._frames(req)
-            except UserError as err:
-                await self.send({"type": "error", "field": "message", "message": str(err)})
-            except asyncio.CancelledError:
-                raise
-            except Exception as err:  # a bug, not bad input: say so and keep serving the next request
-                log.exception("viewer render failed")
-                text = f"internal error: {type(err).__name__}"
-                await self.send({"type": "error", "field": "message", "message": text})
+            except Exception as err:  # (not a cancel: that is a BaseException) say so, serve the next request
+                await self._failed(err, "viewer render failed")
 
     async def _frames(self, req: protocol.RenderRequest) -> None:
         cw, ch = max(1, req.width // COARSE_DIVISOR), max(1, req.height // COARSE_DIVISOR)
         img = await self._render(cw, ch, 1)
         if img is None:
             return
-        await self._send_frame(req.seq, KIND_COARSE, img, "JPEG")
+        await self._send_frame(req.seq, KIND_COARSE, img, _live_jpeg)
         if req.refine and self._pending is None:
             img = await self._render(req.width, req.height, FULL_SPP)
             if img is not None:
-                await self._send_frame(req.seq, KIND_FULL, img, "PNG")
+                await self._send_frame(req.seq, KIND_FULL, img, _live_png)
 
-    async def _send_frame(self, seq: int, kind: int, img: np.ndarray, fmt: str) -> None:
-        data = await asyncio.to_thread(encode, img, fmt)
+    async def _send_frame(self, seq: int, kind: int, img: np.ndarray, encode: Callable[[np.ndarray], bytes]) -> None:
+        data = await asyncio.to_thread(encode, img)
         await self.send(HEADER.pack(seq, kind, img.shape[1], img.shape[0]) + data)
         self.frames += 1
 
@@ -227,62 +210,50 @@ class Session:
         built = await asyncio.to_thread(self._library, sc)
         cs = CScene(sc, built)
         try:
-            ctx = cs.lib.rt_render_new(cs.ptr, width, height, spp, sc.max_depth, self.threads, 0)
-            if not ctx:
-                raise RuntimeError("rt_render_new failed")
-            out = np.zeros((height, width, 3), dtype=np.float32)
-            ptr = out.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
-            self._running = (cs.lib, ctx)
-            if self._pending is not None:  # overtaken while the scene was being built
-                cs.lib.rt_render_cancel(ctx)
-            run = asyncio.ensure_future(asyncio.to_thread(cs.lib.rt_render_run, ctx, ptr))
-            try:
-                code = await asyncio.shield(run)
-            except asyncio.CancelledError:  # the page went away: stop the C threads before freeing what they use
-                cs.lib.rt_render_cancel(ctx)
-                await run
-                raise
-            finally:
-                self._running = None
-                if run.done():
-                    cs.lib.rt_render_free(ctx)
-            if code == 1:
-                return None
-            if code != 0:
-                raise RuntimeError(f"render failed (code {code})")
-            return out
+            with RenderJob(cs, width, height, spp, sc.max_depth, self.threads) as job:
+                self._running = job
+                try:
+                    if self._pending is not None:  # overtaken while the scene was being built
+                        job.cancel()
+                    run = asyncio.ensure_future(asyncio.to_thread(job.run))
+                    try:
+                        return await asyncio.shield(run)
+                    except asyncio.CancelledError:  # the page went away: stop the C threads, wait for them
+                        job.cancel()
+                        await run
+                        raise
+                finally:
+                    self._running = None
         finally:
             cs.close()
 
     async def _save_png(self, width: int, height: int, spp: int) -> None:
-        """The current view at any size through the normal path: render() and write_png()."""
+        """The current view at any size through the normal path: render(), and the PNG encoder write_png uses
+        (the same bytes as `implgen render` writes for this scene)."""
         sc = self.doc.scene(width, height, spp)
 
         def work() -> bytes:
-            img = render(sc, threads=self.threads)
-            with tempfile.TemporaryDirectory(prefix="implgen-view-") as tmp:
-                path = Path(tmp) / "view.png"
-                write_png(img, path)
-                return path.read_bytes()
+            return encode_png(to_uint8(render(sc, threads=self.threads)))
 
         try:
             data = await asyncio.to_thread(work)
-        except UserError as err:
-            await self.send({"type": "error", "field": "message", "message": str(err)})
-            return
-        except Exception as err:  # a bug: say so, keep serving
-            log.exception("viewer save failed")
-            await self.send({"type": "error", "field": "message", "message": f"internal error: {type(err).__name__}"})
+        except Exception as err:  # say so, keep serving
+            await self._failed(err, "viewer save failed")
             return
         await self.send(HEADER.pack(0, KIND_SAVE, width, height) + data)
+
+    async def _failed(self, err: Exception, what: str) -> None:
+        """Tell the page what failed; a bug (not bad input) also goes to the log with its traceback."""
+        if not isinstance(err, UserError):
+            log.error(what, exc_info=err)
+        await self.send(protocol.error_for(err))
 
     async def close(self) -> None:
         self._pending = None
         if self._saving is not None and not self._saving.done():
             await asyncio.wait([self._saving])  # render() cannot be cancelled from here; it ends on its own
         if self._running is not None:
-            lib, ctx = self._running
-            lib.rt_render_cancel(ctx)
+            self._running.cancel()
         if self._task is not None:
             self._task.cancel()
             try:
