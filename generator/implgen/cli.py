@@ -25,6 +25,7 @@ _COMMANDS: dict[str, str] = {
     "render": "implgen.animation.command:main",
     "demo": "implgen.demo:main",
     "view": "implgen.view.command:main",
+    "cache": "implgen.compile.command:main",
 }
 _BENCHES: dict[str, str] = {
     "solvers": "implgen.bench.solvers:main",
