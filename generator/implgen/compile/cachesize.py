@@ -155,13 +155,14 @@ def evict(keep: Iterable[Path] = (), bound: int | None = None) -> list[Unit]:
     return removed
 
 
-def clear(root: Path) -> list[Unit]:
+def clear(root: Path) -> tuple[list[Unit], list[Unit]]:
     """Remove every unit of the inventory (the layout's patterns only; links are removed, not followed), then
-    the subfolders if they are left empty. Returns what was removed."""
-    units = inventory(root)
-    for u in units:
+    the subfolders if they are left empty. Returns (what was removed, what could not be: a read-only cache)."""
+    removed, failed = [], []
+    for u in inventory(root):
         cachedir.remove_entry(u.path)
         cachedir.used_here.discard(u.path)
+        (failed if os.path.lexists(u.path) else removed).append(u)
     for sub, _ in KINDS.values():
         path = root / sub
         st = _lstat(path)
@@ -172,7 +173,7 @@ def clear(root: Path) -> list[Unit]:
                 os.rmdir(path)
             except OSError:
                 pass  # not empty (files implgen does not know) or absent
-    return units
+    return removed, failed
 
 
 def _unlink(path: Path) -> None:

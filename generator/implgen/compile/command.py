@@ -71,8 +71,12 @@ def clear() -> int:
     if root is None:
         print(f"implgen: nothing to clear ({cachedir.cache_root()} does not exist)")
         return 0
-    removed = cachesize.clear(root)
+    removed, failed = cachesize.clear(root)
     print(f"implgen: removed {len(removed)} entries ({_mb(sum(u.size for u in removed))}) from {root}")
+    if failed:
+        raise UserError(
+            cachedir.label(root), f"{len(failed)} entries could not be removed, e.g. {failed[0].path} (read-only?)"
+        )
     return 0
 
 
