@@ -138,16 +138,15 @@ def _writable(folder: Path) -> None:
         )
 
 
-def _object_job(source: Path, include_dirs: Sequence[Path], extra_flags: Sequence[str]) -> Job:
-    """The cached object for one source: its key hashes the source text, every header in `include_dirs`, the
-    flags and the compiler."""
-    cc = compiler()
+def _object_job(source: Path, include_dirs: Sequence[Path], extra_flags: Sequence[str], cc: str, folder: Path) -> Job:
+    """The cached object for one source, in `folder` (obj/): its key hashes the source text, every header in
+    `include_dirs`, the flags and the compiler."""
     flags = [*BASE_FLAGS, *extra_flags]
     h = _digest(cc, flags)
     h.update(b"\0src\0" + Path(source).read_bytes())
     _headers_into(h, include_dirs)
     key = h.hexdigest()
-    target = cachedir.cache_dir("obj") / f"{Path(source).stem}-{key[:32]}.o"
+    target = folder / f"{Path(source).stem}-{key[:32]}.o"
     includes = [f"-I{inc}" for inc in include_dirs]
     return Job(target, key, Path(source).name, lambda tmp: [cc, *flags, "-c", str(source), "-o", tmp, *includes])
 
@@ -185,7 +184,8 @@ def build_jobs(
     """One shared library from C sources, each with the include folders it sees. A library whose seal
     verifies is returned at once (its objects are not looked at); otherwise the missing objects are compiled,
     the library linked and sealed, and the cache brought back within its bound (cachesize.evict)."""
-    objects = [_object_job(src, inc, extra_flags) for src, inc in jobs]
+    cc, folder = compiler(), cachedir.cache_dir("obj")  # once per library: each is a few system calls
+    objects = [_object_job(src, inc, extra_flags, cc, folder) for src, inc in jobs]
     lib = _library_job(objects, libs, tag)
     if cachedir.check_entry(lib.target, lib.key):
         return lib.target
