@@ -9,7 +9,7 @@ itself, never followed.
 The bound is `$IMPLGEN_CACHE_MAX_MB` (cachedir.max_bytes, default 500 MB). clib calls evict() after it links
 a new library -- the moment the cache grows by more than a spec entry -- and each use of an entry touches
 its mtime (cachedir.touch), so "least recently used" does not depend on the file system keeping access
-times. Never evicted: the libraries this process has loaded (a mapped library must keep its file), what
+times. Never evicted: the libraries this process holds loaded (clib keeps a weak map of live handles), what
 another process used in the last GRACE_SECONDS (it may be linking those objects now; this process's own
 entries may go, oldest first, since its library is linked), and `roots_reference/` (the tests' exact
 reference roots: minutes to compute, written by roots/reference.py without touching them on use, so their
@@ -127,7 +127,7 @@ def inventory(root: Path | None = None) -> list[Unit]:
 def evict(keep: Iterable[Path] = (), bound: int | None = None) -> list[Unit]:
     """Remove least-recently-used entries until the cache is within `bound` bytes (default: cachedir.max_bytes()).
 
-    Never removed: `keep` (the libraries this process has loaded), `roots_reference/`, and what another
+    Never removed: `keep` (the libraries this process holds loaded), `roots_reference/`, and what another
     process used in the last GRACE_SECONDS (it may be linking those objects now; what this process used itself
     may go, oldest first, since its library is linked). Leftovers of earlier versions go first. Returns what
     was removed."""

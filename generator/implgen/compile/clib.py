@@ -24,6 +24,7 @@ import hashlib
 import os
 import shutil
 import subprocess
+import weakref
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cache
@@ -39,7 +40,10 @@ WARNING_FLAGS: tuple[str, ...] = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-p
 BASE_FLAGS: tuple[str, ...] = (*WARNING_FLAGS, "-O3", "-fPIC")
 KEY_FORMAT = "clib-2"  # part of every key: entries of an earlier layout are never taken for these
 
-_loaded: set[Path] = set()  # libraries this process has loaded: eviction leaves them alone
+# The libraries this process holds loaded (a live ctypes handle): eviction leaves them alone. Weak, so a library
+# the process has let go of (the viewer's previous equation) may be evicted like any other; its mapping, if the
+# dynamic loader keeps one, does not need the file.
+_in_use: weakref.WeakValueDictionary[Path, ctypes.CDLL] = weakref.WeakValueDictionary()
 
 
 def compiler() -> str:
@@ -192,7 +196,7 @@ def build_jobs(
     _build_all(objects)
     _writable(lib.target.parent)
     _run(lib)
-    cachesize.evict(keep={*_loaded, lib.target})
+    cachesize.evict(keep={*_in_use.keys(), lib.target})
     return lib.target
 
 
@@ -232,5 +236,5 @@ def load(path: Path) -> ctypes.CDLL:
     except OSError as err:
         cachedir.remove_entry(path)
         raise UserError("CC", f"the library {path.name} built by {compiler()} does not load: {err}") from None
-    _loaded.add(path)
+    _in_use[path] = lib
     return lib
