@@ -80,11 +80,26 @@ def clear() -> int:
     return 0
 
 
+HELP = f"""{USAGE}
+
+The build cache: compiled libraries and objects, generated C and parsed specs (docs/tracer.md,
+"Build cache"). Its folder is $IMPLGEN_CACHE, else $XDG_CACHE_HOME/implgen, else ~/.cache/implgen.
+Its size bound is $IMPLGEN_CACHE_MAX_MB (default 500); past it, the least recently used entries go.
+
+  info    the folder, its entries by kind with their sizes, the total and the bound
+  clear   remove every entry (only names of the cache's layout; links are removed, not followed)
+
+examples:
+  # what the cache holds, and its bound
+  implgen cache info
+  # empty it (it is rebuilt on the next render)
+  implgen cache clear"""
+
+
 def main(argv: Sequence[str]) -> int:
     args = list(argv)
     if args in (["-h"], ["--help"]):
-        print(USAGE)
-        print(__doc__.split("\n\n")[1])
+        print(HELP)
         return 0
     if len(args) != 1 or args[0] not in ("info", "clear"):
         raise UserError("cache", f"choose one of: info, clear ({USAGE})")
