@@ -85,6 +85,9 @@ COMMANDS: dict[str, Command] = {
         "what `make demo` runs: the example shapes, end to end",
         "implgen.demo:main",
     ),
+    "cache": Command(
+        "cache info|clear", "the build cache: what it holds and its bound; empty it", "implgen.compile.command:main"
+    ),
     "--version": Command("--version", "print the version", _version),
 }
 ROOT = Command(

@@ -13,6 +13,12 @@ misses and is refused by the full parse with exactly its usual message. What is 
 types, ranges, and that it names the same shape and params as the mapping it was looked up for); anything
 unreadable or out of shape is a miss, parsed in full and written again. What a cached spec does not hold
 (the expression, symbolic bounds, `specialise`) is parsed from the same mapping on first use.
+
+An entry is data, not code, but it decides which generated code a scene compiles, and it sits in the same
+folder as the libraries: the folder's checks apply (cachedir.cache_dir: a folder that is not ours or that
+others can write is refused with one line), an entry is read only when it is a regular file of ours that
+nobody else can write, written atomically with mode 0600, and touched when used (the cache's size bound
+evicts the least recently used entries).
 """
 
 from __future__ import annotations
@@ -20,20 +26,16 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import os
 import re
-import stat
 from pathlib import Path
 from typing import Any
 
-from implgen import abi
-from implgen.cachedir import cache_dir
+from implgen import abi, cachedir
 from implgen.codegen import paramvalues
 from implgen.codegen.fingerprint import implgen_fingerprint
 from implgen.codegen.names import check_identifier, check_shape_name
 from implgen.codegen.specmodel import Spec, Symbolic
 from implgen.errors import UserError
-from implgen.outputs import atomic_write
 from implgen.yamlfile import read_yaml
 
 FORMAT = 2
@@ -98,12 +100,11 @@ def parse_spec(data: Any, source: str = "<spec>") -> Spec:
         return _parse(data, source)
     key = hashlib.sha256(f"{FORMAT}\0{implgen_fingerprint()}\0{content}".encode()).hexdigest()
     path = _entry_path(key)
-    entry = _read_entry(path, key, data) if path is not None else None
+    entry = _read_entry(path, key, data)
     if entry is not None:
         return _cached_spec(entry, content, source)
     spec = _parse(data, source)  # raises exactly as without a cache
-    if path is not None:
-        _write_entry(path, key, spec)
+    _write_entry(path, key, spec)
     return spec
 
 
@@ -132,26 +133,27 @@ def _canonical(data: Any) -> str | None:
     return json.dumps(data, ensure_ascii=True, allow_nan=True, separators=(",", ":"))
 
 
-def _entry_path(key: str) -> Path | None:
-    try:
-        return cache_dir() / "spec" / f"{key[:40]}.json"
-    except OSError:  # no usable cache folder: parse every time
-        return None
+def _entry_path(key: str) -> Path:
+    """Where the entry for `key` lives. The cache folder's checks apply (cachedir.cache_dir: ours, 0700, not a
+    link): a folder someone else could write is refused with its one line here too, before anything is read."""
+    return cachedir.cache_dir("spec") / f"{key[:40]}.json"
 
 
 def _read_entry(path: Path, key: str, data: dict) -> dict | None:
-    try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))  # a fifo must not block the load
-        with os.fdopen(fd, "rb") as fh:
-            if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
-                return None
-            raw = fh.read(MAX_ENTRY_BYTES + 1)
-        if len(raw) > MAX_ENTRY_BYTES:
-            return None
-        entry = json.loads(raw.decode("utf-8"))
-    except (OSError, ValueError, RecursionError):  # missing, unreadable, not UTF-8, not JSON
+    """The entry, if it is a regular file of ours nobody else can write (cachedir.read_file: not a link, a fifo
+    does not block), at most MAX_ENTRY_BYTES, JSON, and in the form _write_entry gives it; a hit is touched
+    (least-recently-used eviction)."""
+    raw = cachedir.read_file(path, MAX_ENTRY_BYTES)
+    if raw is None:  # missing, not ours, writable by others, not a regular file, too long
         return None
-    return entry if _entry_ok(entry, key, data) else None
+    try:
+        entry = json.loads(raw.decode("utf-8"))
+    except (ValueError, RecursionError):  # not UTF-8, not JSON
+        return None
+    if not _entry_ok(entry, key, data):
+        return None
+    cachedir.touch(path)
+    return entry
 
 
 def _named(check: Any, name: Any) -> bool:
@@ -249,7 +251,6 @@ def _write_entry(path: Path, key: str, spec: Spec) -> None:
     }
     data = json.dumps(entry, allow_nan=True).encode()
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        atomic_write(path, lambda fh: fh.write(data))
+        cachedir.write_file(path, data)  # atomic, 0600
     except OSError:  # a read-only cache: the next load parses again
         pass

@@ -2,33 +2,34 @@
 runtime_c and link.
 
 Caches, all under cachedir.cache_dir() (`$IMPLGEN_CACHE`, else `$XDG_CACHE_HOME/implgen`, else
-`~/.cache/implgen`):
+`~/.cache/implgen`; created 0700 and refused unless it is ours alone -- cachedir's notes):
   spec/<key>.json a parsed spec, keyed by its content (codegen/speccache.py): what the build needs of it;
-  gen/<key>/      generated .c/.h of one shape; the key (speccache.spec_key) hashes the spec's content
-                  (equation, params, bounds, folded values, name) and implgen's own generator + template
+  gen/<key>/      generated .c/.h of one shape, each sealed; the key (speccache.spec_key) hashes the spec's
+                  content (equation, params, bounds, folded values, name) and implgen's own generator + template
                   sources, so editing a spec or upgrading implgen regenerates, and nothing else does;
-  obj/<name>-<hash>.o  one object per C source (clib.compile_object hashes the source and the headers it
-                  can see): the runtime's objects are compiled once and shared by every library;
-  glue/glue-<key>.c the C list of a library's shapes, keyed by their C names and implgen's fingerprint;
-  scene-<hash>.so the linked library (clib.link_shared, keyed by its objects).
-An unchanged set of shapes therefore neither imports SymPy nor runs the C compiler the second time, and a new
-shape costs one generation, one small compilation (its .c and the glue) and a link.
+  obj/<name>-<hash>.o  one object per C source (clib: the source, the headers it can see, the flags and the
+                  compiler): the runtime's objects are compiled once and shared by every library;
+  glue/glue-<key>.c the C list of a library's shapes, keyed by their C names and implgen's fingerprint, sealed;
+  lib/scene-<hash>.so the linked library (clib, keyed by its objects' keys), sealed and checked before dlopen.
+Generated files are sources of code, so they are sealed like the objects (cachedir.write_entry): a truncated
+or edited one is generated again, never compiled. An unchanged set of shapes therefore neither imports SymPy
+nor runs the C compiler the second time, and a new shape costs one generation, one small compilation (its .c
+and the glue) and a link.
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from implgen.cachedir import cache_dir
+from implgen import cachedir
 from implgen.codegen.fingerprint import implgen_fingerprint
 from implgen.codegen.specmodel import Spec
 from implgen.compile import clib
-from implgen.outputs import atomic_write
+from implgen.errors import UserError
 from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, TRACER_SOURCES, runtime_dir, runtime_sources
 
 
@@ -41,24 +42,41 @@ class ShapeEntry:
     folded: bool
 
 
+def _gen_key(spec: Spec, fname: str) -> str:
+    return hashlib.sha256(f"gen\0{spec.spec_key}\0{fname}".encode()).hexdigest()
+
+
+def _generated_ok(folder: Path, spec: Spec) -> bool:
+    """The folder holds this spec's sealed .c and .h (and is a folder of ours, not a link)."""
+    if cachedir.folder_problem(folder) is not None:
+        return False
+    return all(cachedir.check_entry(folder / f, _gen_key(spec, f)) for f in (f"{spec.name}.c", f"{spec.name}.h"))
+
+
 def generated_dir(spec: Spec) -> tuple[Path, bool]:
     """Folder with <name>.c/.h for this spec, generated on a cache miss. Returns (folder, was_generated)."""
-    target = cache_dir() / "gen" / spec.spec_key
-    if (target / f"{spec.name}.c").exists() and (target / f"{spec.name}.h").exists():
+    target = cachedir.cache_dir("gen") / spec.spec_key
+    if _generated_ok(target, spec):
+        cachedir.touch(target)
         return target, False
     from implgen.codegen.emit import generate  # SymPy: only when there is something to generate
 
     files = generate(spec, langs=("c",))
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=".gen-", dir=target.parent))
-    for fname, text in files.items():
-        (tmp / fname).write_text(text, encoding="utf-8")
+    tmp = cachedir.temp_path(target.parent)
+    try:
+        os.mkdir(tmp, 0o700)
+        for fname, text in files.items():
+            cachedir.write_entry(tmp / fname, text.encode("utf-8"), _gen_key(spec, fname))
+    except OSError as err:
+        cachedir.remove_entry(tmp)
+        raise UserError(cachedir.label(), f"cannot write in {target.parent}: {err.strerror or err}") from None
+    if os.path.lexists(target) and not _generated_ok(target, spec):
+        cachedir.remove_entry(target)  # broken (it did not verify): made again
     try:
         os.replace(tmp, target)  # atomic: a parallel build sees all files or none
     except OSError:  # another process won the race; use its copy
-        for p in tmp.iterdir():
-            p.unlink()
-        tmp.rmdir()
+        cachedir.remove_entry(tmp)
+    cachedir.touch(target)
     return target, True
 
 
@@ -66,14 +84,16 @@ def _glue(entries: Sequence[ShapeEntry]) -> Path:
     """The C file that lists the shapes for the tracer (templates/scene/glue.c.j2), cached by what it is made
     of: the shapes' C names and implgen's fingerprint (which covers the template)."""
     names = "\0".join(e.c_name for e in entries)
-    key = hashlib.sha256(f"{implgen_fingerprint()}\0{names}".encode()).hexdigest()[:20]
-    glue = cache_dir() / "glue" / f"glue-{key}.c"
-    if not glue.exists():
+    key = hashlib.sha256(f"glue\0{implgen_fingerprint()}\0{names}".encode()).hexdigest()
+    glue = cachedir.cache_dir("glue") / f"glue-{key[:32]}.c"
+    if not cachedir.check_entry(glue, key):
         from implgen.codegen.templating import environment  # Jinja2, only when the glue is new
 
         data = environment().get_template("scene/glue.c.j2").render(entries=entries).encode()
-        glue.parent.mkdir(parents=True, exist_ok=True)
-        atomic_write(glue, lambda fh: fh.write(data))
+        try:
+            cachedir.write_entry(glue, data, key)
+        except OSError as err:
+            raise UserError(cachedir.label(), f"cannot write {glue}: {err.strerror or err}") from None
     return glue
 
 
@@ -91,5 +111,4 @@ def build_library(entries: Sequence[ShapeEntry]) -> tuple[Path, int]:
     jobs = [(src, [rt]) for src in runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES, TRACER_SOURCES)]
     jobs += [(d / f"{e.c_name}.c", [rt, d]) for d, e in zip(dirs, entries)]
     jobs.append((glue, [rt, *dirs]))
-    objects = clib.compile_objects(jobs, extra_flags=["-pthread"])
-    return clib.link_shared(objects, libs=["-lm", "-pthread"], tag="scene"), generated
+    return clib.build_jobs(jobs, extra_flags=["-pthread"], libs=["-lm", "-pthread"], tag="scene"), generated
