@@ -378,3 +378,26 @@ def test_cache_commands_refuse_a_folder_others_can_write(cache: Path) -> None:
 
 def test_cache_command_usage_is_one_line(cache: Path) -> None:
     one_line_error(cache_command(cache, "purge"), "cache", "info, clear")
+
+
+def test_the_exact_reference_cache_is_data_never_a_pickle(tmp_path: Path, monkeypatch) -> None:
+    """roots/reference.py keeps its exact roots as JSON numbers: a pickle (code, when loaded) planted under the
+    entry's name is not read, and neither is a file others can write; both are computed again."""
+    import pickle
+
+    import numpy as np
+
+    from implgen.roots import reference
+
+    monkeypatch.setenv("IMPLGEN_CACHE", str(tmp_path / "cache"))
+    coeffs = np.array([[-2.0, 0.0, 1.0], [6.0, -5.0, 1.0]])  # roots +-sqrt(2); 2 and 3
+    first = reference.reference(coeffs, workers=1)
+    path = reference._cache_file(coeffs)
+    assert path.suffix == ".json" and [[r.value for r in row] for row in first] == [[-(2**0.5), 2**0.5], [2.0, 3.0]]
+    marker = tmp_path / "ran"
+    path.write_bytes(pickle.dumps(f"print(open({str(marker)!r}, 'w'))"))
+    again = reference.reference(coeffs, workers=1)
+    assert not marker.exists() and [[r.value for r in row] for row in again] == [[-(2**0.5), 2**0.5], [2.0, 3.0]]
+    path.write_text("[[[9.0, 1, 1.0]], [[9.0, 1, 1.0]]]")  # well-formed, but writable by others
+    os.chmod(path, 0o666)
+    assert reference.reference(coeffs, workers=1)[0][0].value == -(2**0.5)

@@ -37,7 +37,7 @@ KINDS: dict[str, tuple[str, re.Pattern[str]]] = {
     "glue": ("glue", re.compile(r"glue-[0-9a-f]{32}\.c\Z")),
     "gen": ("gen", re.compile(r"[0-9a-f]{24}\Z")),
     "spec": ("spec", re.compile(r"[0-9a-f]{40}\.json\Z")),
-    "roots_reference": ("roots_reference", re.compile(r"[0-9a-f]{24}\.pkl\Z")),
+    "roots_reference": ("roots_reference", re.compile(r"[0-9a-f]{24}\.(json|pkl)\Z")),
 }
 NOT_EVICTED = ("roots_reference",)
 # What earlier versions of implgen left (libraries at the top, 20-hex names, no seals): never loaded again,

@@ -22,8 +22,8 @@ smallest reference root in [lo, hi]: *missed* when a required root (as above) li
 from __future__ import annotations
 
 import hashlib
+import json
 import os
-import pickle
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -32,6 +32,8 @@ from pathlib import Path
 import mpmath
 import numpy as np
 import sympy as sp
+
+from implgen.cachedir import cache_dir, read_file, write_file
 
 U = 2.0**-53
 WELL_KAPPA = 1e3
@@ -90,24 +92,21 @@ def _batch(rows: list[np.ndarray]) -> list[list[RefRoot]]:
 
 
 def _cache_file(coeffs: np.ndarray) -> Path:
-    from implgen.cachedir import cache_dir
+    h = hashlib.sha256(b"ref-v4" + np.ascontiguousarray(coeffs, dtype=np.float64).tobytes()).hexdigest()[:24]
+    return cache_dir("roots_reference") / f"{h}.json"
 
-    h = hashlib.sha256(b"ref-v3" + np.ascontiguousarray(coeffs, dtype=np.float64).tobytes()).hexdigest()[:24]
-    d = cache_dir() / "roots_reference"
-    d.mkdir(parents=True, exist_ok=True)
-    return d / f"{h}.pkl"
+
+MAX_REFERENCE_BYTES = 256 << 20  # a reference file of the largest case set is a few MB
 
 
 def reference(coeffs: np.ndarray, workers: int | None = None, use_cache: bool = True) -> list[list[RefRoot]]:
     """exact_roots for every row, in parallel, cached on disk (keyed by the coefficient bytes)."""
     coeffs = np.ascontiguousarray(coeffs, dtype=np.float64)
     path = _cache_file(coeffs)
-    if use_cache and path.exists():
-        try:  # plain tuples (value, mult, kappa): independent of where RefRoot lives
-            with open(path, "rb") as fh:
-                return [[RefRoot(v, m, k) for v, m, k in roots] for roots in pickle.load(fh)]
-        except (OSError, pickle.UnpicklingError, EOFError, TypeError, ValueError):
-            pass  # unreadable: compute again
+    if use_cache:
+        cached = _read_reference(path, len(coeffs))
+        if cached is not None:
+            return cached
     rows = list(coeffs)
     workers = workers or min(os.cpu_count() or 1, 4)
     if workers > 1 and len(rows) > 50:
@@ -122,12 +121,25 @@ def reference(coeffs: np.ndarray, workers: int | None = None, use_cache: bool = 
     for roots in result:  # mpf objects do not need to survive the cache
         for r in roots:
             r.exact = None
-    if use_cache:
-        tmp = path.with_suffix(f".tmp{os.getpid()}")
-        with open(tmp, "wb") as fh:
-            pickle.dump([[(r.value, r.mult, r.kappa) for r in roots] for roots in result], fh)
-        os.replace(tmp, path)
+    if use_cache:  # data, not code: JSON of plain (value, multiplicity, condition) triples, never a pickle
+        rows_out = [[[r.value, r.mult, r.kappa] for r in roots] for roots in result]
+        write_file(path, json.dumps(rows_out, allow_nan=True).encode())
     return result
+
+
+def _read_reference(path: Path, nrows: int) -> list[list[RefRoot]] | None:
+    """The cached reference for `nrows` polynomials, or None when it is missing or not exactly what
+    reference() writes (then it is computed again)."""
+    raw = read_file(path, MAX_REFERENCE_BYTES)
+    if raw is None:
+        return None
+    try:
+        rows = json.loads(raw)
+        if not isinstance(rows, list) or len(rows) != nrows:
+            return None
+        return [[RefRoot(float(v), int(m), float(k)) for v, m, k in roots] for roots in rows]
+    except (ValueError, TypeError, RecursionError):
+        return None
 
 
 @dataclass
