@@ -69,9 +69,11 @@ def frames_from_data(data: dict, source: str | Path = "<scene>") -> Frames:
     if not fr.animated:
         return fr
     leaves0 = first.leaves()
-    keyed_mats = contains_keyed(data.get("materials"))
+    keyed_mats = contains_keyed(data.get("materials"), fr.source, "materials")
     keyed = sum(
-        _count_leaves(node) for node, raw in zip(first.objects, data["objects"]) if keyed_mats or contains_keyed(raw)
+        _count_leaves(node)
+        for i, (node, raw) in enumerate(zip(first.objects, data["objects"]))
+        if keyed_mats or contains_keyed(raw, fr.source, f"objects[{i}]")
     )
     for n, limit, what in ((len(leaves0), MAX_OBJECT_FRAMES, ""), (keyed, MAX_KEYED_OBJECT_FRAMES, "keyed ")):
         if n * fr.count > limit:
