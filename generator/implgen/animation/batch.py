@@ -71,6 +71,7 @@ def render_frames(
     """Render the frames of `todo` whose output is missing, each as one task or as `tiles` bands of rows,
     write them in order, then finish the output (encode a video or GIF from all frames of `todo`)."""
     t0 = time.perf_counter()
+    out.check_fps(frames.fps, frames.source)
     skipped = [f for f in todo if out.done(f)]
     missing = [f for f in todo if not out.done(f)]
     out.prepare()

@@ -72,6 +72,7 @@ def main(argv: Sequence[str]) -> int:
     todo = parse_range(args.frames, frames.count) if args.frames is not None else range(frames.count)
     opts = _options(args, frames)
     out = plan_output(args.output, len(todo), todo[-1], opts.width, opts.height)
+    out.check_fps(frames.fps, frames.source)
     if args.fold and frames.params_vary:
         raise UserError("--fold", "the scene's shape params change from frame to frame; they cannot be folded")
     if args.tiles is not None:

@@ -31,6 +31,15 @@ STILL = ".png"
 # The one printf integer field of a frame pattern: %d, %4d or %04d (no other % in the name).
 _FIELD = re.compile(r"%(0?[1-9]?)d")
 CODECS = {".mp4": "libx264", ".webm": "libvpx-vp9"}
+# The frame rates each kind of output can carry (a scene's fps is (0, 1000]; frame PNGs have none). GIF stores a
+# frame's delay in hundredths of a second in 16 bits: at most 655.35 s, so 0.002 fps (500 s) is the slowest
+# round rate it holds. ffmpeg takes the rate as a fraction with a denominator of at most 10^6 (imageio-ffmpeg):
+# 1e-5 fps breaks the .mp4 muxer, 1e-300 becomes 0; 0.001 fps (a frame every 1,000 s) to 1000 fps encode and
+# decode frame for frame with both codecs, for 10,000 frames (tests/test_fps_ranges.py).
+FPS_RANGES = {
+    "gif": (0.002, 1000.0, "a GIF stores each frame's delay in hundredths of a second, at most 655.35 s"),
+    "video": (0.001, 1000.0, "ffmpeg's .mp4 muxer fails below it; a frame shows 1,000 s at 0.001"),
+}
 
 
 @dataclass
@@ -51,6 +60,16 @@ class FrameOutput:
     def done(self, frame: int) -> bool:
         """A frame is complete when its file exists (files appear only by an atomic rename)."""
         return self.kind != "still" and self.path(frame).is_file()
+
+    def check_fps(self, fps: float, source: str) -> None:
+        """The scene's frame rate (animation.fps in `source`) fits this output, before any rendering."""
+        if self.kind not in FPS_RANGES:
+            return
+        lo, hi, why = FPS_RANGES[self.kind]
+        if not lo <= fps <= hi:
+            raise UserError(
+                source, f"animation.fps: {fps:g} is outside [{lo:g}, {hi:g}] for -o {self.target.name} ({why})"
+            )
 
     def prepare(self) -> None:
         self.folder.mkdir(parents=True, exist_ok=True)
