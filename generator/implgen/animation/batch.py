@@ -11,13 +11,13 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from implgen.animation import cluster
-from implgen.animation.frameout import FrameOutput
+from implgen.animation.frameout import FrameOutput, Made
 from implgen.animation.frames import FrameOptions, Frames, decode_png, encode_png, render_frame_png
 from implgen.scene.build import build_scene
 
@@ -53,6 +53,8 @@ class BatchReport:
     skipped: list[int]
     seconds: float
     bytes_moved: int  # PNG bytes that came back from the tasks
+    replaced: list[int] = field(default_factory=list)  # frames there, made otherwise: rendered again
+    replaced_why: str = ""
 
 
 def render_frames(
@@ -72,8 +74,10 @@ def render_frames(
     write them in order, then finish the output (encode a video or GIF from all frames of `todo`)."""
     t0 = time.perf_counter()
     out.check_fps(frames.fps, frames.source)
-    skipped = [f for f in todo if out.done(f)]
-    missing = [f for f in todo if not out.done(f)]
+    made = Made(frames.digest(), opts.width, opts.height, opts.spp, opts.max_depth, opts.seed, fold)
+    claim = out.claim(made, todo)  # frames made by other settings are removed here, or the run refused
+    skipped = [f for f in todo if out.done(f, made)]
+    missing = [f for f in todo if f not in skipped]
     out.prepare()
     written: list[int] = []
     moved = 0
@@ -98,7 +102,8 @@ def render_frames(
             if bar is not None:
                 bar.close()
     out.finish(list(todo), frames.fps, keep_frames=keep_frames)
-    return BatchReport(written=written, skipped=skipped, seconds=time.perf_counter() - t0, bytes_moved=moved)
+    seconds = time.perf_counter() - t0
+    return BatchReport(written, skipped, seconds, moved, replaced=claim.replaced, replaced_why=claim.why)
 
 
 def _jobs(

@@ -153,8 +153,10 @@ def _run(
     n = len(report.written)
     skipped = f", {len(report.skipped)} already there" if report.skipped else ""
     cut = f" in {tiles} tiles each" if tiles > 1 else ""
+    k = len(report.replaced)
+    again = f"; {k} frame{'' if k == 1 else 's'} there rendered again ({report.replaced_why})" if k else ""
     print(
         f"implgen: wrote {n} frame{'' if n == 1 else 's'}{skipped} of {opts.width}x{opts.height}{cut} "
-        f"to {out.target} in {report.seconds:.1f} s ({where})"
+        f"to {out.target} in {report.seconds:.1f} s ({where}){again}"
     )
     return 0

@@ -12,7 +12,9 @@ unit of work of a frame or tile, run in this process or on a Dask worker (scene/
 
 from __future__ import annotations
 
+import hashlib
 import io
+import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -59,6 +61,16 @@ class Frames:
         if frame == 0 or not self.animated:
             return self.first
         return parse_scene(self.data, self.source, frame=frame, memo=self.memo)
+
+    def digest(self) -> str:
+        """What every frame's pixels depend on in the scene: its YAML as read (comments and layout aside;
+        keyed values as written) and the generated code of each shape it uses (spec files, their params and
+        implgen's own code: Spec.spec_key). The resume manifest compares it (frameout.Made)."""
+        h = hashlib.sha256()
+        h.update(json.dumps(self.data, default=repr, separators=(",", ":")).encode())
+        for key in sorted({leaf.spec.spec_key for leaf in self.first.leaves()}):
+            h.update(b"\0" + key.encode())
+        return h.hexdigest()
 
 
 def frames_from_data(data: dict, source: str | Path = "<scene>") -> Frames:
