@@ -19,6 +19,7 @@ import numpy as np
 from implgen.animation import cluster
 from implgen.animation.frameout import FrameOutput, Made
 from implgen.animation.frames import FrameOptions, Frames, decode_png, encode_png, render_frame_png
+from implgen.errors import UserError
 from implgen.scene.build import build_scene
 
 WINDOW_PER_WORKER = 3  # tasks in flight per worker: enough to hide the round trip, little memory
@@ -26,11 +27,13 @@ WINDOW_PER_WORKER = 3  # tasks in flight per worker: enough to hide the round tr
 
 @dataclass
 class Runner:
-    """Where tasks run: `client` None is this process."""
+    """Where tasks run: `client` None is this process. `label` names the option that chose the cluster in
+    messages."""
 
     client: Any = None
     retries: int = 3
     task: Callable[..., bytes] = render_frame_png  # the unit of work; tests wrap it to inject faults
+    label: str = "--cluster"
 
     def workers(self) -> int:
         """Workers the cluster has now (1 for this process)."""
@@ -98,6 +101,14 @@ def render_frames(
                     bar.update(1)
                 if on_written is not None:
                     on_written(f)
+        except cluster.SchedulerLost:
+            n = len(written) + len(skipped)
+            where = getattr(runner.client.scheduler, "address", "")
+            raise UserError(
+                runner.label,
+                f"lost the Dask scheduler{' at ' + where if where else ''} with {n} frames written (kept: "
+                "the same command again renders the rest)",
+            ) from None
         finally:
             if bar is not None:
                 bar.close()

@@ -85,7 +85,8 @@ def main(argv: Sequence[str]) -> int:
     if not distributed:
         return _run(args, frames, todo, opts, out, Runner(retries=args.retries))
     with cluster.connect(args.local_workers, address) as client:
-        return _run(args, frames, todo, opts, out, Runner(client=client, retries=args.retries))
+        label = "--cluster" if address is not None else "--local-workers"
+        return _run(args, frames, todo, opts, out, Runner(client=client, retries=args.retries, label=label))
 
 
 def _options(args: argparse.Namespace, frames: Frames) -> FrameOptions:
