@@ -1,8 +1,9 @@
-"""`--cluster` pointed at things that are not a working Dask scheduler (issue 22, item 6), and Ctrl-C.
+"""`--cluster` pointed at things that are not a working Dask scheduler (issue 22, items 6 and 8).
 
 Every address is on 127.0.0.1: a socket that accepts and says nothing, an HTTP server, a worker of a real
-LocalCluster, a scheduler that goes away in the middle of a run. Each is one line and exit status 2 within
-the timeouts. The command is the installed `implgen`, run as a child process.
+LocalCluster, a scheduler that goes away in the middle of a run, a scheduler with no workers yet. Each is one
+line and exit status 2 within the timeouts, or a run that waits for workers, says so, and uses every worker
+that joins. The command is the installed `implgen`, run as a child process.
 """
 
 from __future__ import annotations
@@ -214,3 +215,119 @@ def test_a_lost_scheduler_is_one_line_and_the_rerun_resumes(tmp_path):
     ran = implgen("render", scene, "-o", out, "--threads", "2", "-q", timeout=120)  # here, without Dask
     assert ran.code == 0 and "already there" in ran.out, ran.err
     assert f"{40 - len(kept)} frames, {len(kept)} already there" in ran.out, ran.out
+
+
+def test_no_workers_yet_is_said_and_workers_that_join_are_used(tmp_path):
+    scene = write_scene(tmp_path)
+    with local_cluster(0) as cl:
+        proc = start("render", scene, "-o", tmp_path / "f%d.png", "--cluster", cl.scheduler_address, "-q")
+        try:
+            lines: list[str] = []
+            reader = threading.Thread(target=lambda: lines.extend(proc.stderr), daemon=True)
+            reader.start()
+            deadline = time.monotonic() + 30
+            while not any("waiting for" in line for line in lines) and time.monotonic() < deadline:
+                assert proc.poll() is None, lines
+                time.sleep(0.05)
+            assert any("waiting for Dask workers" in line for line in lines), lines  # before: silence
+            cl.scale(1)
+            code = proc.wait(timeout=120)
+            reader.join(5)
+        finally:
+            proc.kill()
+    assert code == 0, lines
+    assert len(list(tmp_path.glob("f*.png"))) == 6
+
+
+def _slow_frame(log: str, *args):
+    """The frame task, holding its worker for 0.6 s and noting when: how many ran at once."""
+    import os
+    import time as t
+
+    from implgen.animation.frames import render_frame_png
+
+    t0 = t.time()
+    t.sleep(0.6)
+    with open(Path(log) / f"{os.getpid()}-{t0:.6f}", "w") as fh:
+        fh.write(f"{t0} {t.time()}")
+    return render_frame_png(*args)
+
+
+def test_the_window_grows_with_workers_that_join_later(tmp_path):
+    """One worker at the start gives a window of 3 tasks; three more join: all four are kept busy."""
+    import functools
+
+    from dask.distributed import Client
+
+    from implgen.animation.batch import Runner, render_frames
+    from implgen.animation.frameout import plan_output
+    from implgen.animation.frames import FrameOptions, load_frames
+
+    frames = load_frames(write_scene(tmp_path, frames=24))
+    log = tmp_path / "log"
+    log.mkdir()
+    out = plan_output(tmp_path / "f%d.png", 24, 23, 48, 36)
+    opts = FrameOptions(width=48, height=36, spp=1, max_depth=2, threads=1)
+    with local_cluster(1) as cl, Client(cl) as client:
+        client.wait_for_workers(1, timeout=60)
+        runner = Runner(client=client, task=functools.partial(_slow_frame, str(log)))
+        joined = []
+
+        def grow(f):
+            if f == 0:
+                cl.scale(4)
+                client.wait_for_workers(4, timeout=60)
+                joined.append(time.time())
+
+        render_frames(frames, range(24), opts, out, runner, on_written=grow)
+    spans = [tuple(map(float, p.read_text().split())) for p in log.iterdir()]
+    after = [s for s in spans if s[0] > joined[0] + 1.0]
+    busiest = max(sum(1 for a, b in after if a <= t < b) for t, _ in after)
+    assert busiest == 4, (busiest, sorted(after))  # before: 3, the window fixed when one worker was there
+
+
+class _FakeClient:
+    """Enough of a dask Client for cluster.ordered: workers that come and go, tasks done on demand."""
+
+    status = "running"
+
+    def __init__(self, slots: list[int]):
+        self.slots = slots  # worker threads seen by each successive look
+        self.looks = 0
+        self.in_flight = 0
+        self.most: list[tuple[int, int]] = []  # (threads then, tasks in flight) after each submission
+
+    def nthreads(self):
+        n = self.slots[min(self.looks, len(self.slots) - 1)]
+        self.looks += 1
+        return {f"tcp://127.0.0.1:{i}": 1 for i in range(n)}
+
+    def submit(self, fn, *args, key, retries, pure):
+        client = self
+        self.in_flight += 1
+        self.most.append((self.slots[min(self.looks - 1, len(self.slots) - 1)], self.in_flight))
+
+        class Done:
+            def result(self, timeout=None):
+                client.in_flight -= 1
+                return fn(*args)
+
+            def done(self):
+                return True
+
+            def release(self):
+                pass
+
+            def cancel(self):
+                pass
+
+        return Done()
+
+
+def test_the_window_follows_workers_that_join_and_leave():
+    fake = _FakeClient([1, 1, 4, 4, 4, 4, 2, 2, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1])
+    jobs = [(i, (i,)) for i in range(40)]
+    got = list(cluster.ordered(fake, lambda i: i * i, jobs, retries=0, poll=0.0))
+    assert got == [(i, i * i) for i in range(40)]
+    assert max(n for _, n in fake.most) == 12  # 3 per worker thread while 4 were there
+    assert all(n <= 3 * max(1, threads) for threads, n in fake.most), fake.most

@@ -9,6 +9,7 @@ is an animation of one frame.
 
 from __future__ import annotations
 
+import sys
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -22,32 +23,32 @@ from implgen.animation.frames import FrameOptions, Frames, decode_png, encode_pn
 from implgen.errors import UserError
 from implgen.scene.build import build_scene
 
-WINDOW_PER_WORKER = 3  # tasks in flight per worker: enough to hide the round trip, little memory
+
+def _say(text: str) -> None:
+    print(f"implgen: {text}", file=sys.stderr, flush=True)
 
 
 @dataclass
 class Runner:
     """Where tasks run: `client` None is this process. `label` names the option that chose the cluster in
-    messages."""
+    messages; `say` is told what the run waits for (no workers yet)."""
 
     client: Any = None
     retries: int = 3
     task: Callable[..., bytes] = render_frame_png  # the unit of work; tests wrap it to inject faults
     label: str = "--cluster"
+    say: Callable[[str], None] = _say
 
     def workers(self) -> int:
         """Workers the cluster has now (1 for this process)."""
         if self.client is None:
             return 1
-        return len(self.client.scheduler_info(n_workers=-1).get("workers", {})) or 1
-
-    def window(self) -> int:
-        return 1 if self.client is None else WINDOW_PER_WORKER * self.workers()
+        return len(self.client.nthreads())
 
     def results(self, jobs: Iterator[tuple[Any, tuple]], name: str) -> Iterator[tuple[Any, bytes]]:
         if self.client is None:
             return cluster.serial(self.task, jobs)
-        return cluster.ordered(self.client, self.task, jobs, window=self.window(), retries=self.retries, name=name)
+        return cluster.ordered(self.client, self.task, jobs, retries=self.retries, name=name, say=self.say)
 
 
 @dataclass

@@ -9,12 +9,14 @@ HANDSHAKE_TIMEOUT. Dask's own connect waits for the handshake without a limit, s
 held the command for good, an HTTP server's answer read as a frame length asked NumPy for exabytes, and a
 worker's address failed deep in the Client. Each is now one line naming --cluster.
 
-`ordered(client, fn, jobs, ...)` submits one task per job, at most `window` at a time, and yields the results
-in the jobs' order, so the caller can write frames in order while later ones still render. Each task has
-Dask's `retries`: a task that raises is run again; a task whose worker dies (a crash, a kill, a lost
-machine) is rescheduled by the scheduler on another worker. A scheduler lost mid-run is SchedulerLost,
-which the caller turns into one line; the frames already written stay. Workers need implgen and a C
-compiler installed; they build each scene's library through their own content-hash cache (docs/animation.md).
+`ordered(client, fn, jobs, ...)` submits one task per job and yields the results in the jobs' order, so the
+caller can write frames in order while later ones still render. The tasks in flight follow the workers:
+PER_THREAD per worker thread the scheduler has now, looked up again while results come in, so workers that
+join later are used, and with none (yet, or any more) the caller is told it waits. Each task has Dask's
+`retries`: a task that raises is run again; a task whose worker dies (a crash, a kill, a lost machine) is
+rescheduled by the scheduler on another worker. A scheduler lost mid-run is SchedulerLost, which the caller
+turns into one line; the frames already written stay. Workers need implgen and a C compiler installed; they
+build each scene's library through their own content-hash cache (docs/animation.md).
 """
 
 from __future__ import annotations
@@ -35,6 +37,8 @@ MAX_LOCAL_WORKERS = 256
 CONNECT_TIMEOUT = 20  # seconds to reach a scheduler's port given with --cluster
 HANDSHAKE_TIMEOUT = 10  # seconds, once reached, for Dask's handshake and the answer to `identity`
 CLOSE_TIMEOUT = 2  # seconds a client is given to close (a lost scheduler cannot answer)
+PER_THREAD = 3  # tasks in flight per worker thread: enough to hide the round trip, little memory
+POLL = 0.5  # seconds between looks at the workers while a result is awaited
 _ADDRESS = re.compile(r"^(tcp|tls)://[A-Za-z0-9.\-\[\]:]+:[0-9]{1,5}$")
 
 
@@ -190,52 +194,85 @@ def tag_of(index: Any) -> str:
     return "-".join(map(str, index)) if isinstance(index, tuple) else str(index)
 
 
+def slots(client: Any) -> int:
+    """Worker threads the scheduler has now (0 while no worker is connected)."""
+    return sum(client.nthreads().values())
+
+
 def ordered(
     client: Any,
     fn: Callable[..., Any],
     jobs: Iterable[tuple[Any, tuple]],
     *,
-    window: int,
     retries: int,
     name: str = "implgen",
+    per_thread: int = PER_THREAD,
+    window: int | None = None,
+    poll: float = POLL,
+    say: Callable[[str], None] | None = None,
 ) -> Iterator[tuple[Any, Any]]:
-    """Run fn(*args) for each (index, args) of `jobs` on the cluster; yield (index, result) in job order
-    with at most `window` tasks submitted and not yet yielded. A lost scheduler raises SchedulerLost."""
+    """Run fn(*args) for each (index, args) of `jobs` on the cluster; yield (index, result) in job order,
+    with at most `per_thread` tasks submitted and not yet yielded per worker thread the scheduler has (at
+    least `per_thread`), or a fixed `window` of them when given (the benchmark's). The workers are looked up
+    again at most every `poll` seconds while results come in or are awaited; `say` is told when there are
+    none. A lost scheduler raises SchedulerLost."""
     from distributed import KilledWorker
     from distributed.client import FutureCancelledError
 
     run = secrets.token_hex(4)
     todo = iter(jobs)
     pending: deque = deque()
+    more = True
+    threads, looked = slots(client), time.monotonic()
+    idle = 1 if threads == 0 else 0  # looks in a row that found no worker
 
-    def submit_one() -> bool:
-        job = next(todo, None)
-        if job is None:
-            return False
-        index, args = job
-        fut = client.submit(fn, *args, key=f"{name}-{run}-{tag_of(index)}", retries=retries, pure=False)
-        pending.append((index, fut))
-        return True
+    def look() -> None:
+        nonlocal threads, looked, idle
+        if time.monotonic() - looked < poll:
+            return
+        if client.status != "running":  # reconnecting, or closed: the scheduler is gone
+            raise SchedulerLost(client.status)
+        threads, looked = slots(client), time.monotonic()
+        idle = idle + 1 if threads == 0 else 0
+        if idle == 2 and say is not None:  # twice in a row: not workers and scheduler closing one after the other
+            say("waiting for Dask workers: none is connected to the scheduler")
 
     try:
-        while len(pending) < max(1, window) and submit_one():
-            pass
-        while pending:
-            index, fut = pending.popleft()
+        while True:
+            while more and len(pending) < (window or per_thread * max(1, threads)):
+                job = next(todo, None)
+                if job is None:
+                    more = False
+                    break
+                index, args = job
+                fut = client.submit(fn, *args, key=f"{name}-{run}-{tag_of(index)}", retries=retries, pure=False)
+                pending.append((index, fut))
+            if not pending:
+                return
+            index, fut = pending[0]
+            was_done = fut.done()
             try:
-                result = fut.result()
+                result = fut.result(timeout=None if was_done else poll)
+            except TimeoutError:
+                if was_done:  # the task's own error
+                    raise
+                look()  # the wait's: not done yet (or done just now: the next call returns at once)
+                continue
             except KilledWorker:  # every retry lost its worker: one line, not Dask's traceback
                 raise UserError(
                     "render", f"task {tag_of(index)} lost its worker more often than the scheduler allows"
                 ) from None
             except FutureCancelledError as err:
                 if err.reason == "scheduler-connection-lost" or client.status != "running":
-                    pending.clear()  # gone with the scheduler: nothing to cancel
                     raise SchedulerLost(err.reason) from None
                 raise
+            pending.popleft()
             fut.release()
-            submit_one()
+            look()
             yield index, result
+    except SchedulerLost:
+        pending.clear()  # gone with the scheduler: nothing to cancel
+        raise
     finally:
         for _, fut in pending:
             fut.cancel()

@@ -138,7 +138,6 @@ def _still(args: argparse.Namespace, frames: Frames, frame: int, opts: FrameOpti
 def _run(
     args: argparse.Namespace, frames: Frames, todo: range, opts: FrameOptions, out: FrameOutput, runner: Runner
 ) -> int:
-    where = "this process" if runner.client is None else f"{runner.workers()} Dask workers"
     tiles = args.tiles or 1
     report = render_frames(
         frames,
@@ -151,6 +150,7 @@ def _run(
         progress=not args.quiet,
         keep_frames=args.keep_frames,
     )
+    where = "this process" if runner.client is None else f"{runner.workers()} Dask workers"  # those there now
     n = len(report.written)
     skipped = f", {len(report.skipped)} already there" if report.skipped else ""
     cut = f" in {tiles} tiles each" if tiles > 1 else ""
