@@ -184,3 +184,13 @@ def test_every_frame_is_on_the_disk_before_its_rename(tmp_path, monkeypatch):
     for i in renames:
         src = events[i][1]
         assert ("fsync", src) in events[:i], (src, events[:i])
+
+
+def test_a_pattern_name_near_the_limit_still_gets_a_manifest(tmp_path):
+    """The manifest's name adds 14 bytes to the pattern's: past 255, it takes a short hashed name instead."""
+    scene = write_scene(tmp_path)
+    out = tmp_path / ("a" * 240 + "%04d.png")
+    ok(scene, "-o", out)
+    manifests = [p.name for p in tmp_path.glob(".implgen-*.json")]
+    assert len(manifests) == 1 and len(list(tmp_path.glob("a*.png"))) == FRAMES
+    assert "wrote 0 frames, 6 already there" in ok(scene, "-o", out)

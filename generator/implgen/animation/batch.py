@@ -95,7 +95,10 @@ def render_frames(
             rows = [None] if tiles == 1 else bands(opts.height, tiles)
             results = runner.results(_jobs(frames, missing, rows, opts, runner, fold), name="frame")
             for f, png, nbytes in _assembled(results, len(rows)):
-                out.write(f, png)
+                try:
+                    out.write(f, png)
+                except OSError as err:  # a full disk, a folder removed meanwhile: one line, frames so far kept
+                    raise UserError(f"-o {out.target}", f"cannot write frame {f}: {err.strerror or err}") from None
                 written.append(f)
                 moved += nbytes
                 if bar is not None:

@@ -22,6 +22,7 @@ simply removed.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import re
@@ -148,7 +149,10 @@ class FrameOutput:
         """The record of what made the frames (None for a still, which is never resumed)."""
         if self.kind == "still":
             return None
-        return self.folder / f".{self.target.name}.implgen.json"
+        name = f".{self.target.name}.implgen.json"
+        if len(os.fsencode(name)) > 255:  # a pattern's name near the file system's limit: a short name instead
+            name = f".implgen-{hashlib.sha256(os.fsencode(self.target.name)).hexdigest()[:16]}.json"
+        return self.folder / name
 
     def done(self, frame: int, made: Made) -> bool:
         """A frame is complete when its file exists (files appear only by an atomic rename, after claim() has
@@ -197,7 +201,10 @@ class FrameOutput:
         for path in stale.values():
             path.unlink(missing_ok=True)
         data = json.dumps(made.record(), indent=1).encode() + b"\n"
-        atomic_write(manifest, lambda fh: _write_synced(fh, data))
+        try:
+            atomic_write(manifest, lambda fh: _write_synced(fh, data))
+        except OSError as err:  # what the early checks could not foresee: a full disk, a folder removed
+            raise UserError(f"{option} {self.target}", f"cannot write {manifest}: {err.strerror or err}") from None
         _sync_folder(self.folder)
         return Claim(sorted(f for f in stale if f in wanted), why if stale else "")
 

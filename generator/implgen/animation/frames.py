@@ -67,7 +67,11 @@ class Frames:
         keyed values as written) and the generated code of each shape it uses (spec files, their params and
         implgen's own code: Spec.spec_key). The resume manifest compares it (frameout.Made)."""
         h = hashlib.sha256()
-        h.update(json.dumps(self.data, default=repr, separators=(",", ":")).encode())
+        try:
+            text = json.dumps(self.data, default=repr, separators=(",", ":"))
+        except (TypeError, ValueError):  # a key JSON cannot write (a validated scene has none)
+            text = repr(self.data)
+        h.update(text.encode())
         for key in sorted({leaf.spec.spec_key for leaf in self.first.leaves()}):
             h.update(b"\0" + key.encode())
         return h.hexdigest()
