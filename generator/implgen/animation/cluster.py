@@ -195,8 +195,12 @@ def tag_of(index: Any) -> str:
 
 
 def slots(client: Any) -> int:
-    """Worker threads the scheduler has now (0 while no worker is connected)."""
-    return sum(client.nthreads().values())
+    """Worker threads the scheduler has now (0 while no worker is connected). A scheduler that cannot be
+    asked (the connection is closed or refused) is lost."""
+    try:
+        return sum(client.nthreads().values())
+    except OSError as err:  # CommClosedError is one
+        raise SchedulerLost(type(err).__name__) from None
 
 
 def ordered(
@@ -223,8 +227,7 @@ def ordered(
     todo = iter(jobs)
     pending: deque = deque()
     more = True
-    threads, looked = slots(client), time.monotonic()
-    idle = 1 if threads == 0 else 0  # looks in a row that found no worker
+    idle = 0  # looks in a row that found no worker
 
     def look() -> None:
         nonlocal threads, looked, idle
@@ -234,10 +237,12 @@ def ordered(
             raise SchedulerLost(client.status)
         threads, looked = slots(client), time.monotonic()
         idle = idle + 1 if threads == 0 else 0
-        if idle == 2 and say is not None:  # twice in a row: not workers and scheduler closing one after the other
+        if idle == 2 and say is not None:  # twice in a row: a closing cluster (workers first) does not say it
             say("waiting for Dask workers: none is connected to the scheduler")
 
     try:
+        threads, looked = slots(client), time.monotonic()
+        idle = 1 if threads == 0 else 0
         while True:
             while more and len(pending) < (window or per_thread * max(1, threads)):
                 job = next(todo, None)
