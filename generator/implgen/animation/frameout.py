@@ -169,7 +169,7 @@ class FrameOutput:
         found = {}
         for entry in os.scandir(self.folder):
             m = pattern.match(entry.name)
-            if m and self.name_format.format(int(m.group(1))) == entry.name:
+            if m and self.name_format.format(int(m.group(1))) == entry.name and not entry.is_dir():
                 found[int(m.group(1))] = Path(entry.path)
         return found
 
@@ -198,13 +198,14 @@ class FrameOutput:
                 f"outside the frames asked for (first {outside[0]}): remove them, render them all again "
                 "(--frames), or choose another output, so that the set is not mixed",
             )
-        for path in stale.values():
-            path.unlink(missing_ok=True)
         data = json.dumps(made.record(), indent=1).encode() + b"\n"
         try:
+            for path in stale.values():
+                path.unlink(missing_ok=True)
             atomic_write(manifest, lambda fh: _write_synced(fh, data))
         except OSError as err:  # what the early checks could not foresee: a full disk, a folder removed
-            raise UserError(f"{option} {self.target}", f"cannot write {manifest}: {err.strerror or err}") from None
+            name = err.filename or manifest
+            raise UserError(f"{option} {self.target}", f"cannot replace {name}: {err.strerror or err}") from None
         _sync_folder(self.folder)
         return Claim(sorted(f for f in stale if f in wanted), why if stale else "")
 
