@@ -70,6 +70,31 @@ def silent_port() -> Iterator[tuple[int, list]]:
 
 
 @contextmanager
+def answers_http() -> Iterator[int]:
+    """A port that answers whatever comes with an HTTP error and closes, as many web servers and proxies do
+    with bytes that are not a request. Read as a Dask frame header, "HTTP/1.1" is a length of 3.07 EiB."""
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(16)
+
+    def serve():
+        while True:
+            try:
+                conn, _ = server.accept()
+            except OSError:
+                return
+            with conn:
+                conn.recv(65536)
+                conn.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\nConnection: close\r\n\r\n")
+
+    threading.Thread(target=serve, daemon=True).start()
+    try:
+        yield server.getsockname()[1]
+    finally:
+        server.close()
+
+
+@contextmanager
 def http_server() -> Iterator[int]:
     class Quiet(http.server.SimpleHTTPRequestHandler):
         def log_message(self, *args):
@@ -115,8 +140,18 @@ def test_an_http_server_is_one_line(tmp_path):
     scene = write_scene(tmp_path)
     with http_server() as port:
         ran = implgen("render", scene, "-o", tmp_path / "f%d.png", "--cluster", f"127.0.0.1:{port}", timeout=60)
-    assert_one_line(ran, f"--cluster: tcp://127.0.0.1:{port}", "not a Dask scheduler")  # before: a MemoryError
+    # http.server waits for a request line, which Dask's handshake does not hold: as silent as a silent port
+    assert_one_line(ran, f"--cluster: tcp://127.0.0.1:{port}", "not a Dask scheduler")
     assert ran.seconds < REFUSED_WITHIN, ran.seconds
+
+
+def test_an_http_answer_is_one_line_at_once(tmp_path):
+    scene = write_scene(tmp_path)
+    with answers_http() as port:
+        ran = implgen("render", scene, "-o", tmp_path / "f%d.png", "--cluster", f"127.0.0.1:{port}", timeout=60)
+    # before: MemoryError, "Unable to allocate 3.07 EiB", a traceback
+    assert_one_line(ran, f"--cluster: tcp://127.0.0.1:{port}: not a Dask scheduler (the answer is not Dask's")
+    assert ran.seconds < REFUSED_WITHIN - cluster.HANDSHAKE_TIMEOUT, ran.seconds  # no timeout waited for
 
 
 def test_a_workers_address_is_one_line(tmp_path):
