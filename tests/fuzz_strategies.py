@@ -162,6 +162,22 @@ def _deep_map(n: int) -> Any:
     return value
 
 
+def _deep_csg(n: int, bottom: Any = None) -> Any:
+    """CSG nested n levels as written, two containers a level: {union: [{union: [bottom, y], ...}, y]}."""
+    node = {"equation": "x^2 + y^2 + z^2 - 1"} if bottom is None else bottom
+    for _ in range(n):
+        node = {"union": [node, {"equation": "y"}]}
+    return node
+
+
+# How deep hostile nesting goes, in containers (lists and mappings): past every walk's bound (scene/keys.py
+# MAX_NESTING = 100) and into the band where an unbounded walk of two Python frames per container overflows
+# Python's recursion limit while the YAML reader (which refuses ~500 levels by itself) still takes the file:
+# about 320-460 containers, whether the reader runs from the command line or under pytest and Hypothesis.
+# Hypothesis favours the first of a sampled list: the band comes first.
+DEEP_LEVELS = [400, 340, 440, 380, 460, 200, 120, 60]
+
+
 HOSTILE_VALUES = [
     10**400,
     None,
@@ -206,6 +222,9 @@ HOSTILE_VALUES = [
     _deep_list(60),
     _deep_list(400),
     _deep_map(60),
+    _deep_map(300),
+    _deep_csg(40),
+    _deep_csg(190),
     *HOSTILE_TEXT,
 ]
 
@@ -311,7 +330,20 @@ def _container(doc: Any, path: tuple) -> Any:
     return doc
 
 
-BREAKS = ["keep", "replace", "replace", "replace", "equation", "delete", "add_key", "rename", "repeat", "share", "wrap"]
+BREAKS = [
+    "keep",
+    "replace",
+    "replace",
+    "replace",
+    "equation",
+    "delete",
+    "add_key",
+    "rename",
+    "repeat",
+    "share",
+    "wrap",
+    "nest",
+]
 
 
 @st.composite
@@ -342,6 +374,9 @@ def broken(draw: st.DrawFn, documents: st.SearchStrategy[Any]) -> tuple[str, Any
         box[draw(st.sampled_from(["Equation", "nmae", "param", "bound", " name", "name\x00"]))] = box.pop(key)
     elif how == "repeat" and isinstance(box[key], list) and box[key]:
         box[key] = box[key] * draw(st.sampled_from([2, 300, 1100, 12000]))
+    elif how == "nest":
+        # the value itself, nested hundreds of levels deep: in lists, in mappings, or as CSG around it
+        box[key] = draw(nested(st.just(box[key])))
     elif how == "share":
         # the same node reused twice per level, n levels: an alias bomb once dumped as YAML
         node = box[key]
@@ -349,6 +384,41 @@ def broken(draw: st.DrawFn, documents: st.SearchStrategy[Any]) -> tuple[str, Any
             node = {"union": [node, node]} if draw(st.booleans()) else [node, node]
         box[key] = node
     return how, doc
+
+
+@st.composite
+def nested(draw: st.DrawFn, values: st.SearchStrategy[Any]) -> Any:
+    """A value wrapped DEEP_LEVELS deep: in lists, in mappings, in CSG operations (the value as their leaves)."""
+    value = copy.deepcopy(draw(values))
+    n = draw(st.sampled_from(DEEP_LEVELS))
+    how = draw(st.sampled_from(["csg", "list", "mixed", "map"]))
+    for i in range(n if how != "csg" else 0):
+        if how == "list" or (how == "mixed" and i % 2):
+            value = [value]
+        else:
+            value = {draw(st.sampled_from(["union", "transform", "keys", "a"])) if how == "mixed" else "union": value}
+    return _deep_csg(n // 2, value) if how == "csg" else value
+
+
+@st.composite
+def deep_scenes(draw: st.DrawFn) -> dict:
+    """A valid scene (animated or not) with one object nested deep: hundreds of levels of CSG, lists or
+    mappings around the object, or in its transform (after a keyed param, so the transform is resolved); or
+    valid CSG up to the reader's limit of 32 levels."""
+    doc = copy.deepcopy(draw(scenes()))
+    objects = doc["objects"]
+    i = draw(st.integers(0, len(objects) - 1))
+    how = draw(st.sampled_from(["object", "transform", "valid"]))
+    if how == "object":
+        objects[i] = draw(nested(st.sampled_from([objects[i], {"keys": {0: 1.0}}, [1.0, 2.0, 3.0]])))
+    elif how == "transform":
+        frames = doc.get("animation", {}).get("frames", 2)
+        keyed = {"keys": {0: 1.0, frames - 1: 0.5}} if "animation" in doc else 1.0
+        transform = draw(nested(st.sampled_from([{"scale": 1.0}, [1.0, 1.0, 1.0], 1.0])))
+        objects[i] = {"shape": str(SHAPES / "sphere.yaml"), "params": {"r": keyed}, "transform": transform}
+    else:
+        objects[i] = _deep_csg(draw(st.integers(1, 31)), objects[i])  # deep, and valid
+    return doc
 
 
 # Values no key of a spec or scene accepts, wherever they are put: a document holding one must be refused.

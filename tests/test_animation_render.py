@@ -66,7 +66,7 @@ def test_frames_differ_and_each_equals_the_frame_rendered_alone(tmp_path, anim, 
     assert cli_main(["render", str(anim), "-o", str(tmp_path / "f_%03d.png"), "-q"]) == 0
     assert "wrote 6 frames of 48x36" in capsys.readouterr().out
     names = sorted(p.name for p in tmp_path.iterdir())
-    assert names == [f"f_{i:03d}.png" for i in range(FRAMES)]
+    assert names == [".f_%03d.png.implgen.json"] + [f"f_{i:03d}.png" for i in range(FRAMES)]  # and the manifest
     for f in range(FRAMES):
         assert np.array_equal(read(tmp_path / f"f_{f:03d}.png"), alone[f]), f
     assert all(not np.array_equal(alone[f], alone[f + 1]) for f in range(FRAMES - 1))  # it moves
@@ -74,7 +74,7 @@ def test_frames_differ_and_each_equals_the_frame_rendered_alone(tmp_path, anim, 
 
 def test_a_range_and_a_single_frame(tmp_path, anim, alone):
     assert cli_main(["render", str(anim), "-o", str(tmp_path / "f%d.png"), "--frames", "2:3", "-q"]) == 0
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["f2.png", "f3.png"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".f%d.png.implgen.json", "f2.png", "f3.png"]
     assert np.array_equal(read(tmp_path / "f3.png"), alone[3])
     assert cli_main(["render", str(anim), "-o", str(tmp_path / "one.png"), "--frames", "4", "-q"]) == 0
     assert np.array_equal(read(tmp_path / "one.png"), alone[4])
@@ -127,7 +127,7 @@ def test_a_gif_has_every_frame_and_the_fps(tmp_path, anim, alone):
         picture = np.asarray(im.convert("RGB")).astype(int)
     assert np.abs(picture - alone[2]).mean() < 6  # 256 colours
     kept = sorted(p.name for p in (tmp_path / "loop.gif.frames").iterdir())
-    assert kept == [f"{i:04d}.png" for i in range(FRAMES)]
+    assert kept == [".loop.gif.implgen.json"] + [f"{i:04d}.png" for i in range(FRAMES)]
 
 
 def test_a_video_resumes_from_its_sidecar_frames(tmp_path, anim, capsys):
@@ -136,7 +136,7 @@ def test_a_video_resumes_from_its_sidecar_frames(tmp_path, anim, capsys):
     assert cli_main(["render", str(anim), "-o", str(out), "-q", "--frames", "0:3", "--keep-frames"]) == 0
     out.unlink()  # as if the run had died before encoding
     capsys.readouterr()
-    mtimes = {p.name: p.stat().st_mtime_ns for p in sidecar.iterdir()}
+    mtimes = {p.name: p.stat().st_mtime_ns for p in sidecar.glob("*.png")}
     assert cli_main(["render", str(anim), "-o", str(out), "-q"]) == 0
     assert "wrote 2 frames, 4 already there" in capsys.readouterr().out
     assert len(list(iio.imiter(out))) == FRAMES and not sidecar.exists()
@@ -151,7 +151,7 @@ def test_frames_share_one_library(tmp_path, anim, monkeypatch):
     real = batch.build_scene
     monkeypatch.setattr(batch, "build_scene", lambda *a, **k: calls.append(1) or real(*a, **k))
     assert cli_main(["render", str(anim), "-o", str(tmp_path / "f%d.png"), "-q"]) == 0
-    assert len(calls) == 1 and len(list(tmp_path.iterdir())) == FRAMES
+    assert len(calls) == 1 and len(list(tmp_path.glob("*.png"))) == FRAMES
 
 
 def test_the_example_animation_is_valid_on_every_frame():

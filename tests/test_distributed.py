@@ -76,7 +76,8 @@ def test_every_frame_from_the_workers_equals_the_frame_rendered_alone(tmp_path, 
         assert np.array_equal(read(out.path(f)), alone[f]), f
     # and the bytes are those of the same frame encoded here: nothing but the PNG crossed the wire
     here = render_frame_png(frames.scene(3), opts_of(frames))
-    assert out.path(3).read_bytes() == here and report.bytes_moved == sum(p.stat().st_size for p in tmp_path.iterdir())
+    assert out.path(3).read_bytes() == here
+    assert report.bytes_moved == sum(p.stat().st_size for p in tmp_path.glob("*.png"))
 
 
 def _dies_once(marker: str, *args):
@@ -113,7 +114,7 @@ def test_a_worker_killed_mid_task_still_ends_with_every_frame(tmp_path, client, 
     assert killed in pids_before
     assert report.written == list(range(FRAMES))
     names = sorted(p.name for p in (tmp_path / "out").iterdir())
-    assert names == [f"f_{f:02d}.png" for f in range(FRAMES)]  # no temporary file left behind
+    assert names == [".f_%02d.png.implgen.json"] + [f"f_{f:02d}.png" for f in range(FRAMES)]  # no temporary file
     for f in range(FRAMES):
         assert np.array_equal(read(out.path(f)), alone[f]), f
     client.wait_for_workers(2, timeout=120)  # the nanny started a new worker process in its place
@@ -231,4 +232,5 @@ def test_a_task_that_keeps_killing_workers_ends_in_one_line(tmp_path, frames):
         finally:
             cluster.close()
     assert "lost its worker" in str(err.value) and "\n" not in str(err.value)
-    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+    assert not list((tmp_path / "out").glob("*.png"))  # no frame, not even a temporary one
+    assert not list((tmp_path / "out").glob(".ig-*"))

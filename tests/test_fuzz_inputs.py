@@ -19,6 +19,7 @@ import io
 import os
 import shutil
 import signal
+import sys
 from pathlib import Path
 
 import pytest
@@ -32,6 +33,7 @@ from fuzz_strategies import (
     SHAPES,
     bad_equations,
     broken,
+    deep_scenes,
     example_files,
     expressions,
     mutated,
@@ -68,9 +70,31 @@ def time_limit(seconds: float = TIME_LIMIT):
         signal.signal(signal.SIGALRM, old)
 
 
+def _stack_depth() -> int:
+    frame, n = sys._getframe(1), 0
+    while frame is not None:
+        frame, n = frame.f_back, n + 1
+    return n
+
+
+@contextlib.contextmanager
+def command_line_stack(frames_above_main: int = 10):
+    """Python's recursion limit as the code under test has it under `implgen` from a shell: the default
+    limit, less the few frames from the interpreter to cli.main. Hypothesis raises the limit by up to 2,000
+    frames while a test runs, which would hide a walk that overflows on the command line (docs: issue 22,
+    200 levels of CSG); this puts it back for the duration of the call."""
+    limit = sys.getrecursionlimit()
+    sys.setrecursionlimit(_stack_depth() + 1000 - frames_above_main)
+    try:
+        yield
+    finally:
+        sys.setrecursionlimit(limit)
+
+
 def outcome(load, *args):
-    """(value, None) on success, (None, message) for a UserError; anything else propagates and fails."""
-    with time_limit():
+    """(value, None) on success, (None, message) for a UserError; anything else propagates and fails. The load
+    runs with the recursion room it has on the command line (command_line_stack)."""
+    with time_limit(), command_line_stack():
         try:
             value = load(*args)
             event("accepted")
@@ -93,8 +117,16 @@ def work(tmp_path_factory) -> Path:
     return root
 
 
-def dump(doc) -> str:
-    return yaml.safe_dump(doc, allow_unicode=True, sort_keys=False, width=10_000)
+def dump(doc, flow: bool | None = None) -> str:
+    """YAML text of a document. PyYAML's writer recurses a few frames per level, so documents nested hundreds
+    of levels deep (fuzz_strategies.DEEP_LEVELS) are written with room to recurse; the code under test runs
+    with the usual limit."""
+    limit = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(limit, 20_000))
+    try:
+        return yaml.safe_dump(doc, allow_unicode=True, sort_keys=False, width=10_000, default_flow_style=flow)
+    finally:
+        sys.setrecursionlimit(limit)
 
 
 def run_cli(argv: list[str]) -> tuple[int, str, str]:
@@ -218,6 +250,19 @@ def test_scene_loader_broken_scenes(work, case):
     how, doc = case
     path = work / "scenes" / "scene.yaml"
     path.write_text(dump(doc), encoding="utf-8")
+    scene, message = outcome(load_frames, path)
+    if scene is None:
+        assert message.startswith(f"{path}: "), message
+        _refusal_through_cli(work, path)
+
+
+@fuzz_settings(60)
+@given(deep_scenes(), st.booleans())
+def test_scene_loader_deep_scenes(work, case, flow):
+    """Objects nested deep (valid up to the CSG limit, then hundreds of levels of CSG, lists or mappings), in
+    block or flow style: loaded, or refused in one line naming the file; never a RecursionError."""
+    path = work / "scenes" / "deep.yaml"
+    path.write_text(dump(case, flow=flow or None), encoding="utf-8")
     scene, message = outcome(load_frames, path)
     if scene is None:
         assert message.startswith(f"{path}: "), message

@@ -9,43 +9,47 @@ is an animation of one frame.
 
 from __future__ import annotations
 
+import sys
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from implgen.animation import cluster
-from implgen.animation.frameout import FrameOutput
+from implgen.animation.frameout import FrameOutput, Made
 from implgen.animation.frames import FrameOptions, Frames, render_frame_png
+from implgen.errors import UserError
 from implgen.imagefile import decode_png, encode_png
 from implgen.scene.build import build_scene
 
-WINDOW_PER_WORKER = 3  # tasks in flight per worker: enough to hide the round trip, little memory
+
+def _say(text: str) -> None:
+    print(f"implgen: {text}", file=sys.stderr, flush=True)
 
 
 @dataclass
 class Runner:
-    """Where tasks run: `client` None is this process."""
+    """Where tasks run: `client` None is this process. `label` names the option that chose the cluster in
+    messages; `say` is told what the run waits for (no workers yet)."""
 
     client: Any = None
     retries: int = 3
     task: Callable[..., bytes] = render_frame_png  # the unit of work; tests wrap it to inject faults
+    label: str = "--cluster"
+    say: Callable[[str], None] = _say
 
     def workers(self) -> int:
         """Workers the cluster has now (1 for this process)."""
         if self.client is None:
             return 1
-        return len(self.client.scheduler_info(n_workers=-1).get("workers", {})) or 1
-
-    def window(self) -> int:
-        return 1 if self.client is None else WINDOW_PER_WORKER * self.workers()
+        return len(self.client.nthreads())
 
     def results(self, jobs: Iterator[tuple[Any, tuple]], name: str) -> Iterator[tuple[Any, bytes]]:
         if self.client is None:
             return cluster.serial(self.task, jobs)
-        return cluster.ordered(self.client, self.task, jobs, window=self.window(), retries=self.retries, name=name)
+        return cluster.ordered(self.client, self.task, jobs, retries=self.retries, name=name, say=self.say)
 
 
 @dataclass
@@ -54,6 +58,8 @@ class BatchReport:
     skipped: list[int]
     seconds: float
     bytes_moved: int  # PNG bytes that came back from the tasks
+    replaced: list[int] = field(default_factory=list)  # frames there, made otherwise: rendered again
+    replaced_why: str = ""
 
 
 def render_frames(
@@ -72,8 +78,11 @@ def render_frames(
     """Render the frames of `todo` whose output is missing, each as one task or as `tiles` bands of rows,
     write them in order, then finish the output (encode a video or GIF from all frames of `todo`)."""
     t0 = time.perf_counter()
-    skipped = [f for f in todo if out.done(f)]
-    missing = [f for f in todo if not out.done(f)]
+    out.check_fps(frames.fps, frames.source)
+    made = Made(frames.digest(), opts.width, opts.height, opts.spp, opts.max_depth, opts.seed, fold)
+    claim = out.claim(made, todo)  # frames made by other settings are removed here, or the run refused
+    skipped = [f for f in todo if out.done(f, made)]
+    missing = [f for f in todo if f not in skipped]
     out.prepare()
     written: list[int] = []
     moved = 0
@@ -87,18 +96,30 @@ def render_frames(
             rows = [None] if tiles == 1 else bands(opts.height, tiles)
             results = runner.results(_jobs(frames, missing, rows, opts, runner, fold), name="frame")
             for f, png, nbytes in _assembled(results, len(rows)):
-                out.write(f, png)
+                try:
+                    out.write(f, png)
+                except OSError as err:  # a full disk, a folder removed meanwhile: one line, frames so far kept
+                    raise UserError(f"-o {out.target}", f"cannot write frame {f}: {err.strerror or err}") from None
                 written.append(f)
                 moved += nbytes
                 if bar is not None:
                     bar.update(1)
                 if on_written is not None:
                     on_written(f)
+        except cluster.SchedulerLost:
+            n = len(written) + len(skipped)
+            where = getattr(runner.client.scheduler, "address", "")
+            raise UserError(
+                runner.label,
+                f"lost the Dask scheduler{' at ' + where if where else ''} with {n} frames written (kept: "
+                "the same command again renders the rest)",
+            ) from None
         finally:
             if bar is not None:
                 bar.close()
     out.finish(list(todo), frames.fps, keep_frames=keep_frames)
-    return BatchReport(written=written, skipped=skipped, seconds=time.perf_counter() - t0, bytes_moved=moved)
+    seconds = time.perf_counter() - t0
+    return BatchReport(written, skipped, seconds, moved, replaced=claim.replaced, replaced_why=claim.why)
 
 
 def _jobs(

@@ -95,6 +95,7 @@ def main(argv: Sequence[str]) -> int:
     todo = parse_range(args.frames, frames.count) if args.frames is not None else range(frames.count)
     opts = _options(args, frames)
     out = plan_output(args.output, len(todo), todo[-1], opts.width, opts.height)
+    out.check_fps(frames.fps, frames.source)
     if args.fold and frames.params_vary:
         raise UserError("--fold", "the scene's shape params change from frame to frame; they cannot be folded")
     if args.tiles is not None:
@@ -107,7 +108,8 @@ def main(argv: Sequence[str]) -> int:
     if not distributed:
         return _run(args, frames, todo, opts, out, Runner(retries=args.retries))
     with cluster.connect(args.local_workers, address) as client:
-        return _run(args, frames, todo, opts, out, Runner(client=client, retries=args.retries))
+        label = "--cluster" if address is not None else "--local-workers"
+        return _run(args, frames, todo, opts, out, Runner(client=client, retries=args.retries, label=label))
 
 
 def _options(args: argparse.Namespace, frames: Frames) -> FrameOptions:
@@ -152,7 +154,6 @@ def _still(args: argparse.Namespace, frames: Frames, frame: int, opts: FrameOpti
 def _run(
     args: argparse.Namespace, frames: Frames, todo: range, opts: FrameOptions, out: FrameOutput, runner: Runner
 ) -> int:
-    where = "this process" if runner.client is None else f"{runner.workers()} Dask workers"
     tiles = args.tiles or 1
     report = render_frames(
         frames,
@@ -165,11 +166,14 @@ def _run(
         progress=not args.quiet,
         keep_frames=args.keep_frames,
     )
+    where = "this process" if runner.client is None else f"{runner.workers()} Dask workers"  # those there now
     n = len(report.written)
     skipped = f", {len(report.skipped)} already there" if report.skipped else ""
     cut = f" in {tiles} tiles each" if tiles > 1 else ""
+    k = len(report.replaced)
+    again = f"; {k} frame{'' if k == 1 else 's'} there rendered again ({report.replaced_why})" if k else ""
     print(
         f"implgen: wrote {n} frame{'' if n == 1 else 's'}{skipped} of {opts.width}x{opts.height}{cut} "
-        f"to {out.target} in {report.seconds:.1f} s ({where})"
+        f"to {out.target} in {report.seconds:.1f} s ({where}){again}"
     )
     return 0

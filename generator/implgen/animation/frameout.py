@@ -5,21 +5,33 @@
     -o film.mp4 | .webm       H.264 / VP9 through imageio-ffmpeg (its wheel carries the ffmpeg binary)
     -o loop.gif               an animated GIF (Pillow), looping
 
-Every frame is a PNG written atomically (outputs.atomic_write), so a frame file exists only once complete and
-a rerun skips the frames already there (resume after a crash or an interrupt). A video or GIF is assembled
-from such PNGs kept in a sidecar folder beside it (`film.mp4.frames/`), encoded to a temporary name and
-renamed into place at the end; the sidecar is then removed (unless asked to keep it), so a crash before the
-end leaves the rendered frames to resume from and no half-written video.
+Every frame is a PNG written atomically (outputs.atomic_write) and flushed to disk before its rename, so a
+frame file exists only once complete. A video or GIF is assembled from such PNGs kept in a sidecar folder
+beside it (`film.mp4.frames/`), encoded to a temporary name and renamed into place at the end; the sidecar
+is then removed (unless asked to keep it), so a crash before the end leaves the rendered frames to resume
+from and no half-written video.
+
+A rerun skips the frames already there (resume after a crash or an interrupt), but only frames made by the
+same settings: a small manifest beside the frames (`.f_%04d.png.implgen.json`, `.film.mp4.implgen.json` in
+the sidecar) records what made them, `Made`: the scene's digest (its YAML and the code of every shape it
+uses) and the options that change pixels. Frames made otherwise, or with no manifest, are removed and
+rendered again when the run covers them all; when some lie outside the run (`--frames`), a frame pattern is
+refused in one line rather than left holding a mixed set. A sidecar is implgen's own: its stale frames are
+simply removed.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 import re
 import secrets
 import shutil
-from collections.abc import Sequence
-from dataclasses import dataclass
+import string
+import struct
+from collections.abc import Iterable, Sequence
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from implgen.errors import UserError
@@ -32,6 +44,90 @@ STILL = ".png"
 # The one printf integer field of a frame pattern: %d, %4d or %04d (no other % in the name).
 _FIELD = re.compile(r"%(0?[1-9]?)d")
 CODECS = {".mp4": "libx264", ".webm": "libvpx-vp9"}
+# The frame rates each kind of output can carry (a scene's fps is (0, 1000]; frame PNGs have none). GIF stores a
+# frame's delay in hundredths of a second in 16 bits: at most 655.35 s, so 0.002 fps (500 s) is the slowest
+# round rate it holds. ffmpeg takes the rate as a fraction with a denominator of at most 10^6 (imageio-ffmpeg):
+# 1e-5 fps breaks the .mp4 muxer, 1e-300 becomes 0; 0.001 fps (a frame every 1,000 s) to 1000 fps encode and
+# decode frame for frame with both codecs, for 10,000 frames (tests/test_fps_ranges.py).
+FPS_RANGES = {
+    "gif": (0.002, 1000.0, "a GIF stores each frame's delay in hundredths of a second, at most 655.35 s"),
+    "video": (0.001, 1000.0, "ffmpeg's .mp4 muxer fails below it; a frame shows 1,000 s at 0.001"),
+}
+
+
+MANIFEST_FORMAT = 1
+_PNG_HEAD = b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR"  # signature, then the IHDR chunk's length and type
+
+
+@dataclass(frozen=True)
+class Made:
+    """What a frame's pixels depend on: the scene (frames.Frames.digest) and the options that change pixels.
+    Threads and tiles do not: a pixel's samples depend only on the pixel and the seed."""
+
+    scene: str
+    width: int
+    height: int
+    spp: int
+    max_depth: int
+    seed: int
+    fold: bool
+
+    def record(self) -> dict:
+        return {"implgen_frames": MANIFEST_FORMAT, **asdict(self)}
+
+    def differences(self, old: object) -> str:
+        """How the manifest `old` (as read; anything) differs from this, for a message; '' when it does not."""
+        if not isinstance(old, dict) or old.get("implgen_frames") != MANIFEST_FORMAT:
+            return "no record of what made them"
+        if old == self.record():
+            return ""
+        out = ["the scene or its shapes changed"] if old.get("scene") != self.scene else []
+        for k, v in asdict(self).items():
+            if k != "scene" and old.get(k) != v:
+                out.append(f"{k} {old.get(k)!r}, now {v!r}")
+        return ", ".join(out) or "other settings"
+
+
+@dataclass
+class Claim:
+    """What `FrameOutput.claim` found: frames made otherwise and removed to be rendered again, and why."""
+
+    replaced: list[int]
+    why: str
+
+
+def png_size(path: Path) -> tuple[int, int] | None:
+    """(width, height) from a PNG file's header, or None when it is not a PNG (too short, another file)."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(24)
+    except OSError:
+        return None
+    if len(head) < 24 or not head.startswith(_PNG_HEAD):
+        return None
+    return struct.unpack(">II", head[16:24])
+
+
+def _write_synced(fh, data: bytes) -> None:
+    """Write and flush to the disk before the caller's rename: after a power loss, a name is never left
+    pointing at a file whose bytes did not reach the disk (a frame that looks complete and is empty)."""
+    fh.write(data)
+    fh.flush()
+    os.fsync(fh.fileno())
+
+
+def _sync_folder(folder: Path) -> None:
+    """Make the renames in `folder` durable (where the file system allows opening a folder)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
 
 
 @dataclass
@@ -49,15 +145,86 @@ class FrameOutput:
         assert self.name_format is not None
         return self.folder / self.name_format.format(frame)
 
-    def done(self, frame: int) -> bool:
-        """A frame is complete when its file exists (files appear only by an atomic rename)."""
-        return self.kind != "still" and self.path(frame).is_file()
+    @property
+    def manifest(self) -> Path | None:
+        """The record of what made the frames (None for a still, which is never resumed)."""
+        if self.kind == "still":
+            return None
+        name = f".{self.target.name}.implgen.json"
+        if len(os.fsencode(name)) > 255:  # a pattern's name near the file system's limit: a short name instead
+            name = f".implgen-{hashlib.sha256(os.fsencode(self.target.name)).hexdigest()[:16]}.json"
+        return self.folder / name
+
+    def done(self, frame: int, made: Made) -> bool:
+        """A frame is complete when its file exists (files appear only by an atomic rename, after claim() has
+        removed frames made otherwise) and is a PNG of this run's size."""
+        return self.kind != "still" and png_size(self.path(frame)) == (made.width, made.height)
+
+    def existing(self) -> dict[int, Path]:
+        """The frame files in the folder now, by frame number: the names this output's format gives a number."""
+        if self.name_format is None or not self.folder.is_dir():
+            return {}
+        parts = list(string.Formatter().parse(self.name_format))  # literal text (unescaped) and the one field
+        name = "".join(re.escape(text) + (r" *(\d{1,9})" if field is not None else "") for text, field, _, _ in parts)
+        pattern = re.compile(name + "$")
+        found = {}
+        for entry in os.scandir(self.folder):
+            m = pattern.match(entry.name)
+            if m and self.name_format.format(int(m.group(1))) == entry.name and not entry.is_dir():
+                found[int(m.group(1))] = Path(entry.path)
+        return found
+
+    def claim(self, made: Made, todo: Iterable[int], option: str = "-o") -> Claim:
+        """Before any frame is written: unless the manifest says the frames here were made by `made`, remove
+        them to be rendered again -- or refuse in one line when a frame pattern holds some outside `todo`, as
+        its set would be mixed -- and record `made`."""
+        manifest = self.manifest
+        if manifest is None:
+            return Claim([], "")
+        self.prepare()
+        try:
+            old = json.loads(manifest.read_bytes())
+        except (OSError, ValueError):
+            old = None
+        why = made.differences(old)
+        if not why:
+            return Claim([], "")
+        stale = self.existing()
+        wanted = set(todo)
+        outside = sorted(f for f in stale if f not in wanted)
+        if outside and self.kind == "pattern":
+            raise UserError(
+                f"{option} {self.target}",
+                f"{len(stale)} frame files there were made otherwise ({why}), and {len(outside)} of them are "
+                f"outside the frames asked for (first {outside[0]}): remove them, render them all again "
+                "(--frames), or choose another output, so that the set is not mixed",
+            )
+        data = json.dumps(made.record(), indent=1).encode() + b"\n"
+        try:
+            for path in stale.values():
+                path.unlink(missing_ok=True)
+            atomic_write(manifest, lambda fh: _write_synced(fh, data))
+        except OSError as err:  # what the early checks could not foresee: a full disk, a folder removed
+            name = err.filename or manifest
+            raise UserError(f"{option} {self.target}", f"cannot replace {name}: {err.strerror or err}") from None
+        _sync_folder(self.folder)
+        return Claim(sorted(f for f in stale if f in wanted), why if stale else "")
+
+    def check_fps(self, fps: float, source: str) -> None:
+        """The scene's frame rate (animation.fps in `source`) fits this output, before any rendering."""
+        if self.kind not in FPS_RANGES:
+            return
+        lo, hi, why = FPS_RANGES[self.kind]
+        if not lo <= fps <= hi:
+            raise UserError(
+                source, f"animation.fps: {fps:g} is outside [{lo:g}, {hi:g}] for -o {self.target.name} ({why})"
+            )
 
     def prepare(self) -> None:
         self.folder.mkdir(parents=True, exist_ok=True)
 
     def write(self, frame: int, png: bytes) -> None:
-        atomic_write(self.path(frame), lambda fh: fh.write(png))
+        atomic_write(self.path(frame), lambda fh: _write_synced(fh, png))
 
     def finish(self, frames: Sequence[int], fps: float, keep_frames: bool = False) -> None:
         """Encode a video or GIF from the frame PNGs (all present), atomically; then drop the sidecar."""
@@ -71,6 +238,8 @@ class FrameOutput:
             else:
                 _write_video(tmp, paths, fps, CODECS[self.target.suffix.lower()])
             os.chmod(tmp, 0o666 & ~_umask())
+            with open(tmp, "rb+") as fh:  # on the disk before the rename
+                os.fsync(fh.fileno())
             os.replace(tmp, self.target)
         except BaseException:
             tmp.unlink(missing_ok=True)

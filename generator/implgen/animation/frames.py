@@ -12,6 +12,8 @@ unit of work of a frame or tile, run in this process or on a Dask worker (scene/
 
 from __future__ import annotations
 
+import hashlib
+import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -58,6 +60,20 @@ class Frames:
             return self.first
         return parse_scene(self.data, self.source, frame=frame, memo=self.memo)
 
+    def digest(self) -> str:
+        """What every frame's pixels depend on in the scene: its YAML as read (comments and layout aside;
+        keyed values as written) and the generated code of each shape it uses (spec files, their params and
+        implgen's own code: Spec.spec_key). The resume manifest compares it (frameout.Made)."""
+        h = hashlib.sha256()
+        try:
+            text = json.dumps(self.data, default=repr, separators=(",", ":"))
+        except (TypeError, ValueError):  # a key JSON cannot write (a validated scene has none)
+            text = repr(self.data)
+        h.update(text.encode())
+        for key in sorted({leaf.spec.spec_key for leaf in self.first.leaves()}):
+            h.update(b"\0" + key.encode())
+        return h.hexdigest()
+
 
 def frames_from_data(data: dict, source: str | Path = "<scene>") -> Frames:
     """Validate every frame of a scene mapping (see the module docstring)."""
@@ -67,9 +83,11 @@ def frames_from_data(data: dict, source: str | Path = "<scene>") -> Frames:
     if not fr.animated:
         return fr
     leaves0 = first.leaves()
-    keyed_mats = contains_keyed(data.get("materials"))
+    keyed_mats = contains_keyed(data.get("materials"), fr.source, "materials")
     keyed = sum(
-        _count_leaves(node) for node, raw in zip(first.objects, data["objects"]) if keyed_mats or contains_keyed(raw)
+        _count_leaves(node)
+        for i, (node, raw) in enumerate(zip(first.objects, data["objects"]))
+        if keyed_mats or contains_keyed(raw, fr.source, f"objects[{i}]")
     )
     for n, limit, what in ((len(leaves0), MAX_OBJECT_FRAMES, ""), (keyed, MAX_KEYED_OBJECT_FRAMES, "keyed ")):
         if n * fr.count > limit:

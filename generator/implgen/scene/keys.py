@@ -32,6 +32,10 @@ KEYED_KEYS = ("keys", "ease")
 ANIMATION_KEYS = ("frames", "fps")
 ORBIT_KEYS = ("center", "radius", "height", "turns")
 MAX_TURNS = 1000
+# Lists and mappings inside each other that a walk over raw YAML follows. A valid scene nests about 70 deep
+# at most (32 CSG levels of a mapping and a list each, then a leaf's transform or material), so 100 refuses
+# nothing valid, and a walk stops there, long before Python's recursion limit, whatever the reader checks later.
+MAX_NESTING = 100
 
 
 @dataclass
@@ -132,16 +136,25 @@ def _cached(ctx: FrameKeys, key: str, raw: dict) -> Keyed:
     return entry[1]
 
 
-def resolve(ctx: FrameKeys, key: str, raw: Any) -> Any:
+def too_deep(source: str, key: str) -> UserError:
+    """The one-line error of a walk that met more than MAX_NESTING lists and mappings inside each other."""
+    where = key if len(key) <= 80 else f"{key[:80]}..."
+    return UserError(source, f"{where}: nested more than {MAX_NESTING} levels deep (lists and mappings)")
+
+
+def resolve(ctx: FrameKeys, key: str, raw: Any, depth: int = 0) -> Any:
     """`raw` with every keyed value inside it replaced by its value at this frame (for parts of a scene where
-    every leaf is a number, such as a transform). The key paths of the keyed values found go to `ctx.keyed`."""
+    every leaf is a number, such as a transform). The key paths of the keyed values found go to `ctx.keyed`.
+    `depth` counts the containers above `raw`: past MAX_NESTING the walk stops with one line."""
     if is_keyed(raw):
         ctx.keyed.append(key)
         return _cached(ctx, key, raw).at(ctx.frame)
+    if isinstance(raw, (dict, list)) and depth >= MAX_NESTING:
+        raise too_deep(ctx.source, key)
     if isinstance(raw, dict):
-        return {k: resolve(ctx, f"{key}.{validate.key_name(k)}", v) for k, v in raw.items()}
+        return {k: resolve(ctx, f"{key}.{validate.key_name(k)}", v, depth + 1) for k, v in raw.items()}
     if isinstance(raw, list):
-        return [resolve(ctx, f"{key}[{i}]", v) for i, v in enumerate(raw)]
+        return [resolve(ctx, f"{key}[{i}]", v, depth + 1) for i, v in enumerate(raw)]
     return raw
 
 
@@ -170,15 +183,17 @@ def inline_params(ctx: FrameKeys, key: str, raw: Any) -> tuple[Any, dict]:
     return {**raw, **first}, keyed
 
 
-def contains_keyed(raw: Any) -> bool:
-    """Whether a keyed value appears anywhere in a raw YAML value."""
+def contains_keyed(raw: Any, source: str, key: str, depth: int = 0) -> bool:
+    """Whether a keyed value appears anywhere in the raw YAML value `raw` of `key` in `source`. It runs before
+    the reader has checked anything, so it bounds its own depth: past MAX_NESTING containers, one line."""
     if is_keyed(raw):
         return True
-    if isinstance(raw, dict):
-        return any(contains_keyed(v) for v in raw.values())
-    if isinstance(raw, list):
-        return any(contains_keyed(v) for v in raw)
-    return False
+    if not isinstance(raw, (dict, list)):
+        return False
+    if depth >= MAX_NESTING:
+        raise too_deep(source, key)
+    values = raw.values() if isinstance(raw, dict) else raw
+    return any(contains_keyed(v, source, key, depth + 1) for v in values)
 
 
 def orbit_camera(ctx: FrameKeys, cam: dict) -> tuple[tuple[float, float, float], tuple[float, float, float]]:

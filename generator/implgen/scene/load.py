@@ -58,7 +58,8 @@ def parse_scene(data: Any, source: str | Path = "<scene>", *, frame: int = 0, me
     objs = data.get("objects")
     if not isinstance(objs, list) or not objs:
         raise ctx.fail("objects", "expected a non-empty list")
-    fixed = ctx.static if not keys.contains_keyed(mats) else None  # no object can change with the frame
+    keyed_mats = keys.contains_keyed(mats, ctx.source, "materials")
+    fixed = ctx.static if not keyed_mats else None  # no object can change with the frame
     sc.objects = [parse_object(ctx, i, raw, named, fixed) for i, raw in enumerate(objs)]
     sc.keyed = tuple(ctx.keyed)
     _check_objects(ctx, sc.objects)

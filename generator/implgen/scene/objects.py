@@ -134,7 +134,7 @@ def _node(ctx: Reader, key: str, raw: Any, named: dict[str, Material], depth: in
 
 def parse_object(ctx: Reader, i: int, raw: Any, named: dict[str, Material], fixed: dict | None) -> Node:
     """objects[i]; one with no keyed value is parsed on the first frame only and shared by later frames."""
-    if fixed is not None and i not in fixed and not keys.contains_keyed(raw):
+    if fixed is not None and i not in fixed and not keys.contains_keyed(raw, ctx.source, f"objects[{i}]"):
         leaves, inline = ctx.leaves, ctx.inline_count
         node = _node(ctx, f"objects[{i}]", raw, named, 0)
         fixed[i] = (node, ctx.leaves - leaves, ctx.inline_count - inline)
