@@ -86,12 +86,10 @@ void rt_scene_set_background(rt_scene *s, const double color[3]);
 /* Computes boxes and the BVH. Returns 0, or -1 with a message. No changes after a successful commit. */
 int rt_scene_commit(rt_scene *s);
 const char *rt_scene_error(const rt_scene *s);
-/* Counts, for tests and the Python side. */
+/* Counts of the scene's parts (bound by implgen.scene.tracer; nothing calls it at present). */
 int rt_scene_count(const rt_scene *s, int what /* 0 nodes, 1 objects, 2 unbounded objects, 3 bvh nodes */);
 /* The distance that stands in for infinity on unbounded shapes: 1e5 x the scene's size. */
 double rt_scene_far(const rt_scene *s);
-/* World box of a node: returns 1 and fills box when bounded, 0 when unbounded. */
-int rt_scene_node_box(const rt_scene *s, int node, double box[6]);
 
 /* ---- ray queries (tracer_hit.c, tracer_csg.c) ---- */
 /* Closest hit with tmin < t < tmax (tmax may be INFINITY). Returns 1 and fills *hit, or 0. */
