@@ -1,10 +1,10 @@
 /* The scene tracer: algebraic shapes under affine transforms, CSG, Whitted-style shading with glass.
  *
- * Who calls this: generator/render.py through ctypes (one shared library per scene, built by
- * generator/build.py from this runtime plus the generated shapes the scene uses), and the C test drivers
- * in tests/c/tracer_*.c. Nothing here has global mutable state: a scene is an `rt_scene` value built once
- * and then read by any number of render threads; a render's state (progress, ray counts, cancel flag) lives
- * in an `rt_render` context.
+ * Who calls this: implgen.scene.render through ctypes (signatures in implgen.scene.tracer; one shared library
+ * per scene, built by implgen.scene.build from this runtime plus the generated shapes the scene uses), and the
+ * C test drivers in tests/c/tracer_*.c. Nothing here has global mutable state: a scene is an `rt_scene` value
+ * built once and then read by any number of render threads; a render's state (progress, ray counts, cancel
+ * flag) lives in an `rt_render` context.
  *
  * Conventions (see docs/tracer.md for the user-level description):
  *  - Transforms are affine 3x4 matrices, row-major: m[0..3] = (a00 a01 a02 tx), m[4..7], m[8..11].
@@ -26,7 +26,8 @@
 /* Node kinds. */
 enum { RT_LEAF = 0, RT_UNION = 1, RT_INTERSECTION = 2, RT_DIFFERENCE = 3 };
 
-/* Limits (validated by generator/scene.py too, with the same numbers). */
+/* Limits. implgen.scene.load checks scenes against RT_MAX_CSG_DEPTH, RT_MAX_DEPTH and RT_MAX_SPP too, reading
+ * the numbers from this header (implgen.abi). */
 #define RT_MAX_CSG_DEPTH 96 /* depth of the binary CSG tree below a top-level object */
 #define RT_MAX_SPANS 64     /* inside-intervals kept per CSG node and ray (the nearest ones) */
 #define RT_MAX_MEDIA 8      /* nested transparent media a ray can be inside at once */
@@ -86,12 +87,10 @@ void rt_scene_set_background(rt_scene *s, const double color[3]);
 /* Computes boxes and the BVH. Returns 0, or -1 with a message. No changes after a successful commit. */
 int rt_scene_commit(rt_scene *s);
 const char *rt_scene_error(const rt_scene *s);
-/* Counts, for tests and the Python side. */
+/* Counts of the scene's parts (bound by implgen.scene.tracer; nothing calls it at present). */
 int rt_scene_count(const rt_scene *s, int what /* 0 nodes, 1 objects, 2 unbounded objects, 3 bvh nodes */);
 /* The distance that stands in for infinity on unbounded shapes: 1e5 x the scene's size. */
 double rt_scene_far(const rt_scene *s);
-/* World box of a node: returns 1 and fills box when bounded, 0 when unbounded. */
-int rt_scene_node_box(const rt_scene *s, int node, double box[6]);
 
 /* ---- ray queries (tracer_hit.c, tracer_csg.c) ---- */
 /* Closest hit with tmin < t < tmax (tmax may be INFINITY). Returns 1 and fills *hit, or 0. */

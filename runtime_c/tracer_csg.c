@@ -246,11 +246,90 @@ static int plane_hit(const rt_node *n, int k, const rt_ray *ray, double tmin, do
     return 1;
 }
 
+/* A transformed leaf's ray as ig_shape_solve takes it: the origin oo in object space and the unit
+ * object-space direction u. Returns the length L of the object-space direction (the solve's parameter is
+ * s = t L); u is set only when L is positive and finite, which the caller checks. */
+static inline double object_unit_ray(const rt_node *n, const rt_ray *ray, double oo[3], double u[3])
+{
+    double od[3], L;
+    rt_xform_point(n->minv, ray->o, oo);
+    rt_xform_vector(n->minv, ray->d, od);
+    L = sqrt(rt_dot(od, od));
+    if (!(L > 0.0) || !isfinite(L))
+        return L;
+    u[0] = od[0] / L;
+    u[1] = od[1] / L;
+    u[2] = od[2] / L;
+    return L;
+}
+
+/* The roots (in s = t L) among which the leaf's hit is the first in (tmin, tmax). The solver stops at the first
+ * root in [lo, hi] (with any, at any point of the piece that holds it); only when that one cannot be used -- a
+ * root exactly at tmin, or an unrefined point at an end -- are all of them needed. ex: NULL, or receives the
+ * solve's expansion. */
+static inline int leaf_solve(const rt_node *n, const double *po, const double *pu, double L, double tmin, double tmax,
+                             double lo, double hi, int any, double *r, ig_shape_expansion *ex)
+{
+    int nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO,
+                            any ? IG_ANY_ROOT : IG_FIRST_ROOT, r, ex);
+    if (nr && (!(r[0] / L > tmin) || (any && !(r[0] / L < tmax))))
+        nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, IG_ALL_ROOTS, r, ex);
+    return nr;
+}
+
+/* The first of the roots r (in s = t L) with tmin < t < tmax, as the leaf's pending hit; ex: the solve's
+ * expansion, or NULL for an opaque shadow ray's yes/no solve (its hit is never finished). */
+static inline int first_root_hit(const rt_node *n, int k, const double *r, int nr, double L, double tmin, double tmax,
+                                 const ig_shape_expansion *ex, rt_pending *hit)
+{
+    int i;
+    for (i = 0; i < nr; ++i) {
+        double t = r[i] / L;
+        if (t > tmin && t < tmax) {
+            surface_hit(hit, k, t);
+            hit->noise_known = ex != NULL;
+            if (ex)
+                rt_expansion_noise(ex, n->prep.degree, r[i], &hit->noise_sum, &hit->noise_val);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* A CSG object's hit: the first end of its inside-intervals in (tmin, tmax) that lies on a surface (an end is
+ * open where the ray's range starts or ends inside), the ray entering there or leaving. */
+static inline int csg_hit(const rt_scene *s, int k, const rt_ray *ray, double tmin, double tmax, double lo, double hi,
+                          rt_pending *hit)
+{
+    rt_span sp[RT_MAX_SPANS];
+    int ns = rt_spans(s, k, ray->o, ray->d, lo, hi, sp, RT_MAX_SPANS), i;
+    for (i = 0; i < ns; ++i) {
+        const rt_end *e = NULL;
+        if (sp[i].in.t > tmin && sp[i].in.t < tmax && sp[i].in.leaf >= 0) {
+            e = &sp[i].in;
+            hit->entering = 1;
+        } else if (sp[i].out.t > tmin && sp[i].out.t < tmax && sp[i].out.leaf >= 0) {
+            e = &sp[i].out;
+            hit->entering = 0;
+        }
+        if (e) {
+            hit->t = e->t;
+            hit->leaf = e->leaf;
+            hit->face = e->face;
+            hit->entering_known = 1;
+            return 1;
+        }
+    }
+    return 0;
+}
+
 int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, int any, rt_pending *hit)
 {
-    int k = s->objects[object];
+    int k = s->objects[object], nr;
     const rt_node *n = &s->nodes[k];
-    double lo = tmin, hi = tmax;
+    double lo = tmin, hi = tmax, oo[3], u[3], L = ray->len, r[IG_MAX_DEGREE + 2];
+    const double *po = ray->o, *pu = ray->u;
+    ig_shape_expansion ex, *ex_wanted;
     /* A bounded object needs no clip to its world box here: the BVH has clipped the ray to a box around it,
      * a CSG root clips to its own box first thing in rt_spans, and a leaf's solve clips to the object-space box,
      * which the world box contains with room (its corners transformed, then padded by 1e-9 of its size). An
@@ -263,74 +342,27 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
     }
     hit->object = object;
     hit->noise_known = 0;
-    if (n->kind == RT_LEAF) {
-        /* A top-level leaf is a surface: its nearest root after tmin. The solver stops at the first root in
-         * [lo, hi]; only when that one is not after tmin (a root exactly at tmin) are all of them needed. The
-         * solve runs along the unit object-space direction (see rt_leaf_roots); an identity leaf takes the
-         * ray's own. */
-        double oo[3], od[3], u[3], L = ray->len, r[IG_MAX_DEGREE + 2];
-        const double *po = ray->o, *pu = ray->u;
-        ig_shape_expansion ex, *exp;
-        int nr, i;
-        if (n->prep.degree == 1 && !n->prep.bounded) {
-            int got = plane_hit(n, k, ray, tmin, tmax, lo, hi, hit);
-            if (got >= 0)
-                return got;
-        }
-        if (!n->identity) {
-            rt_xform_point(n->minv, ray->o, oo);
-            rt_xform_vector(n->minv, ray->d, od);
-            L = sqrt(rt_dot(od, od));
-            if (!(L > 0.0) || !isfinite(L))
-                return 0;
-            u[0] = od[0] / L;
-            u[1] = od[1] / L;
-            u[2] = od[2] / L;
-            po = oo;
-            pu = u;
-        } else if (!(L > 0.0) || !isfinite(L)) {
-            return 0;
-        }
-        /* an opaque shadow ray only asks whether there is a hit: the root need not be refined */
-        /* (nor is its expansion needed: an opaque shadow hit is never finished) */
-        if (any && !rt_leaf_opaque(s, n))
-            any = 0;
-        exp = any ? NULL : &ex;
-        nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO,
-                            any ? IG_ANY_ROOT : IG_FIRST_ROOT, r, exp);
-        if (nr && (!(r[0] / L > tmin) || (any && !(r[0] / L < tmax)))) /* (an unrefined point at an end) */
-            nr = ig_shape_solve(n->shape, n->params, &n->prep, po, pu, lo * L, hi * L, IG_ROOTS_AUTO, 0, r, exp);
-        for (i = 0; i < nr; ++i) {
-            double t = r[i] / L;
-            if (t > tmin && t < tmax) {
-                surface_hit(hit, k, t);
-                hit->noise_known = !any; /* an opaque shadow hit is never finished */
-                if (!any)
-                    rt_expansion_noise(&ex, n->prep.degree, r[i], &hit->noise_sum, &hit->noise_val);
-                return 1;
-            }
-        }
-        return 0;
-    } else {
-        rt_span sp[RT_MAX_SPANS];
-        int ns = rt_spans(s, k, ray->o, ray->d, lo, hi, sp, RT_MAX_SPANS), i;
-        for (i = 0; i < ns; ++i) {
-            const rt_end *e = NULL;
-            if (sp[i].in.t > tmin && sp[i].in.t < tmax && sp[i].in.leaf >= 0) {
-                e = &sp[i].in;
-                hit->entering = 1;
-            } else if (sp[i].out.t > tmin && sp[i].out.t < tmax && sp[i].out.leaf >= 0) {
-                e = &sp[i].out;
-                hit->entering = 0;
-            }
-            if (e) {
-                hit->t = e->t;
-                hit->leaf = e->leaf;
-                hit->face = e->face;
-                hit->entering_known = 1;
-                return 1;
-            }
-        }
-        return 0;
+    if (n->kind != RT_LEAF)
+        return csg_hit(s, k, ray, tmin, tmax, lo, hi, hit);
+    /* A top-level leaf is a surface: its hit is the nearest root after tmin, solved along the unit object-space
+     * direction (see rt_leaf_roots); an identity leaf takes the ray's own. */
+    if (n->prep.degree == 1 && !n->prep.bounded) {
+        int got = plane_hit(n, k, ray, tmin, tmax, lo, hi, hit);
+        if (got >= 0)
+            return got;
     }
+    if (!n->identity) {
+        L = object_unit_ray(n, ray, oo, u);
+        po = oo;
+        pu = u;
+    }
+    if (!(L > 0.0) || !isfinite(L))
+        return 0;
+    /* An opaque shadow ray only asks whether there is a hit: the root need not be refined, nor its expansion
+     * kept (an opaque shadow hit is never finished). */
+    if (any && !rt_leaf_opaque(s, n))
+        any = 0;
+    ex_wanted = any ? NULL : &ex;
+    nr = leaf_solve(n, po, pu, L, tmin, tmax, lo, hi, any, r, ex_wanted);
+    return first_root_hit(n, k, r, nr, L, tmin, tmax, ex_wanted, hit);
 }

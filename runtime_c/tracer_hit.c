@@ -185,14 +185,12 @@ static double distance_bound(const rt_node *n, const double po[3], const double 
     return isfinite(best) ? best : 0.0;
 }
 
-void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], const double d[3], rt_hit *hit,
-                   rt_hit_lazy *lazy)
+/* The hit point in world and object space, and the rays and solver noise rt_hit_error will need kept in lz. */
+static inline void hit_points(const rt_node *n, const rt_pending *pd, const double o[3], const double d[3], rt_hit *hit,
+                              rt_hit_lazy *lz)
 {
-    const rt_node *n = &s->nodes[pd->leaf];
-    rt_hit_lazy own, *lz = lazy ? lazy : &own;
-    double g[3], nw[3], len, t = pd->t;
-    int a, singular = 0, face = pd->face, entering = pd->entering, entering_known = pd->entering_known;
-
+    double t = pd->t;
+    int a;
     rt_to_object(n, o, d, lz->oo, lz->od);
     memcpy(lz->o, o, sizeof lz->o);
     memcpy(lz->d, d, sizeof lz->d);
@@ -206,47 +204,65 @@ void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], c
     lz->noise_known = pd->noise_known;
     lz->noise_sum = pd->noise_sum;
     lz->noise_val = pd->noise_val;
-    if (face == 0) {
-        double f = n->shape->value(hit->po, n->params), gl;
-        n->shape->gradient(hit->po, n->params, g);
-        gl = sqrt(rt_dot(g, g));
-        if (!(gl > 0.0) || !isfinite(gl) || !isfinite(f))
-            singular = 1;
-        /* the direction rt_hit_error measures the distance to f = 0 along */
-        if (!singular) {
-            for (a = 0; a < 3; ++a)
-                lz->u[a] = g[a] / gl;
-            lz->gl = gl;
-        } else {
-            double l = sqrt(rt_dot(lz->od, lz->od));
-            for (a = 0; a < 3; ++a)
-                lz->u[a] = lz->od[a] / l;
-        }
-        lz->f = f;
-    } else {
+}
+
+/* The object-space normal g, not unit: grad f on the surface, the outward axis on a face of the bounds box.
+ * On the surface also f at po and the direction rt_hit_error measures the distance to f = 0 along (into lz).
+ * Returns 1 at a singular point: grad f zero or not finite, or f not finite. */
+static inline int object_normal(const rt_node *n, int face, const double po[3], rt_hit_lazy *lz, double g[3])
+{
+    double f, gl;
+    int a;
+    if (face != 0) {
         g[0] = g[1] = g[2] = 0.0;
         g[abs(face) - 1] = face > 0 ? 1.0 : -1.0;
+        return 0;
     }
-    /* World normal by the inverse transpose: n_w = Minv^T g. */
-    if (!singular) {
+    f = n->shape->value(po, n->params);
+    n->shape->gradient(po, n->params, g);
+    gl = sqrt(rt_dot(g, g));
+    lz->f = f;
+    if (!(gl > 0.0) || !isfinite(gl) || !isfinite(f)) {
+        double l = sqrt(rt_dot(lz->od, lz->od));
         for (a = 0; a < 3; ++a)
-            nw[a] = n->minv[a] * g[0] + n->minv[4 + a] * g[1] + n->minv[8 + a] * g[2];
-        len = sqrt(rt_dot(nw, nw));
-        if (!(len > 0.0) || !isfinite(len))
-            singular = 1;
-        else
-            for (a = 0; a < 3; ++a)
-                nw[a] /= len;
+            lz->u[a] = lz->od[a] / l;
+        return 1;
     }
+    for (a = 0; a < 3; ++a)
+        lz->u[a] = g[a] / gl;
+    lz->gl = gl;
+    return 0;
+}
+
+/* The unit world normal nw = Minv^T g (normals map by the inverse transpose). Returns 0 when it has no length
+ * or is not finite. */
+static inline int world_normal(const rt_node *n, const double g[3], double nw[3])
+{
+    double len;
+    int a;
+    for (a = 0; a < 3; ++a)
+        nw[a] = n->minv[a] * g[0] + n->minv[4 + a] * g[1] + n->minv[8 + a] * g[2];
+    len = sqrt(rt_dot(nw, nw));
+    if (!(len > 0.0) || !isfinite(len))
+        return 0;
+    for (a = 0; a < 3; ++a)
+        nw[a] /= len;
+    return 1;
+}
+
+/* Turns the normals nw and g to their side and returns whether the ray enters the solid at the hit. */
+static inline int orient_normals(const rt_pending *pd, int singular, const double d[3], double nw[3], double g[3])
+{
+    int a, entering = pd->entering;
     if (singular) {
         /* grad f = 0 (a cusp, an apex): no normal exists; face the ray so shading stays finite. */
-        len = sqrt(rt_dot(d, d));
+        double len = sqrt(rt_dot(d, d));
         for (a = 0; a < 3; ++a)
             nw[a] = -d[a] / len;
         g[0] = g[1] = g[2] = 0.0;
-        if (!entering_known)
+        if (!pd->entering_known)
             entering = 1;
-    } else if (!entering_known) {
+    } else if (!pd->entering_known) {
         entering = rt_dot(nw, d) < 0.0;
     } else if ((rt_dot(nw, d) < 0.0) != (entering != 0)) {
         /* CSG: orient by the interval end (this also flips a subtracted part's normal). */
@@ -255,15 +271,31 @@ void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], c
             g[a] = -g[a];
         }
     }
+    return entering;
+}
+
+void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], const double d[3], rt_hit *hit,
+                   rt_hit_lazy *lazy)
+{
+    const rt_node *n = &s->nodes[pd->leaf];
+    rt_hit_lazy own, *lz = lazy ? lazy : &own;
+    double g[3], nw[3], len;
+    int a, singular, entering;
+
+    hit_points(n, pd, o, d, hit, lz);
+    singular = object_normal(n, pd->face, hit->po, lz, g);
+    if (!singular && !world_normal(n, g, nw))
+        singular = 1;
+    entering = orient_normals(pd, singular, d, nw, g);
     memcpy(hit->n, nw, sizeof nw);
     len = sqrt(rt_dot(g, g));
     for (a = 0; a < 3; ++a)
         hit->no[a] = len > 0.0 ? g[a] / len : nw[a];
     hit->err = 0.0;
-    hit->t = t;
+    hit->t = pd->t;
     hit->object = pd->object;
     hit->leaf = pd->leaf;
-    hit->face = face;
+    hit->face = pd->face;
     hit->material = n->material;
     hit->entering = entering != 0;
     hit->singular = singular;

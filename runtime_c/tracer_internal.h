@@ -118,6 +118,8 @@ int rt_spawn_skip(const rt_scene *s, const rt_hit *h);
 /* tracer_scene.c */
 void rt_xform_point(const double m[12], const double p[3], double out[3]);
 void rt_xform_vector(const double m[12], const double v[3], double out[3]);
+/* The ray in a leaf's object space (a copy when the leaf's transform is the identity). */
+void rt_to_object(const rt_node *n, const double o[3], const double d[3], double oo[3], double od[3]);
 /* tracer_hit.c */
 void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far);
 int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
@@ -133,17 +135,13 @@ void rt_expansion_noise(const ig_shape_expansion *ex, int deg, double s, double 
 /* Works out hit->err if rt_finish_hit left it pending (else does nothing): the same value either way. */
 void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lazy);
 
-/* The ray in a leaf's object space (a copy when the leaf's transform is the identity). */
-void rt_to_object(const rt_node *n, const double o[3], const double d[3], double oo[3], double od[3]);
-
 /* tracer_csg.c */
 int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r);
 int rt_spans(const rt_scene *s, int node, const double o[3], const double d[3], double a, double b, rt_span *out,
              int max);
-/* Closest hit of one top-level object with tmin < t < tmax: 1 and *hit filled, or 0. */
-/* The nearest hit of one top-level object in (tmin, tmax). any != 0: a yes/no query for an opaque shadow ray --
- * on an opaque top-level leaf the hit's t may be left unrefined (any point of the certified piece that holds
- * the root, see IG_ANY_ROOT), so only its existence may be used. */
+/* The nearest hit of one top-level object with tmin < t < tmax: 1 and *hit filled, or 0. any != 0: a yes/no
+ * query for an opaque shadow ray -- on an opaque top-level leaf the hit's t may be left unrefined (any point of
+ * the certified piece that holds the root, see IG_ANY_ROOT), so only its existence may be used. */
 int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, int any, rt_pending *hit);
 
 /* small vector helpers */

@@ -507,11 +507,3 @@ int rt_scene_count(const rt_scene *s, int what)
 }
 
 double rt_scene_far(const rt_scene *s) { return s->far; }
-
-int rt_scene_node_box(const rt_scene *s, int node, double box[6])
-{
-    if (node < 0 || node >= s->nnodes || !s->nodes[node].wbounded)
-        return 0;
-    memcpy(box, s->nodes[node].wbox, 6 * sizeof(double));
-    return 1;
-}

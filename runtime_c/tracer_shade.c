@@ -195,123 +195,186 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
     }
 }
 
+/* One hit as the shading steps of trace see it. */
+typedef struct rt_surface {
+    rt_hit h;
+    /* h.err is worked out (rt_hit_error) only before a ray leaves h: a surface lit by no light and neither
+     * reflecting nor refracting never needs it */
+    rt_hit_lazy lazy;
+    const rt_material *m;
+    double u[3];  /* the unit ray direction */
+    double nf[3]; /* the unit normal turned to face the ray */
+    double dl;    /* |d|: world length per unit of t (absorb needs the length travelled) */
+    int back;     /* the ray sees the side the normal points away from */
+} rt_surface;
+
+static void trace(const rt_tracer *tr, const double o[3], const double d[3], int skip, int depth, const rt_media *media,
+                  double weight, double rgb[3]);
+
+/* The ray's unit direction, which side of the surface it sees, and the normal turned towards it. */
+static inline void face_the_ray(rt_surface *sf, const double d[3])
+{
+    int a;
+    sf->dl = sqrt(rt_dot(d, d));
+    for (a = 0; a < 3; ++a)
+        sf->u[a] = d[a] / sf->dl;
+    sf->back = !(rt_dot(sf->h.n, sf->u) < 0.0);
+    if (!sf->back)
+        memcpy(sf->nf, sf->h.n, sizeof sf->nf);
+    else
+        for (a = 0; a < 3; ++a)
+            sf->nf[a] = -sf->h.n[a];
+}
+
+/* The Phong highlight's weight for a light in the unit direction L / ll. */
+static inline double specular_term(const rt_surface *sf, const double L[3], double ll)
+{
+    double hv[3], ndh;
+    int a;
+    for (a = 0; a < 3; ++a)
+        hv[a] = L[a] / ll - sf->u[a];
+    normalize3(hv);
+    ndh = rt_dot(sf->nf, hv);
+    return ndh > 0.0 ? sf->m->specular * highlight_power(ndh, sf->m->shininess) : 0.0;
+}
+
+/* Adds one light's diffuse and specular light at the hit to local, times what of it the scene lets through. */
+static inline void add_light(const rt_tracer *tr, rt_surface *sf, const double *lp, const double base[3],
+                             double local[3])
+{
+    const rt_material *m = sf->m;
+    const double *lc = lp + 3;
+    double L[3], ll, ndl, T[3], spec = 0.0;
+    int a;
+    for (a = 0; a < 3; ++a)
+        L[a] = lp[a] - sf->h.p[a];
+    ll = sqrt(rt_dot(L, L));
+    if (!(ll > 0.0))
+        return;
+    ndl = rt_dot(sf->nf, L) / ll;
+    if (ndl <= 0.0)
+        return; /* the light is behind the surface as seen from the ray */
+    rt_hit_error(tr->s, &sf->h, &sf->lazy);
+    shadow_transmittance(tr, &sf->h, lp, T);
+    if (T[0] + T[1] + T[2] <= 0.0)
+        return;
+    if (m->specular > 0.0)
+        spec = specular_term(sf, L, ll);
+    for (a = 0; a < 3; ++a)
+        local[a] += T[a] * lc[a] * (m->diffuse * base[a] * ndl + spec);
+}
+
+/* The opaque part of the colour: (1 - transparency) x (ambient + the lights that reach the hit). */
+static inline void local_colour(const rt_tracer *tr, rt_surface *sf, double col[3])
+{
+    const rt_scene *s = tr->s;
+    const rt_material *m = sf->m;
+    double base[3], local[3];
+    int a, l;
+    base_colour(m, &sf->h, sf->back, base);
+    for (a = 0; a < 3; ++a)
+        local[a] = m->ambient * base[a];
+    if (m->transparency < 1.0)
+        for (l = 0; l < s->nlights; ++l)
+            add_light(tr, sf, s->lights + 6 * l, base, local);
+    for (a = 0; a < 3; ++a)
+        col[a] = (1.0 - m->transparency) * local[a];
+}
+
+/* Where a transparent surface sends the refracted ray: the media stack behind the surface (next), the
+ * direction tdir and the Fresnel reflectance *F (1 under total internal reflection). Returns 0 under total
+ * internal reflection, else 1. */
+static inline int refraction(const rt_scene *s, const rt_surface *sf, const rt_media *media, rt_media *next,
+                             double tdir[3], double *F)
+{
+    double ci = -rt_dot(sf->u, sf->nf), n1, n2;
+    int can_refract;
+    if (sf->h.entering) {
+        n1 = media_ior(s, media);
+        n2 = sf->m->ior;
+        if (next->n < RT_MAX_MEDIA)
+            next->mat[next->n++] = sf->h.material;
+    } else {
+        n1 = sf->m->ior;
+        media_remove(next, sf->h.material);
+        n2 = media_ior(s, next);
+    }
+    can_refract = rt_refract(sf->u, sf->nf, n1 / n2, tdir);
+    *F = can_refract ? rt_fresnel(ci, n1 / n2) : 1.0;
+    return can_refract;
+}
+
+/* Traces the secondary ray leaving the hit along dir (inside media) and adds k times its colour to col. */
+static inline void add_secondary(const rt_tracer *tr, rt_surface *sf, const double dir[3], int depth,
+                                 const rt_media *media, double weight, double k, double col[3])
+{
+    double q[3], c[3];
+    int a;
+    rt_hit_error(tr->s, &sf->h, &sf->lazy);
+    rt_spawn_origin(&sf->h, dir, q);
+    if (tr->stats)
+        tr->stats[RT_RAYS_SECONDARY] += 1.0;
+    trace(tr, q, dir, rt_spawn_skip(tr->s, &sf->h), depth + 1, media, weight * k, c);
+    for (a = 0; a < 3; ++a)
+        col[a] += k * c[a];
+}
+
+/* Adds the mirror and glass part of the colour: the reflected and the refracted ray, each cast only when its
+ * share of the pixel (weight) is above RT_MIN_WEIGHT. */
+static inline void add_reflection_refraction(const rt_tracer *tr, rt_surface *sf, int depth, const rt_media *media,
+                                             double weight, double col[3])
+{
+    const rt_material *m = sf->m;
+    double F = 0.0, kr, kt, tdir[3] = {0.0, 0.0, 0.0};
+    rt_media next = *media;
+    int can_refract = 0;
+    if (m->transparency > 0.0)
+        can_refract = refraction(tr->s, sf, media, &next, tdir, &F);
+    kr = m->reflectivity + m->transparency * F;
+    if (kr > 1.0)
+        kr = 1.0;
+    kt = can_refract ? m->transparency * (1.0 - F) : 0.0;
+    if (kr * weight > RT_MIN_WEIGHT) {
+        double r[3];
+        rt_reflect(sf->u, sf->nf, r);
+        add_secondary(tr, sf, r, depth, media, weight, kr, col);
+    }
+    if (kt * weight > RT_MIN_WEIGHT)
+        add_secondary(tr, sf, tdir, depth, &next, weight, kt, col);
+}
+
+/* Beer-Lambert over the segment just travelled (len world units), if it ran inside an absorbing medium. */
+static inline void absorb(const rt_scene *s, const rt_media *media, double len, double col[3])
+{
+    const rt_material *mm;
+    int a;
+    if (media->n == 0)
+        return;
+    mm = &s->materials[media->mat[media->n - 1]];
+    for (a = 0; a < 3; ++a)
+        col[a] *= exp(-mm->absorption[a] * len);
+}
+
 /* The colour seen along o + t d; skip: an object the ray need not test (rt_spawn_skip), or -1. */
 static void trace(const rt_tracer *tr, const double o[3], const double d[3], int skip, int depth, const rt_media *media,
                   double weight, double rgb[3])
 {
     const rt_scene *s = tr->s;
-    const rt_material *m;
-    rt_hit h;
-    rt_hit_lazy lazy;
+    rt_surface sf;
     rt_pending ph;
-    double u[3], nf[3], base[3], local[3], col[3], dl;
-    int a, l, back;
+    double col[3];
 
     if (!rt_scene_closest(s, o, d, 0.0, INFINITY, RT_CLOSEST, skip, &ph)) {
         memcpy(rgb, s->background, 3 * sizeof(double));
         return;
     }
-    /* h.err is worked out (rt_hit_error) only before a ray leaves h: a surface lit by no light and
-     * neither reflecting nor refracting never needs it */
-    rt_finish_hit(s, &ph, o, d, &h, &lazy);
-    m = &s->materials[h.material];
-    dl = sqrt(rt_dot(d, d));
-    for (a = 0; a < 3; ++a)
-        u[a] = d[a] / dl;
-    back = !(rt_dot(h.n, u) < 0.0);
-    if (!back)
-        memcpy(nf, h.n, sizeof nf);
-    else
-        for (a = 0; a < 3; ++a)
-            nf[a] = -h.n[a];
-
-    base_colour(m, &h, back, base);
-    for (a = 0; a < 3; ++a)
-        local[a] = m->ambient * base[a];
-    if (m->transparency < 1.0) {
-        for (l = 0; l < s->nlights; ++l) {
-            const double *lp = s->lights + 6 * l, *lc = lp + 3;
-            double L[3], ll, ndl, T[3], spec = 0.0;
-            for (a = 0; a < 3; ++a)
-                L[a] = lp[a] - h.p[a];
-            ll = sqrt(rt_dot(L, L));
-            if (!(ll > 0.0))
-                continue;
-            ndl = rt_dot(nf, L) / ll;
-            if (ndl <= 0.0)
-                continue; /* the light is behind the surface as seen from the ray */
-            rt_hit_error(s, &h, &lazy);
-            shadow_transmittance(tr, &h, lp, T);
-            if (T[0] + T[1] + T[2] <= 0.0)
-                continue;
-            if (m->specular > 0.0) {
-                double hv[3], ndh;
-                for (a = 0; a < 3; ++a)
-                    hv[a] = L[a] / ll - u[a];
-                normalize3(hv);
-                ndh = rt_dot(nf, hv);
-                if (ndh > 0.0)
-                    spec = m->specular * highlight_power(ndh, m->shininess);
-            }
-            for (a = 0; a < 3; ++a)
-                local[a] += T[a] * lc[a] * (m->diffuse * base[a] * ndl + spec);
-        }
-    }
-    for (a = 0; a < 3; ++a)
-        col[a] = (1.0 - m->transparency) * local[a];
-
-    if (depth < tr->max_depth) {
-        double ci = -rt_dot(u, nf), F = 0.0, kr, kt, tdir[3] = {0.0, 0.0, 0.0};
-        rt_media next = *media;
-        int can_refract = 0;
-        if (m->transparency > 0.0) {
-            double n1, n2;
-            if (h.entering) {
-                n1 = media_ior(s, media);
-                n2 = m->ior;
-                if (next.n < RT_MAX_MEDIA)
-                    next.mat[next.n++] = h.material;
-            } else {
-                n1 = m->ior;
-                media_remove(&next, h.material);
-                n2 = media_ior(s, &next);
-            }
-            can_refract = rt_refract(u, nf, n1 / n2, tdir);
-            F = can_refract ? rt_fresnel(ci, n1 / n2) : 1.0;
-        }
-        kr = m->reflectivity + m->transparency * F;
-        if (kr > 1.0)
-            kr = 1.0;
-        kt = can_refract ? m->transparency * (1.0 - F) : 0.0;
-        if (kr * weight > RT_MIN_WEIGHT) {
-            double r[3], q[3], c[3];
-            rt_reflect(u, nf, r);
-            rt_hit_error(s, &h, &lazy);
-            rt_spawn_origin(&h, r, q);
-            if (tr->stats)
-                tr->stats[RT_RAYS_SECONDARY] += 1.0;
-            trace(tr, q, r, rt_spawn_skip(s, &h), depth + 1, media, weight * kr, c);
-            for (a = 0; a < 3; ++a)
-                col[a] += kr * c[a];
-        }
-        if (kt * weight > RT_MIN_WEIGHT) {
-            double q[3], c[3];
-            rt_hit_error(s, &h, &lazy);
-            rt_spawn_origin(&h, tdir, q);
-            if (tr->stats)
-                tr->stats[RT_RAYS_SECONDARY] += 1.0;
-            trace(tr, q, tdir, rt_spawn_skip(s, &h), depth + 1, &next, weight * kt, c);
-            for (a = 0; a < 3; ++a)
-                col[a] += kt * c[a];
-        }
-    }
-    /* Beer-Lambert over the segment just travelled, if it ran inside an absorbing medium. */
-    if (media->n > 0) {
-        const rt_material *mm = &s->materials[media->mat[media->n - 1]];
-        double len = h.t * dl;
-        for (a = 0; a < 3; ++a)
-            col[a] *= exp(-mm->absorption[a] * len);
-    }
+    rt_finish_hit(s, &ph, o, d, &sf.h, &sf.lazy);
+    sf.m = &s->materials[sf.h.material];
+    face_the_ray(&sf, d);
+    local_colour(tr, &sf, col);
+    if (depth < tr->max_depth)
+        add_reflection_refraction(tr, &sf, depth, media, weight, col);
+    absorb(s, media, sf.h.t * sf.dl, col);
     memcpy(rgb, col, 3 * sizeof(double));
 }
 

@@ -1,4 +1,5 @@
-/* Robustness of secondary-ray origins (issue 4, item 4).
+/* Robustness of secondary-ray origins: how often a ray leaving a hit from rt_spawn_origin hits its own surface
+ * again (self-hit) or skips the true next surface (miss), per shape and scale.
  *
  * For each shape in the table (tests/test_tracer_c.py writes it: every example shape with its default
  * params) and each scale 1e-3, 1e-1, 1, 1e1, 1e3 (a uniform scale with a random rotation and a translation
