@@ -1,7 +1,7 @@
 /* The scene tracer: algebraic shapes under affine transforms, CSG, Whitted-style shading with glass.
  *
- * Who calls this: implgen.scene.render through ctypes (signatures in implgen.scene.tracer; one shared library
- * per scene, built by implgen.scene.build from this runtime plus the generated shapes the scene uses), and the
+ * Who calls this: implgen.scene.renderjob through ctypes (signatures in implgen.scene.tracer; one shared library
+ * per scene, built by implgen.compile.library from this runtime plus the generated shapes the scene uses), and the
  * C test drivers in tests/c/tracer_*.c. Nothing here has global mutable state: a scene is an `rt_scene` value
  * built once and then read by any number of render threads; a render's state (progress, ray counts, cancel
  * flag) lives in an `rt_render` context.
@@ -87,8 +87,6 @@ void rt_scene_set_background(rt_scene *s, const double color[3]);
 /* Computes boxes and the BVH. Returns 0, or -1 with a message. No changes after a successful commit. */
 int rt_scene_commit(rt_scene *s);
 const char *rt_scene_error(const rt_scene *s);
-/* Counts of the scene's parts (bound by implgen.scene.tracer; nothing calls it at present). */
-int rt_scene_count(const rt_scene *s, int what /* 0 nodes, 1 objects, 2 unbounded objects, 3 bvh nodes */);
 /* The distance that stands in for infinity on unbounded shapes: 1e5 x the scene's size. */
 double rt_scene_far(const rt_scene *s);
 

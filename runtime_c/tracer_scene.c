@@ -490,20 +490,4 @@ int rt_scene_commit(rt_scene *s)
     return 0;
 }
 
-int rt_scene_count(const rt_scene *s, int what)
-{
-    switch (what) {
-    case 0:
-        return s->nnodes;
-    case 1:
-        return s->nobjects;
-    case 2:
-        return s->nunbounded;
-    case 3:
-        return s->nbvh;
-    default:
-        return -1;
-    }
-}
-
 double rt_scene_far(const rt_scene *s) { return s->far; }
