@@ -45,12 +45,11 @@ def write_scene(folder: Path, frames: int = 6, **image) -> Path:
 
 
 @contextmanager
-def silent_port() -> Iterator[tuple[int, list]]:
-    """A TCP port on 127.0.0.1 that accepts connections and never says a word."""
+def _listening(handle) -> Iterator[int]:
+    """A TCP port on 127.0.0.1 whose every connection is given to `handle(conn)` on a server thread."""
     server = socket.socket()
     server.bind(("127.0.0.1", 0))
     server.listen(16)
-    accepted: list = []
 
     def serve():
         while True:
@@ -58,13 +57,23 @@ def silent_port() -> Iterator[tuple[int, list]]:
                 conn, _ = server.accept()
             except OSError:
                 return
-            accepted.append(conn)
+            handle(conn)
 
     threading.Thread(target=serve, daemon=True).start()
     try:
-        yield server.getsockname()[1], accepted
+        yield server.getsockname()[1]
     finally:
         server.close()
+
+
+@contextmanager
+def silent_port() -> Iterator[tuple[int, list]]:
+    """A TCP port on 127.0.0.1 that accepts connections and never says a word."""
+    accepted: list = []
+    try:
+        with _listening(accepted.append) as port:
+            yield port, accepted
+    finally:
         for conn in accepted:
             conn.close()
 
@@ -73,25 +82,14 @@ def silent_port() -> Iterator[tuple[int, list]]:
 def answers_http() -> Iterator[int]:
     """A port that answers whatever comes with an HTTP error and closes, as many web servers and proxies do
     with bytes that are not a request. Read as a Dask frame header, "HTTP/1.1" is a length of 3.07 EiB."""
-    server = socket.socket()
-    server.bind(("127.0.0.1", 0))
-    server.listen(16)
 
-    def serve():
-        while True:
-            try:
-                conn, _ = server.accept()
-            except OSError:
-                return
-            with conn:
-                conn.recv(65536)
-                conn.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\nConnection: close\r\n\r\n")
+    def answer(conn) -> None:
+        with conn:
+            conn.recv(65536)
+            conn.sendall(b"HTTP/1.1 400 Bad Request\r\nContent-Length: 0\r\nConnection: close\r\n\r\n")
 
-    threading.Thread(target=serve, daemon=True).start()
-    try:
-        yield server.getsockname()[1]
-    finally:
-        server.close()
+    with _listening(answer) as port:
+        yield port
 
 
 @contextmanager
