@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import signal
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -38,8 +39,14 @@ def implgen(*args: str, cwd: Path | None = None, timeout: float = 60) -> Ran:
     return Ran(proc.returncode, proc.stdout, proc.stderr, time.monotonic() - t0)
 
 
+def _as_in_a_terminal() -> None:
+    """Ctrl-C as a user's terminal sends it: a shell that runs a job in the background (`make test &`, a CI
+    runner) starts it with SIGINT ignored, and a Python started so never installs KeyboardInterrupt."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def start(*args: str, cwd: Path | None = None) -> subprocess.Popen:
-    """The command started in the background (stdout and stderr piped, text)."""
+    """The command started in the background (stdout and stderr piped, text), with SIGINT as in a terminal."""
     return subprocess.Popen(
         [IMPLGEN, *map(str, args)],
         stdout=subprocess.PIPE,
@@ -47,6 +54,7 @@ def start(*args: str, cwd: Path | None = None) -> subprocess.Popen:
         text=True,
         cwd=cwd,
         env=env(),
+        preexec_fn=_as_in_a_terminal,
     )
 
 
