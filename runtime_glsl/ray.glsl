@@ -28,7 +28,8 @@
 //      finest leaves) is the same stretch of noise around that root, cut in two by one segment that the
 //      noise let through: the root is certified and the bracket starts at the doubt. A doubt further
 //      before it sets IG_EARLIER: the hit is certain, but a tangent root may come before t. A ray that ends
-//      with a doubt is a miss flagged IG_UNSURE.
+//      with a doubt is a miss flagged IG_UNSURE. Bisection finds a root of its bracket, not always the first:
+//      when the root found lies more than IG_MERGE finest leaves after the bracket's start, IG_EARLIER too.
 //      A run is where f is within rounding noise of zero (a grazing ray's flat stretch): halving further does
 //      not help there, so every IG_RUN_GROWTH leaves of a run the depth limit drops by one and the leaves
 //      grow (the traversal's own order makes the next segments larger), instead of crossing the stretch in
@@ -96,6 +97,7 @@ struct IgRay {
     int status;
     float s_hit;
     float ra, rb; // refinement bracket: sign known at ra, the other sign at rb
+    float bracket_a; // where the bracket started: the first root is in [bracket_a, the root found]
     int refine_left;
     int steps;
 };
@@ -198,6 +200,7 @@ void ig_ray_query(IgRay ray, out vec3 x, out vec3 y, out vec3 z)
 
 void ig_ray_refine(inout IgRay ray, float ra, float rb)
 {
+    ray.bracket_a = ra;
     ray.ra = ra;
     ray.rb = rb;
     ig_ray_ask_point(ray, 0.5 * (ra + rb), IG_REFINE);
@@ -329,6 +332,9 @@ void ig_ray_on_refine(inout IgRay ray, vec3 f)
     float m = 0.5 * (ray.ra + ray.rb);
     bool resolved = ray.rb - ray.ra <= 2.0 * IG_U * max(abs(ray.ra), abs(ray.rb)) || m == ray.ra || m == ray.rb;
     if (ray.refine_left <= 0 || resolved) {
+        // bisection finds a root of the bracket, not necessarily its first: when the bracket started well
+        // before it (a long run of noise), an earlier root may hide in between
+        ray.earlier = ray.earlier || m - ray.bracket_a > float(IG_MERGE) * ray.finest;
         ig_ray_stop(ray, true, m);
         return;
     }
