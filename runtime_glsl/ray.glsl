@@ -28,12 +28,16 @@
 //      finest leaves) is the same stretch of noise around that root, cut in two by one segment that the
 //      noise let through: the root is certified and the bracket starts at the doubt. A doubt further
 //      before it sets IG_EARLIER: the hit is certain, but a tangent root may come before t. A ray that ends
-//      with a doubt is a miss flagged IG_UNSURE. Bisection finds a root of its bracket, not always the first:
-//      when the root found lies more than IG_MERGE finest leaves after the bracket's start, IG_EARLIER too.
-//      A run is where f is within rounding noise of zero (a grazing ray's flat stretch): halving further does
-//      not help there, so every IG_RUN_GROWTH leaves of a run the depth limit drops by one and the leaves
-//      grow (the traversal's own order makes the next segments larger), instead of crossing the stretch in
-//      thousands of leaves of the finest size.
+//      with a doubt is a miss flagged IG_UNSURE.
+//      A run is where f is within rounding noise of zero: halving further does not help there, so after
+//      IG_RUN_DENSE leaves of a run, every IG_RUN_GROWTH more leaves the depth limit drops by one and the
+//      leaves grow (the traversal's own order makes the next segments larger), instead of crossing a grazing
+//      ray's flat stretch in thousands of leaves.
+//      Bisection finds a root of its bracket, not always the first; the first root lies between the bracket's
+//      start and the root found. When that stretch is longer than the ray's blur, 2^-IG_BLUR of the working
+//      interval plus IG_MERGE times the coordinates' rounding error (about half a pixel at 640 x 480 when the
+//      box fills the picture; on a far ray, about as close as float can place a point), the hit is flagged
+//      IG_EARLIER: certain, but the first root may lie before t by more than that.
 //   5. Everything is bounded: IG_MAX_STEPS shape evaluations per ray; a ray that runs out is flagged.
 //
 // What is certified is the ray as given in float (o, d): the shift's rounding is in the coordinates' error.
@@ -44,11 +48,17 @@
 #ifndef IG_MAX_STEPS
 #define IG_MAX_STEPS 1024
 #endif
+#ifndef IG_RUN_DENSE
+#define IG_RUN_DENSE 16
+#endif
 #ifndef IG_RUN_GROWTH
 #define IG_RUN_GROWTH 4
 #endif
 #ifndef IG_MERGE
 #define IG_MERGE 16
+#endif
+#ifndef IG_BLUR
+#define IG_BLUR 10
 #endif
 #ifndef IG_REFINE_STEPS
 #define IG_REFINE_STEPS 30
@@ -98,6 +108,7 @@ struct IgRay {
     float s_hit;
     float ra, rb; // refinement bracket: sign known at ra, the other sign at rb
     float bracket_a; // where the bracket started: the first root is in [bracket_a, the root found]
+    float blur;   // how well float can place a root on this ray (s units)
     int refine_left;
     int steps;
 };
@@ -181,6 +192,8 @@ IgRay ig_ray_begin(vec3 o, vec3 d, float tmin, float tmax, vec3 lo, vec3 hi)
     ray.a = ray.s0;
     ray.b = ray.s1;
     ray.finest = (ray.s1 - ray.s0) * ig_ray_scale(IG_MAX_DEPTH);
+    float e = max(max(ray.e0.x, ray.e0.y), ray.e0.z) + IG_ULP * length(ray.o);
+    ray.blur = (ray.s1 - ray.s0) * ig_ray_scale(IG_BLUR) + float(IG_MERGE) * e / max(max(abs(d.x), abs(d.y)), abs(d.z));
     ig_ray_ask_point(ray, ray.s0, IG_START);
     return ray;
 }
@@ -291,7 +304,8 @@ void ig_ray_on_segment(inout IgRay ray, vec3 f)
         return;
     }
     bool splittable = ray.b - ray.a > 8.0 * IG_U * max(abs(ray.a), abs(ray.b));
-    int depth = ray.run ? max(IG_MAX_DEPTH - ray.run_leaves / IG_RUN_GROWTH, 1) : IG_MAX_DEPTH;
+    int grown = max(ray.run_leaves - IG_RUN_DENSE, 0) / IG_RUN_GROWTH;
+    int depth = ray.run ? max(IG_MAX_DEPTH - grown, 1) : IG_MAX_DEPTH;
     if (ray.level < depth && splittable) {
         ray.level += 1;
         ray.index *= 2;
@@ -332,9 +346,7 @@ void ig_ray_on_refine(inout IgRay ray, vec3 f)
     float m = 0.5 * (ray.ra + ray.rb);
     bool resolved = ray.rb - ray.ra <= 2.0 * IG_U * max(abs(ray.ra), abs(ray.rb)) || m == ray.ra || m == ray.rb;
     if (ray.refine_left <= 0 || resolved) {
-        // bisection finds a root of the bracket, not necessarily its first: when the bracket started well
-        // before it (a long run of noise), an earlier root may hide in between
-        ray.earlier = ray.earlier || m - ray.bracket_a > float(IG_MERGE) * ray.finest;
+        ray.earlier = ray.earlier || m - ray.bracket_a > ray.blur;
         ig_ray_stop(ray, true, m);
         return;
     }
