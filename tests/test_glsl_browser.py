@@ -40,12 +40,6 @@ def _compare(gl, case: glslcheck.Case) -> glslcheck.Comparison:
     return glslcheck.compare(case, out, glslcheck.run_c(case))
 
 
-def _cases(which: str) -> list[glslcheck.Case]:
-    if which == "examples":
-        return glslcases.example_cases(SHAPES_DIR, SIZE)
-    return glslcases.high_degree_cases(SIZE, (True,))
-
-
 EXAMPLES = glslcases.example_cases(SHAPES_DIR, SIZE)
 NESTED = glslcases.high_degree_cases(SIZE, (True,))
 
