@@ -5,11 +5,11 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.implgen-installed
-SOURCES := pyproject.toml $(shell find generator templates runtime_c -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' \
+SOURCES := pyproject.toml $(shell find generator templates runtime_c runtime_glsl -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' -o -name '*.glsl' \
                        -o -name '*.html' -o -name '*.js' -o -name '*.css' \) 2>/dev/null)
 C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c)
 
-.PHONY: demo test lint tools browser povray screenshot install regen gallery bench clean
+.PHONY: demo test lint tools browser povray glslang screenshot install regen gallery bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -26,7 +26,7 @@ install: $(STAMP)
 demo: install
 	$(BIN)/implgen demo
 
-test: install browser povray
+test: install browser povray glslang
 	$(BIN)/python -m pytest -q tests
 
 # $(call debian,PROGRAMS,PACKAGES,WHAT IS SKIPPED): when a program is missing, install the Debian packages as
@@ -46,6 +46,10 @@ browser:
 # POV-Ray for the exporter's tests that render with it.
 povray:
 	@$(call debian,povray,povray,the POV-Ray render tests will be skipped)
+
+# Khronos' reference compiler, which validates every generated shader as GLSL ES 3.00 and as GLSL 4.50.
+glslang:
+	@$(call debian,glslangValidator,glslang-tools,the GLSL validation tests will be skipped)
 
 # The README's picture of `implgen view`, taken by the browser test.
 screenshot: install browser

@@ -13,8 +13,8 @@ ground plane, one light, shadows, 800x600, 1 sample) it
      plane; POV-Ray: `finish { ambient 1 diffuse 0 }`, black background, no plane, no light), counts the
      pixels where they disagree and decides each disputed pixel exactly: its primary ray is mapped to object
      space in rational arithmetic, f(o + t d) is expanded over Q, t is clipped to the object's box, and
-     Descartes' rule of signs with bisection on integers (implgen.roots.descartes) decides whether a real root
-     lies there;
+     Descartes' rule of signs with bisection on integers (implgen.roots.exactray, implgen.roots.descartes)
+     decides whether a real root lies there;
   4. times the generated C intersectors of a dense degree-n family (n = 2..20): coefficients, solve, total;
   5. writes report.md, results.json and the images into the output folder.
 Every number in the report comes from this one run.
@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import platform
 import re
@@ -57,9 +56,10 @@ def _ensure_current_install() -> None:
 _ensure_current_install()
 
 from implgen.bench.machine import cpu_model  # noqa: E402
-from implgen.codegen.spec import exact_polynomial, param_symbol  # noqa: E402
+from implgen.codegen.spec import param_symbol  # noqa: E402,F401 -- tests/test_povray_compare.py uses pc.param_symbol
 from implgen.export import povray as pv  # noqa: E402
 from implgen.roots.descartes import has_root  # noqa: E402
+from implgen.roots.exactray import box_span, exact_terms, integer_ray_poly, padded_box  # noqa: E402
 from implgen.scene.load import load_scene  # noqa: E402
 
 # --------------------------------------------------------------------------------------------- POV-Ray
@@ -171,7 +171,7 @@ def pov_mask(png: Path) -> np.ndarray:
 class ExactJudge:
     """Does the primary ray of a pixel truly hit an object inside its box? Decided in exact rational arithmetic:
     f(o + t d) expanded over Q, t clipped to the object's box (as exported with `clipped_by`), and the integer
-    Descartes/bisection test of implgen.roots.descartes on that interval."""
+    Descartes/bisection test of implgen.roots.descartes on that interval (implgen.roots.exactray)."""
 
     def __init__(self, scene, w: int, h: int):
         import sympy as sp
@@ -181,26 +181,13 @@ class ExactJudge:
         for leaf in scene.leaves():
             if leaf.spec.degree == 1 and leaf.spec.name == "ground":
                 continue
-            subs = {param_symbol(k): sp.Rational(Fraction(float(v))) for k, v in leaf.params.items()}
-            poly = exact_polynomial(leaf.spec.f.xreplace(subs), [])
-            terms = [
-                (tuple(int(e) for e in m), Fraction(int(c.numerator), int(c.denominator))) for m, c in poly.terms()
-            ]
+            terms = exact_terms(leaf.spec, leaf.params)
             m = sp.Matrix(3, 4, [sp.Rational(Fraction(float(v))) for v in np.asarray(leaf.matrix).ravel()])
             inv = m[:, :3].inv()
             frac = lambda v: Fraction(int(sp.numer(v)), int(sp.denom(v)))  # noqa: E731
             inv_f = [[frac(inv[i, j]) for j in range(3)] for i in range(3)]
             tr_f = [frac(m[i, 3]) for i in range(3)]
             self.objects.append((terms, inv_f, tr_f, leaf.spec.degree, _padded_box(leaf.spec.box(leaf.params))))
-
-    @staticmethod
-    def _mul(a: list[int], b: list[int]) -> list[int]:
-        out = [0] * (len(a) + len(b) - 1)
-        for i, x in enumerate(a):
-            if x:
-                for j, y in enumerate(b):
-                    out[i + j] += x * y
-        return out
 
     @staticmethod
     def object_ray(obj, o: np.ndarray, d: np.ndarray) -> tuple[list[Fraction], list[Fraction]]:
@@ -214,28 +201,9 @@ class ExactJudge:
 
     def ray_poly(self, obj, o: np.ndarray, d: np.ndarray) -> list[int]:
         """Integer coefficients (lowest first) of a positive multiple of f(o' + t d'), o', d' the object-space
-        ray: with o' = A / D and d' = B / D over one denominator D, D^deg f(o' + t d') = sum c_m D^(deg - |m|)
-        prod_k (A_k + B_k t)^(m_k), and the c_m are scaled to integers: all in Python integers, no gcd."""
+        ray (implgen.roots.exactray.integer_ray_poly)."""
         terms, _, _, deg, _ = obj
-        oo, dd = self.object_ray(obj, o, d)
-        den = 1
-        for v in (*oo, *dd, *(c for _, c in terms)):
-            den = den * v.denominator // math.gcd(den, v.denominator)
-        lin = [[int(oo[k] * den), int(dd[k] * den)] for k in range(3)]
-        powers = []
-        for k in range(3):
-            pw = [[1]]
-            for _ in range(deg):
-                pw.append(self._mul(pw[-1], lin[k]))
-            powers.append(pw)
-        acc = [0] * (deg + 1)
-        dpow = [den**e for e in range(deg + 2)]
-        for (i, j, k), c in terms:
-            scale = int(c * den) * dpow[deg - (i + j + k)]
-            p = self._mul(self._mul(powers[0][i], powers[1][j]), powers[2][k])
-            for e, v in enumerate(p):
-                acc[e] += scale * v
-        return acc
+        return integer_ray_poly(terms, deg, *self.object_ray(obj, o, d))
 
     def hits(self, px: int, py: int) -> bool:
         o, d = camera_ray(self.scene, px + 0.5, py + 0.5, self.w, self.h)
@@ -248,41 +216,8 @@ class ExactJudge:
         return has_root(self.ray_poly(obj, o, d), *span)  # a tangent root counts
 
 
-def _padded_box(box):
-    """The spec box grown by 1e-9 of its extent, in doubles as runtime_c/shape.c does (and the exporter's
-    clipped_by), as exact rationals; None bounds for infinite ones."""
-    if box is None:
-        return None
-    box = np.asarray(box, dtype=float)
-    lo, hi = box[:3], box[3:]
-    scale = np.maximum(np.where(np.isfinite(lo), np.abs(lo), 0.0), np.where(np.isfinite(hi), np.abs(hi), 0.0))
-    lo, hi = lo - 1e-9 * scale, hi + 1e-9 * scale
-    return [
-        (Fraction(float(a)) if np.isfinite(a) else None, Fraction(float(b)) if np.isfinite(b) else None)
-        for a, b in zip(lo, hi)
-    ]
-
-
-def _box_span(box, oo, dd) -> tuple[Fraction, Fraction | None] | None:
-    """[t0, t1] (t1 None: unbounded) of t >= 0 where o + t d is inside the box, exactly; None when empty."""
-    t0, t1 = Fraction(0), None
-    for k, (lo, hi) in enumerate(box or []):
-        for bound, is_lo in ((lo, True), (hi, False)):
-            if bound is None:
-                continue
-            if dd[k] == 0:
-                if (oo[k] < bound) if is_lo else (oo[k] > bound):
-                    return None
-                continue
-            t = (bound - oo[k]) / dd[k]
-            entering = (dd[k] > 0) == is_lo
-            if entering:
-                t0 = max(t0, t)
-            else:
-                t1 = t if t1 is None else min(t1, t)
-    if t1 is not None and t1 < t0:
-        return None
-    return t0, t1
+_padded_box = padded_box  # the names this script and its tests have used
+_box_span = box_span
 
 
 # ------------------------------------------------------------------------------------- degree family

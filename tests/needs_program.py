@@ -15,7 +15,12 @@ import shutil
 import pytest
 
 #: the Debian package each program comes from
-PACKAGES = {"chromium": "chromium", "chromedriver": "chromium-driver", "povray": "povray"}
+PACKAGES = {
+    "chromium": "chromium",
+    "chromedriver": "chromium-driver",
+    "povray": "povray",
+    "glslangValidator": "glslang-tools",
+}
 REQUIRE_ALL = "IMPLGEN_REQUIRE_ALL"
 
 

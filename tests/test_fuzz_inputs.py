@@ -225,7 +225,7 @@ def test_spec_generation_writes_only_the_parsed_text(work, case):
     assert err == ""
     spec = load_spec(path)
     texts = [p.read_text() for p in out.iterdir()]
-    assert len(texts) == 3
+    assert len(texts) == 4  # .h, .c, .py, .glsl
     raw = doc["equation"].strip() if isinstance(doc.get("equation"), str) else ""
     for text in texts:
         assert spec.equation in text and "Zq9" not in text

@@ -1,4 +1,4 @@
-"""Where the package data (templates, C runtime sources) lives once installed, and which runtime sources make
+"""Where the package data (templates, C and GLSL runtime sources) lives once installed, and which runtime sources make
 which library.
 
 The lists are explicit: a scene library links the solvers, the shape layer and the tracer -- never the
@@ -25,6 +25,8 @@ SOLVER_SOURCES = (
 BENCH_SOURCES = ("roots_bench.c",)  # clock_gettime around every solve: `implgen bench solvers`
 SHAPE_SOURCES = ("shape.c",)
 TRACER_SOURCES = ("tracer_scene.c", "tracer_hit.c", "tracer_csg.c", "tracer_shade.c", "tracer_render.c")
+# The GLSL runtime, in the order a program concatenates it (before the generated shapes: docs/glsl.md)
+GLSL_RUNTIME_SOURCES = ("raa.glsl", "clip.glsl", "ray.glsl", "camera.glsl", "shade.glsl")
 
 
 def templates_dir() -> Path:
@@ -35,6 +37,11 @@ def templates_dir() -> Path:
 def runtime_dir() -> Path:
     """Folder holding the hand-written C runtime sources (`*.c`, `*.h`)."""
     return _PACKAGE_DIR / "runtime_c" if (_PACKAGE_DIR / "runtime_c").is_dir() else _TREE / "runtime_c"
+
+
+def runtime_glsl_dir() -> Path:
+    """Folder holding the hand-written GLSL runtime (`*.glsl`, concatenated in GLSL_RUNTIME_SOURCES order)."""
+    return _PACKAGE_DIR / "runtime_glsl" if (_PACKAGE_DIR / "runtime_glsl").is_dir() else _TREE / "runtime_glsl"
 
 
 def runtime_sources(*groups: tuple[str, ...]) -> list[Path]:

@@ -1,6 +1,7 @@
 """One backend per target language: a SymPy code printer and the templates it fills, with their file names.
 
-Adding a language means adding a printer here, its templates under templates/<lang>/ and one BACKENDS entry;
+Adding a language means adding a printer here, its templates under templates/<lang>/ and one BACKENDS entry
+(with, when its templates need more than the printed blocks, a function of the derivation giving the rest);
 emit.py has no per-language branches. Every printer writes only finite double constants: a constant beyond
 double range (from an equation's coefficients) raises ConstantRangeError, which generation turns into a
 one-line error naming the spec.
@@ -8,6 +9,7 @@ one-line error naming the spec.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import sympy
@@ -15,6 +17,8 @@ from sympy.codegen.rewriting import create_expand_pow_optimization
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.codeprinter import CodePrinter
 from sympy.printing.pycode import PythonCodePrinter
+
+from implgen.codegen.glsl import GLSLPrinter, glsl_extra
 
 EXPAND_POW = create_expand_pow_optimization(3)  # b**2, b**3 -> b*b, b*b*b; higher powers are chained
 _EXACT_INT = 2**53
@@ -77,9 +81,11 @@ class PyPrinter(_FiniteConstants, PythonCodePrinter):
 class Backend:
     printer: type[CodePrinter]
     files: tuple[tuple[str, str], ...]  # (template under templates/, file name pattern with {name})
+    extra: Callable | None = None  # derivation -> more template variables (dict), or None
 
 
 BACKENDS: dict[str, Backend] = {
     "c": Backend(CPrinter, (("c/shape.h.j2", "{name}.h"), ("c/shape.c.j2", "{name}.c"))),
     "python": Backend(PyPrinter, (("python/shape.py.j2", "{name}.py"),)),
+    "glsl": Backend(GLSLPrinter, (("glsl/shape.glsl.j2", "{name}.glsl"),), glsl_extra),
 }

@@ -1,4 +1,4 @@
-"""`implgen SPEC.yaml [SPEC.yaml ...] --lang c|python|all [-o DIR]`: validate, derive, emit, write.
+"""`implgen SPEC.yaml [SPEC.yaml ...] --lang c|python|glsl|all [-o DIR]`: validate, derive, emit, write.
 
 Every spec is read and every file produced in memory before anything is written, so bad input leaves the
 output folder untouched.
@@ -28,12 +28,12 @@ def _parser() -> argparse.ArgumentParser:
     p = ArgumentParser(
         label="command line",
         prog="implgen",
-        description="Generate C and Python ray intersectors from implicit surface specs. Every spec is checked "
+        description="Generate C, Python and GLSL ray intersectors from implicit surface specs. Every spec is checked "
         "and every file made before anything is written. The other commands: implgen --help.",
         examples=EXAMPLES,
     )
     p.add_argument("specs", nargs="+", type=Path, metavar="SPEC.yaml", help="shape specs (docs/formats.md)")
-    p.add_argument("--lang", choices=["c", "python", "all"], default="all", help="what to write (default: all)")
+    p.add_argument("--lang", choices=[*LANGS, "all"], default="all", help="what to write (default: all)")
     p.add_argument(
         "-o", "--output", type=Path, default=Path("generated"), metavar="DIR", help="output folder (default: generated)"
     )

@@ -81,7 +81,7 @@ def _render(env, template: str, context: dict) -> str:
 
 
 def generate(spec: Spec, langs: Iterable[str] = LANGS, derivation: Derivation | None = None) -> dict[str, str]:
-    """{file name: text} for the requested languages (BACKENDS: "c" -> .h and .c, "python" -> .py)."""
+    """{file name: text} for the requested languages (BACKENDS: "c" -> .h and .c, "python" -> .py, "glsl" -> .glsl)."""
     unknown = [lang for lang in langs if lang not in BACKENDS]
     if unknown:
         raise ValueError(f"unknown language {unknown[0]!r}; backends: {', '.join(BACKENDS)}")
@@ -92,6 +92,8 @@ def generate(spec: Spec, langs: Iterable[str] = LANGS, derivation: Derivation | 
         for lang in langs:
             backend = BACKENDS[lang]
             ctx = _context(derivation, backend.printer().doprint)
+            if backend.extra is not None:
+                ctx.update(backend.extra(derivation))
             for template, pattern in backend.files:
                 files[pattern.format(name=spec.name)] = _render(env, template, ctx)
     except ConstantRangeError as err:

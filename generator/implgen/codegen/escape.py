@@ -11,11 +11,15 @@ file name, a description) goes through one of these functions, each safe for ANY
   py_docstring inside \"\"\"...\"\"\" : backslash and every quote escaped (so no quote run can end it),
               anything not printable ASCII as \\xNN / \\uNNNN / \\UNNNNNNNN.
   py_string   a complete Python string literal (quotes included), printable ASCII only.
+  glsl_comment after // : letters, digits, space and `_ . , : ; + - * / ^ ( ) =` only (GLSL ES 3.00 refuses
+              many characters even in comments, and a backslash at the end would continue the comment onto
+              the next line of code); anything else as U+XXXX.
 """
 
 from __future__ import annotations
 
 _PRINTABLE = frozenset(chr(c) for c in range(0x20, 0x7F))
+_GLSL_COMMENT = frozenset("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789 _.,:;+-*/^()=")
 
 
 def _py_escape(ch: str) -> str:
@@ -71,3 +75,8 @@ def py_docstring(text: str) -> str:
 def py_string(text: str) -> str:
     """A double-quoted Python string literal that evaluates to `text` (printable ASCII only)."""
     return f'"{py_docstring(text)}"'
+
+
+def glsl_comment(text: str) -> str:
+    """`text` made safe after `//` in GLSL: one line of a small alphabet, anything else written U+XXXX."""
+    return "".join(ch if ch in _GLSL_COMMENT else f"U+{ord(ch):04X}" for ch in str(text))

@@ -1,7 +1,7 @@
 """The Jinja2 environment every generated file comes from (shapes and the scene glue).
 
 StrictUndefined, so a template naming a missing value fails instead of printing nothing; no autoescaping,
-because the targets are C and Python, not HTML: text that lands in a comment, docstring or string literal
+because the targets are C, Python and GLSL, not HTML: text that lands in a comment, docstring or string literal
 goes through the filter for that place (codegen/escape.py). Cheap to import: no SymPy here.
 """
 
@@ -26,6 +26,10 @@ def environment() -> jinja2.Environment:
         autoescape=False,
     )
     env.filters.update(
-        c_comment=escape.c_comment, c_string=escape.c_string, py_doc=escape.py_docstring, py_str=escape.py_string
+        c_comment=escape.c_comment,
+        c_string=escape.c_string,
+        py_doc=escape.py_docstring,
+        py_str=escape.py_string,
+        glsl_comment=escape.glsl_comment,
     )
     return env

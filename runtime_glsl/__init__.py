@@ -1,0 +1,1 @@
+"""Package marker: lets setuptools ship the GLSL runtime sources as package data."""
