@@ -1,12 +1,14 @@
 """`implgen view [SPEC.yaml | SCENE.yaml] [--port P] [--host H] [--no-browser]`: the interactive viewer.
 
 The file is read and checked like every input (a mapping with `objects` is a scene, anything else a spec);
-with no file the page starts from a torus. The socket is bound before anything starts, so a port in use is
-one line and exit status 2. The server runs until Ctrl-C.
+with no file the page starts from a torus. The limits (work.py) are read from IMPLGEN_VIEW_* variables and the
+socket is bound before anything starts, so a bad limit or a port in use is one line and exit status 2. The
+server runs until Ctrl-C, which cancels every render and returns within a second or two.
 """
 
 from __future__ import annotations
 
+import asyncio
 import socket
 import threading
 import webbrowser
@@ -17,7 +19,10 @@ from implgen.args import ArgumentParser
 from implgen.codegen.spec import parse_spec
 from implgen.errors import UserError
 from implgen.view.document import STARTER, Document
+from implgen.view.work import Limits
 from implgen.yamlfile import read_yaml
+
+SHUTDOWN_GRACE = 1  # seconds uvicorn waits for the pages' handlers at Ctrl-C (their renders are cancelled first)
 
 
 def document_factory(path: Path | None):
@@ -52,7 +57,19 @@ def bind(host: str, port: int) -> socket.socket:
     return sock
 
 
-def serve(sock: socket.socket, make_document, threads: int | None = None, on_ready=None) -> None:
+def is_loopback(host: str) -> bool:
+    from implgen.view.server import LOOPBACK_HOSTS
+
+    return host in LOOPBACK_HOSTS or host.startswith("127.")
+
+
+def serve(
+    sock: socket.socket,
+    make_document,
+    threads: int | None = None,
+    on_ready=None,
+    limits: Limits | None = None,
+) -> None:
     """Run the server on a bound socket until it is stopped (Ctrl-C, or server.should_exit)."""
     import uvicorn
 
@@ -60,13 +77,42 @@ def serve(sock: socket.socket, make_document, threads: int | None = None, on_rea
     from implgen.view.server import LOOPBACK_HOSTS, create_app
 
     host = sock.getsockname()[0]
-    loopback = host in LOOPBACK_HOSTS or host.startswith("127.")
-    app = create_app(make_document, threads=threads, allowed_hosts=(*LOOPBACK_HOSTS, host) if loopback else None)
-    config = uvicorn.Config(app, log_level="warning", ws_max_size=MAX_MESSAGE, lifespan="off")
-    server = uvicorn.Server(config)
+    loopback = is_loopback(host)
+    limits = limits or Limits()
+    app = create_app(
+        make_document,
+        threads=threads,
+        allowed_hosts=(*LOOPBACK_HOSTS, host) if loopback else None,
+        limits=limits,
+    )
+    config = uvicorn.Config(
+        app,
+        log_level="warning",
+        ws_max_size=MAX_MESSAGE,
+        ws_ping_interval=limits.ping,
+        ws_ping_timeout=limits.ping,
+        lifespan="off",
+        timeout_graceful_shutdown=SHUTDOWN_GRACE,
+    )
+    work = app.state.work
+
+    class Server(uvicorn.Server):
+        def handle_exit(self, sig, frame) -> None:
+            """Ctrl-C: every render is cancelled at once and no page waits for its C threads to finish their
+            row (on the event loop: this is a signal handler, which must not take the pools' locks)."""
+            super().handle_exit(sig, frame)
+            try:
+                asyncio.get_running_loop().call_soon_threadsafe(work.shutdown)
+            except RuntimeError:  # no loop running in this thread: the `finally` below does it
+                pass
+
+    server = Server(config)
     if on_ready is not None:
         on_ready(server)
-    server.run(sockets=[sock])
+    try:
+        server.run(sockets=[sock])  # uvicorn then closes every socket, and waits SHUTDOWN_GRACE at most
+    finally:
+        work.shutdown()
 
 
 EXAMPLES = (
@@ -94,6 +140,7 @@ def main(argv: Sequence[str]) -> int:
     args = ap.parse_args(list(argv))
     if not 0 <= args.port <= 65535:
         raise UserError("--port", f"{args.port} is outside [0, 65535]")
+    limits = Limits.from_env()
     make_document = document_factory(args.file)
     make_document()  # a scene's shapes are checked now, not when the first page connects
     sock = bind(args.host, args.port)
@@ -102,5 +149,5 @@ def main(argv: Sequence[str]) -> int:
     print(f"implgen view: {url}  (Ctrl-C stops)", flush=True)
     if not args.no_browser:
         threading.Timer(0.5, webbrowser.open, args=(url,)).start()
-    serve(sock, make_document)
+    serve(sock, make_document, limits=limits)
     return 0

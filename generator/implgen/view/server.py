@@ -1,16 +1,21 @@
 """The viewer's web server: Starlette routes for the page's own three files and one WebSocket per page.
 
 Nothing else is served: the static files are a fixed table read from the package, not a folder mapped onto
-URLs. Messages are bounded (uvicorn's ws_max_size and protocol.MAX_MESSAGE); each page gets its own Session.
+URLs. Messages are bounded (uvicorn's ws_max_size and protocol.MAX_MESSAGE); each page gets its own Session,
+all of them one Work (work.py: the pools, budgets and limits).
 
 Browsers let any web page open a WebSocket to 127.0.0.1, so the socket accepts a browser's connection only
 from the page's own origin (Origin equal to the Host the request was sent to), and, when the server listens
 on a loopback address, only under a loopback host name: a foreign site, or one that re-binds its DNS name to
 127.0.0.1, cannot drive the renderer.
+
+A page is counted from its accept to the end of its last piece of work (`try/finally`), whatever ended it: a
+scene file that no longer reads (one line to the page), the page closing, or a bug.
 """
 
 from __future__ import annotations
 
+import asyncio
 import logging
 from collections.abc import Callable, Sequence
 from importlib import resources
@@ -18,11 +23,13 @@ from importlib import resources
 from starlette.applications import Starlette
 from starlette.responses import Response
 from starlette.routing import Route, WebSocketRoute
-from starlette.websockets import WebSocket, WebSocketDisconnect
+from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
 
+from implgen.errors import UserError
 from implgen.view import protocol
 from implgen.view.document import Document
 from implgen.view.session import Session
+from implgen.view.work import Limits, Work
 
 log = logging.getLogger("implgen.view")
 
@@ -36,7 +43,6 @@ HEADERS = {
     "X-Content-Type-Options": "nosniff",
     "Content-Security-Policy": "default-src 'self'; img-src 'self' blob: data:; connect-src 'self'",
 }
-MAX_PAGES = 8  # pages connected at once
 LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "::1")
 
 
@@ -57,6 +63,14 @@ def origin_allowed(headers, allowed_hosts: Sequence[str] | None) -> bool:
     return origin is None or origin.lower() in (f"http://{host}".lower(), f"https://{host}".lower())
 
 
+async def _close(ws: WebSocket, code: int, reason: str) -> None:
+    """Close the socket from our side, whatever state the page left it in."""
+    try:
+        await ws.close(code=code, reason=reason)
+    except (WebSocketDisconnect, RuntimeError, OSError):
+        pass
+
+
 def _static(name: str, media: str) -> Callable:
     body = resources.files("implgen.view").joinpath("static", name).read_bytes()
 
@@ -67,10 +81,16 @@ def _static(name: str, media: str) -> Callable:
 
 
 def create_app(
-    make_document: Callable[[], Document], threads: int | None = None, allowed_hosts: Sequence[str] | None = None
+    make_document: Callable[[], Document],
+    threads: int | None = None,
+    allowed_hosts: Sequence[str] | None = None,
+    limits: Limits | None = None,
 ) -> Starlette:
-    """The app; `make_document` gives each new page its own copy of the starting state. `allowed_hosts`: the
-    host names the page may be reached under (None: any, for a server listening beyond this machine)."""
+    """The app; `make_document` gives each new page its own copy of the starting state (called on the parse
+    pool: a scene file is read again for each page). `allowed_hosts`: the host names the page may be reached
+    under (None: any, for a server listening beyond this machine). The app's Work is
+    `app.state.work`: shut it down when the server stops."""
+    work = Work(limits)
     pages = {"open": 0}
 
     async def frames(ws: WebSocket) -> None:
@@ -78,19 +98,33 @@ def create_app(
             await ws.close(code=1008, reason="not this page's origin")
             return
         await ws.accept()
-        if pages["open"] >= MAX_PAGES:
+        if pages["open"] >= work.limits.max_pages:
             await ws.close(code=1013, reason="too many pages open")
             return
-        pages["open"] += 1
 
         async def send(msg: dict | bytes) -> None:
-            if isinstance(msg, bytes):
-                await ws.send_bytes(msg)
-            else:
-                await ws.send_json(msg)
+            if ws.application_state != WebSocketState.CONNECTED:
+                return  # closed by the server: a render that ends later has no one to tell
+            try:
+                if isinstance(msg, bytes):
+                    await ws.send_bytes(msg)
+                else:
+                    await ws.send_json(msg)
+            except (WebSocketDisconnect, RuntimeError, OSError):
+                pass  # the page has gone; its receive loop ends on the disconnect
 
-        session = Session(make_document(), send, threads=threads)
+        pages["open"] += 1
+        session = None
         try:
+            try:
+                doc = await work.call(work.parse, make_document)
+            except Exception as err:  # a scene file that no longer reads: its line to the page; a bug: logged
+                if not isinstance(err, UserError):
+                    log.exception("viewer page could not start")
+                await send(protocol.error_for(err))
+                await _close(ws, 1011, "the page could not start")
+                return
+            session = Session(doc, send, threads=threads, work=work)
             await send(session.hello())
             while True:
                 msg = await ws.receive()
@@ -105,12 +139,17 @@ def create_app(
                 except Exception as err:  # a bug, not bad input: tell the page, keep serving
                     log.exception("viewer message failed")
                     await send(protocol.error_for(err))
-        except WebSocketDisconnect:
-            pass
+        except (WebSocketDisconnect, asyncio.CancelledError):
+            pass  # the page has gone, or the server stops (Ctrl-C) while it waits for a parse: end quietly
         finally:
-            pages["open"] -= 1
-            await session.close()
+            try:
+                if session is not None:
+                    await session.close()  # its renders and its save stop first: they count against the page
+            finally:
+                pages["open"] -= 1
 
     routes = [Route(path, _static(name, media)) for path, (name, media) in STATIC.items()]
     routes.append(WebSocketRoute("/ws", frames))
-    return Starlette(routes=routes)
+    app = Starlette(routes=routes)
+    app.state.work = work
+    return app
