@@ -17,6 +17,7 @@ import json
 import os
 import re
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -350,6 +351,43 @@ def test_a_broken_scene_file_costs_no_page(servers, tmp_path) -> None:
     assert p.hello["mode"] == "scene"
     p.close()
     assert "Traceback" not in srv.stderr(), srv.stderr()
+
+
+def test_idle_and_half_open_sockets_time_out(servers) -> None:
+    """Eight pages that say nothing no longer lock the real page out: each is closed after the idle time, and
+    the ninth page gets in. A socket that stopped reading after its handshake (a vanished peer, which answers
+    no ping) is closed too."""
+    srv = servers(IMPLGEN_VIEW_IDLE="2", IMPLGEN_VIEW_PING="1")
+    quiet = [open_ws(srv.ws_url()) for _ in range(8)]  # their client answers pings: only silence tells
+    deadline = time.monotonic() + GUARD
+    while True:
+        try:
+            page = srv.page()
+            break
+        except (ConnectionClosed, InvalidStatus):
+            assert time.monotonic() < deadline, "the silent pages still hold every place"
+            time.sleep(0.5)
+    seq = page.render()
+    assert page.next() == (seq, KIND_COARSE)
+    page.close()
+    for ws in quiet:
+        with pytest.raises(ConnectionClosed) as closed:
+            while True:
+                ws.recv(GUARD)
+        assert "idle" in (closed.value.rcvd.reason if closed.value.rcvd else ""), closed.value
+    s = socket.create_connection(("127.0.0.1", srv.port), timeout=GUARD)
+    s.sendall(
+        b"GET /ws HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+        b"Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n"
+    )
+    got = b""
+    while b"idle" not in got:  # closed: its pings unanswered, or idle (a close frame with its reason)
+        data = s.recv(65536)
+        if not data:
+            break
+        got += data
+    assert b"ping timeout" in got or b"idle" in got, got
+    s.close()
 
 
 def test_the_limits_come_from_the_environment_and_a_bad_one_is_one_line(monkeypatch, capsys) -> None:

@@ -10,7 +10,8 @@ on a loopback address, only under a loopback host name: a foreign site, or one t
 127.0.0.1, cannot drive the renderer.
 
 A page is counted from its accept to the end of its last piece of work (`try/finally`), whatever ended it: a
-scene file that no longer reads (one line to the page), the page closing, or a bug.
+scene file that no longer reads (one line to the page), the page closing, idle for Limits.idle seconds, or a
+bug.
 """
 
 from __future__ import annotations
@@ -91,6 +92,7 @@ def create_app(
     under (None: any, for a server listening beyond this machine). The app's Work is
     `app.state.work`: shut it down when the server stops."""
     work = Work(limits)
+    idle = work.limits.idle
     pages = {"open": 0}
 
     async def frames(ws: WebSocket) -> None:
@@ -104,7 +106,7 @@ def create_app(
 
         async def send(msg: dict | bytes) -> None:
             if ws.application_state != WebSocketState.CONNECTED:
-                return  # closed by the server: a render that ends later has no one to tell
+                return  # closed by the server (idle): a render that ends later has no one to tell
             try:
                 if isinstance(msg, bytes):
                     await ws.send_bytes(msg)
@@ -127,7 +129,12 @@ def create_app(
             session = Session(doc, send, threads=threads, work=work)
             await send(session.hello())
             while True:
-                msg = await ws.receive()
+                try:
+                    async with asyncio.timeout(idle):  # not wait_for: it would receive in a task of its own
+                        msg = await ws.receive()
+                except TimeoutError:
+                    await _close(ws, 1001, f"idle for {idle:g} s: reload the page to go on")
+                    break
                 if msg["type"] == "websocket.disconnect":
                     break
                 text = msg.get("text")
