@@ -13,6 +13,7 @@ served with no token and no warning; Ctrl-C waited for the saves.
 
 from __future__ import annotations
 
+import http.client
 import json
 import os
 import re
@@ -388,6 +389,33 @@ def test_idle_and_half_open_sockets_time_out(servers) -> None:
         got += data
     assert b"ping timeout" in got or b"idle" in got, got
     s.close()
+
+
+# ------------------------------------------------------------------------------------- 10: beyond loopback
+
+
+def test_beyond_loopback_the_page_needs_its_token_and_the_server_warns(servers) -> None:
+    srv = servers("--host", "0.0.0.0")
+    warning = [line for line in srv.stderr().splitlines() if "warning" in line]
+    assert len(warning) == 1 and "0.0.0.0" in warning[0] and "token" in warning[0], srv.stderr()
+    assert srv.token and len(srv.token) >= 16, srv.line
+
+    def get(path: str) -> int:
+        conn = http.client.HTTPConnection("127.0.0.1", srv.port, timeout=GUARD)
+        conn.request("GET", path)
+        status = conn.getresponse().status
+        conn.close()
+        return status
+
+    assert get(f"/?token={srv.token}") == 200
+    assert get("/") == 403 and get("/?token=wrong") == 403
+    for token in ("", "wrong"):
+        with pytest.raises((InvalidStatus, ConnectionClosed)):
+            srv.page(token=token)
+    p = srv.page()
+    seq = p.render()
+    assert p.next() == (seq, KIND_COARSE)
+    p.close()
 
 
 def test_the_limits_come_from_the_environment_and_a_bad_one_is_one_line(monkeypatch, capsys) -> None:

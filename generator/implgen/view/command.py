@@ -2,14 +2,17 @@
 
 The file is read and checked like every input (a mapping with `objects` is a scene, anything else a spec);
 with no file the page starts from a torus. The limits (work.py) are read from IMPLGEN_VIEW_* variables and the
-socket is bound before anything starts, so a bad limit or a port in use is one line and exit status 2. The
-server runs until Ctrl-C, which cancels every render and returns within a second or two.
+socket is bound before anything starts, so a bad limit or a port in use is one line and exit status 2. Beyond
+loopback the server makes a token, prints the link with it and a warning line. The server runs until Ctrl-C,
+which cancels every render and returns within a second or two.
 """
 
 from __future__ import annotations
 
 import asyncio
+import secrets
 import socket
+import sys
 import threading
 import webbrowser
 from collections.abc import Sequence
@@ -69,8 +72,10 @@ def serve(
     threads: int | None = None,
     on_ready=None,
     limits: Limits | None = None,
+    token: str | None = None,
 ) -> None:
-    """Run the server on a bound socket until it is stopped (Ctrl-C, or server.should_exit)."""
+    """Run the server on a bound socket until it is stopped (Ctrl-C, or server.should_exit). A socket bound beyond
+    loopback needs a `token` (the page's link carries it)."""
     import uvicorn
 
     from implgen.view.protocol import MAX_MESSAGE
@@ -78,12 +83,15 @@ def serve(
 
     host = sock.getsockname()[0]
     loopback = is_loopback(host)
+    if not loopback and not token:
+        raise ValueError(f"a server listening on {host} needs a token")
     limits = limits or Limits()
     app = create_app(
         make_document,
         threads=threads,
         allowed_hosts=(*LOOPBACK_HOSTS, host) if loopback else None,
         limits=limits,
+        token=None if loopback else token,
     )
     config = uvicorn.Config(
         app,
@@ -145,9 +153,21 @@ def main(argv: Sequence[str]) -> int:
     make_document()  # a scene's shapes are checked now, not when the first page connects
     sock = bind(args.host, args.port)
     host, port = sock.getsockname()[:2]
-    url = f"http://{'[' + host + ']' if ':' in host else host}:{port}/"
+    token = None
+    shown = host
+    if not is_loopback(host):
+        token = secrets.token_urlsafe(24)
+        if host in ("0.0.0.0", "::"):  # every address: the link names the machine
+            shown = socket.gethostname()
+        print(
+            f"implgen view: warning: listening on {host}:{port}, beyond this machine: anyone who can reach the "
+            "port and has the link (its token) can use the page and this machine's CPU",
+            file=sys.stderr,
+            flush=True,
+        )
+    url = f"http://{'[' + shown + ']' if ':' in shown else shown}:{port}/" + (f"?token={token}" if token else "")
     print(f"implgen view: {url}  (Ctrl-C stops)", flush=True)
     if not args.no_browser:
         threading.Timer(0.5, webbrowser.open, args=(url,)).start()
-    serve(sock, make_document, limits=limits)
+    serve(sock, make_document, limits=limits, token=token)
     return 0

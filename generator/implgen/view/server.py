@@ -7,7 +7,8 @@ all of them one Work (work.py: the pools, budgets and limits).
 Browsers let any web page open a WebSocket to 127.0.0.1, so the socket accepts a browser's connection only
 from the page's own origin (Origin equal to the Host the request was sent to), and, when the server listens
 on a loopback address, only under a loopback host name: a foreign site, or one that re-binds its DNS name to
-127.0.0.1, cannot drive the renderer.
+127.0.0.1, cannot drive the renderer. Beyond loopback any host name may reach it, so the page and the socket
+ask for the token the server was started with (in the URL it prints).
 
 A page is counted from its accept to the end of its last piece of work (`try/finally`), whatever ended it: a
 scene file that no longer reads (one line to the page), the page closing, idle for Limits.idle seconds, or a
@@ -17,12 +18,13 @@ bug.
 from __future__ import annotations
 
 import asyncio
+import hmac
 import logging
 from collections.abc import Callable, Sequence
 from importlib import resources
 
 from starlette.applications import Starlette
-from starlette.responses import Response
+from starlette.responses import PlainTextResponse, Response
 from starlette.routing import Route, WebSocketRoute
 from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
 
@@ -45,6 +47,7 @@ HEADERS = {
     "Content-Security-Policy": "default-src 'self'; img-src 'self' blob: data:; connect-src 'self'",
 }
 LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "::1")
+NO_TOKEN = "this viewer listens beyond this machine: open it with the link it printed, token included\n"
 
 
 def _host_name(host: str) -> str:
@@ -64,6 +67,11 @@ def origin_allowed(headers, allowed_hosts: Sequence[str] | None) -> bool:
     return origin is None or origin.lower() in (f"http://{host}".lower(), f"https://{host}".lower())
 
 
+def token_allowed(query: str | None, token: str | None) -> bool:
+    """Whether a request's `token` query parameter is the server's (always, when it has none)."""
+    return token is None or hmac.compare_digest((query or "").encode(), token.encode())
+
+
 async def _close(ws: WebSocket, code: int, reason: str) -> None:
     """Close the socket from our side, whatever state the page left it in."""
     try:
@@ -72,10 +80,13 @@ async def _close(ws: WebSocket, code: int, reason: str) -> None:
         pass
 
 
-def _static(name: str, media: str) -> Callable:
+def _static(name: str, media: str, token: str | None) -> Callable:
     body = resources.files("implgen.view").joinpath("static", name).read_bytes()
+    guarded = name == "index.html"  # the page itself; its script and style are the package's, public anyway
 
     async def serve(request) -> Response:
+        if guarded and not token_allowed(request.query_params.get("token"), token):
+            return PlainTextResponse(NO_TOKEN, status_code=403, headers=HEADERS)
         return Response(body, media_type=media, headers=HEADERS)
 
     return serve
@@ -86,10 +97,11 @@ def create_app(
     threads: int | None = None,
     allowed_hosts: Sequence[str] | None = None,
     limits: Limits | None = None,
+    token: str | None = None,
 ) -> Starlette:
     """The app; `make_document` gives each new page its own copy of the starting state (called on the parse
     pool: a scene file is read again for each page). `allowed_hosts`: the host names the page may be reached
-    under (None: any, for a server listening beyond this machine). The app's Work is
+    under (None: any, for a server listening beyond this machine, which then needs `token`). The app's Work is
     `app.state.work`: shut it down when the server stops."""
     work = Work(limits)
     idle = work.limits.idle
@@ -98,6 +110,9 @@ def create_app(
     async def frames(ws: WebSocket) -> None:
         if not origin_allowed(ws.headers, allowed_hosts):
             await ws.close(code=1008, reason="not this page's origin")
+            return
+        if not token_allowed(ws.query_params.get("token"), token):
+            await ws.close(code=1008, reason="no token, or not this server's")
             return
         await ws.accept()
         if pages["open"] >= work.limits.max_pages:
@@ -155,7 +170,7 @@ def create_app(
             finally:
                 pages["open"] -= 1
 
-    routes = [Route(path, _static(name, media)) for path, (name, media) in STATIC.items()]
+    routes = [Route(path, _static(name, media, token)) for path, (name, media) in STATIC.items()]
     routes.append(WebSocketRoute("/ws", frames))
     app = Starlette(routes=routes)
     app.state.work = work

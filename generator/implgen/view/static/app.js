@@ -224,7 +224,10 @@
 
   function connect() {
     const proto = location.protocol === "https:" ? "wss" : "ws";
-    ws = new WebSocket(`${proto}://${location.host}/ws`);
+    // a server listening beyond this machine gave its link a token: the socket asks for it too
+    const token = new URLSearchParams(location.search).get("token");
+    const query = token ? `?token=${encodeURIComponent(token)}` : "";
+    ws = new WebSocket(`${proto}://${location.host}/ws${query}`);
     ws.binaryType = "arraybuffer";
     ws.addEventListener("message", onMessage);
     ws.addEventListener("close", (e) => {
