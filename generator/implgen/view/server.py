@@ -99,10 +99,10 @@ def create_app(
     limits: Limits | None = None,
     token: str | None = None,
 ) -> Starlette:
-    """The app; `make_document` gives each new page its own copy of the starting state (called on the parse
-    pool: a scene file is read again for each page). `allowed_hosts`: the host names the page may be reached
-    under (None: any, for a server listening beyond this machine, which then needs `token`). The app's Work is
-    `app.state.work`: shut it down when the server stops."""
+    """The app; `make_document` gives each new page its own copy of the starting state (on the parse pool when
+    it says `reads_files`: a scene file is read again for each page). `allowed_hosts`: the host names the page
+    may be reached under (None: any, for a server listening beyond this machine, which then needs `token`). The
+    app's Work is `app.state.work`: shut it down when the server stops."""
     work = Work(limits)
     idle = work.limits.idle
     pages = {"open": 0}
@@ -133,8 +133,9 @@ def create_app(
         pages["open"] += 1
         session = None
         try:
-            try:
-                doc = await work.call(work.parse, make_document)
+            try:  # a scene file is read again for each page: on the parse pool
+                slow = getattr(make_document, "reads_files", False)
+                doc = await work.call(work.parse, make_document) if slow else make_document()
             except Exception as err:  # a scene file that no longer reads: its line to the page; a bug: logged
                 if not isinstance(err, UserError):
                     log.exception("viewer page could not start")

@@ -1,8 +1,8 @@
 """The viewer's work and its limits: one bounded pool of threads for each kind of work, a time budget for every
 C render, one memory bound for all saves.
 
-    parse   SymPy (a new equation, a scene file, the generated C or YAML) and builds (the compiler): two
-            threads, so heavy equations queue up there and never stop the event loop; the libraries built are
+    parse   SymPy (a new equation, a scene file, the generated C or YAML) and builds (the compiler): one
+            thread, so heavy equations queue up there and never stop the event loop; the libraries built are
             kept for every page that shows the same shapes
     render  the pages' live frames, each encoded on the same thread: a few at once
     save    Save PNG: one at a time; the memory of every save asked for, running or waiting, is reserved when it
@@ -53,7 +53,7 @@ class Limits:
     save_memory: float = 2048.0  # MB reserved by all saves, running or waiting
     idle: float = 600.0  # seconds a page may send nothing before it is closed
     ping: float = 20.0  # seconds between WebSocket pings, and for the answer: a vanished peer is closed
-    parse_threads: int = 2  # one can compile (no GIL) while the other parses
+    parse_threads: int = 1  # SymPy holds the GIL: a second thread parses no faster and slows the event loop
     render_threads: int = 4
     save_threads: int = 1
 
