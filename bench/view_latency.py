@@ -1,6 +1,7 @@
 """Edit-to-picture latency and frame rate of `implgen view`, measured through the real server's WebSocket.
 
-    .venv/bin/python bench/view_latency.py [--rounds N] [--orbit-frames N] [-o bench/results/view.md]
+    .venv/bin/python bench/view_latency.py [--rounds N] [--orbit-frames N] [--neighbour-seconds S] [-o FILE]
+    .venv/bin/python bench/view_latency.py --neighbours-only     # the last measure alone, printed, not written
 
 Starts `implgen view --no-browser --port 0` in its own process with an empty build cache, connects as the page
 does, and for every example shape of degree <= 8, interleaved round by round, measures:
@@ -9,6 +10,9 @@ does, and for every example shape of degree <= 8, interleaved round by round, me
   - cached equation: the same edit sent again (generated code, objects and library all in the cache);
   - orbit: coarse frames per second while turning, each request sent when the previous frame has arrived;
   - refinement: from the coarse frame to the full 640 x 480, 4 samples per pixel frame of a resting view.
+Then, with heavy neighbours (project issue 22): one page orbits while three other pages keep sending
+`(x+y+z+a+b+1)^15` with a new constant each time (seconds of SymPy, then a build), and the orbiting page's
+frames per second and its longest wait for a frame are measured.
 Prints the medians and writes them, with the machine, to the results file.
 """
 
@@ -21,9 +25,11 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
+from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
 from implgen.bench.machine import describe as machine
@@ -103,6 +109,52 @@ class Page:
         return t1 - t0, t2 - t1
 
 
+NEIGHBOUR_EQUATION = "(x+y+z+a+b+1)^15"
+NEIGHBOURS = 3
+
+
+def neighbours(url: str, seconds: float) -> dict[str, float]:
+    """Orbit frames/s and the longest frame wait of one page while NEIGHBOURS pages send heavy new equations."""
+    stop = threading.Event()
+    sent = [0]
+
+    def neighbour(k: int) -> None:
+        page = Page(url)
+        n = 0
+        try:
+            while not stop.is_set():
+                n += 1
+                equation = f"{NEIGHBOUR_EQUATION} + {n}/{1000 + k}"  # never seen before: parsed and built
+                page.send({"type": "shape", "equation": equation, "params": {"a": 1, "b": 1}})
+                sent[0] += 1
+                try:
+                    page.reply()
+                except RuntimeError:
+                    pass  # refused: send the next one
+        except ConnectionClosed:
+            return  # the server stopped
+        page.ws.close()
+
+    good = Page(url)
+    good.frame(good.render(False), KIND_COARSE)  # its shape is built before the neighbours start
+    threads = [threading.Thread(target=neighbour, args=(k,), daemon=True) for k in range(NEIGHBOURS)]
+    for t in threads:
+        t.start()
+    time.sleep(1.0)  # their first equations are being parsed
+    frames, longest = 0, 0.0
+    start = time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        good.orbit["yaw"] = (good.orbit["yaw"] + 3.0) % 360.0
+        t0 = time.perf_counter()
+        good.frame(good.render(False), KIND_COARSE)
+        longest = max(longest, time.perf_counter() - t0)
+        frames += 1
+    elapsed = time.perf_counter() - start
+    stop.set()
+    good.ws.close()
+    return {"fps": frames / elapsed, "longest": longest, "equations": sent[0], "seconds": elapsed}
+
+
 def frame_for(spec, page: Page) -> None:
     """Point the page's camera at the shape (its box, else the clip ball) as the viewer does for a spec file."""
     from implgen.view.document import Document
@@ -126,8 +178,22 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=7)
     ap.add_argument("--orbit-frames", type=int, default=60, dest="orbit_frames")
+    ap.add_argument("--neighbour-seconds", type=float, default=20.0, dest="neighbour_seconds")
+    ap.add_argument("--neighbours-only", action="store_true", dest="neighbours_only")
     ap.add_argument("-o", "--output", type=Path, default=ROOT / "bench" / "results" / "view.md")
     args = ap.parse_args()
+    if args.neighbours_only:
+        with tempfile.TemporaryDirectory(prefix="implgen-bench-view-") as cache:
+            cmd = [sys.executable, "-m", "implgen.cli", "view", "--no-browser", "--port", "0"]
+            server = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True, env=dict(os.environ, IMPLGEN_CACHE=cache))
+            try:
+                line = server.stdout.readline()
+                url = "ws://" + line.split("http://", 1)[1].split("/", 1)[0] + "/ws"
+                print(neighbours(url, args.neighbour_seconds))
+            finally:
+                server.kill()
+                server.wait(30)
+        return 0
     specs = [s for s in (load_spec(p) for p in sorted(SHAPES.glob("*.yaml"))) if s.degree <= MAX_DEGREE]
     nonce = time.time_ns() % 10**9
     load_before = os.getloadavg()[0]
@@ -168,6 +234,7 @@ def main() -> int:
                         page.frame(page.render(False), KIND_COARSE)
                     add(spec.name, "fps", args.orbit_frames / (time.perf_counter() - start))
                     print(f"round {r + 1}/{args.rounds} {spec.name}", file=sys.stderr, flush=True)
+            busy = neighbours(url, args.neighbour_seconds) if args.neighbour_seconds > 0 else None
         finally:
             server.terminate()
             server.wait(30)
@@ -206,6 +273,14 @@ def main() -> int:
         f"server starts at most {MAX_RENDERS_PER_SECOND} renders a second per page, which caps the orbit rate.",
         "",
     ]
+    if busy is not None:
+        lines += [
+            f"With heavy neighbours: {NEIGHBOURS} other pages kept sending `{NEIGHBOUR_EQUATION} + n/k` (a new "
+            f"equation each time: seconds of SymPy on the parse pool, then a build; {busy['equations']} sent) "
+            f"while the torus page orbited for {busy['seconds']:.0f} s: {busy['fps']:.1f} coarse frames/s, the "
+            f"longest wait for a frame {busy['longest']:.3f} s.",
+            "",
+        ]
     text = "\n".join(lines)
     print(text)
     write_results(args.output, text)

@@ -224,7 +224,7 @@ def test_failures_are_one_error_reply_and_the_page_keeps_going(client, monkeypat
         }
         monkeypatch.undo()
         for raise_, reply in ((bug, "internal error: ZeroDivisionError"), (bad, "save_png: too big for today")):
-            monkeypatch.setattr(session_mod, "render", raise_)
+            monkeypatch.setattr(session_mod, "_file_png", raise_)  # the save, on its pool thread
             ws.send_text(json.dumps({"type": "save_png", "width": 32, "height": 32, "spp": 1}))
             assert ws.receive_json() == {"type": "error", "field": "message", "message": reply}
         ws.send_text(json.dumps({"type": "shape", "equation": "x^2 +"}))

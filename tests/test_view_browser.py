@@ -187,3 +187,33 @@ def test_the_page_in_a_real_browser(server, driver) -> None:
         time.sleep(1.0)
         driver.save_screenshot(shot)
     assert parse_spec({"name": "t", "equation": EQUATION, "params": {"c": 11.8}}).degree == 4
+
+
+def test_beyond_loopback_the_page_works_through_its_token(driver) -> None:
+    """A server listening on every address (as `--host 0.0.0.0`) asks for its token: the page opened with the
+    link's token draws its picture (the page hands the token to its socket); without it, the page is refused.
+    The browser reaches it on 127.0.0.1 only."""
+    sock = bind("0.0.0.0", 0)
+    holder: dict = {}
+    token = "t0ken-for-the-test_0123456789"
+    thread = threading.Thread(
+        target=serve,
+        args=(sock, document_factory(None), 2, lambda s: holder.setdefault("server", s)),
+        kwargs={"token": token},
+        daemon=True,
+    )
+    thread.start()
+    deadline = time.monotonic() + 30
+    while not getattr(holder.get("server"), "started", False):
+        assert time.monotonic() < deadline and thread.is_alive(), "the server did not start"
+        time.sleep(0.05)
+    url = f"http://127.0.0.1:{sock.getsockname()[1]}/"
+    try:
+        driver.get(url)
+        assert "token" in driver.find_element("tag name", "body").text
+        driver.get(f"{url}?token={token}")
+        wait_full_after(driver, -1)
+        assert canvas_pixels(driver).std() > 10
+    finally:
+        holder["server"].should_exit = True
+        thread.join(30)

@@ -1,13 +1,18 @@
 """`implgen view [SPEC.yaml | SCENE.yaml] [--port P] [--host H] [--no-browser]`: the interactive viewer.
 
 The file is read and checked like every input (a mapping with `objects` is a scene, anything else a spec);
-with no file the page starts from a torus. The socket is bound before anything starts, so a port in use is
-one line and exit status 2. The server runs until Ctrl-C.
+with no file the page starts from a torus. The limits (work.py) are read from IMPLGEN_VIEW_* variables and the
+socket is bound before anything starts, so a bad limit or a port in use is one line and exit status 2. Beyond
+loopback the server makes a token, prints the link with it and a warning line. The server runs until Ctrl-C,
+which cancels every render and returns within a second or two.
 """
 
 from __future__ import annotations
 
+import asyncio
+import secrets
 import socket
+import sys
 import threading
 import webbrowser
 from collections.abc import Sequence
@@ -17,11 +22,16 @@ from implgen.args import ArgumentParser
 from implgen.codegen.spec import parse_spec
 from implgen.errors import UserError
 from implgen.view.document import STARTER, Document
+from implgen.view.work import Limits
 from implgen.yamlfile import read_yaml
+
+SHUTDOWN_GRACE = 1  # seconds uvicorn waits for the pages' handlers at Ctrl-C (their renders are cancelled first)
 
 
 def document_factory(path: Path | None):
-    """A function giving each page a fresh Document for the file (parsed once, here)."""
+    """A function giving each page a fresh Document for the file (a spec parsed once, here: microseconds a page;
+    a scene read again for each page, so the function says `reads_files` and the server calls it on its parse
+    pool)."""
     from implgen.scene.load import parse_scene
 
     if path is None:
@@ -30,7 +40,12 @@ def document_factory(path: Path | None):
     data = read_yaml(path, what="spec or scene")
     if isinstance(data, dict) and "objects" in data:
         scene_path = path
-        return lambda: Document.for_scene(parse_scene(read_yaml(scene_path, what="scene"), scene_path))
+
+        def scene_document() -> Document:
+            return Document.for_scene(parse_scene(read_yaml(scene_path, what="scene"), scene_path))
+
+        scene_document.reads_files = True
+        return scene_document
     spec = parse_spec(data, str(path))
     return lambda: Document.for_spec(spec)
 
@@ -52,21 +67,72 @@ def bind(host: str, port: int) -> socket.socket:
     return sock
 
 
-def serve(sock: socket.socket, make_document, threads: int | None = None, on_ready=None) -> None:
-    """Run the server on a bound socket until it is stopped (Ctrl-C, or server.should_exit)."""
+def is_loopback(host: str) -> bool:
+    from implgen.view.server import LOOPBACK_HOSTS
+
+    return host in LOOPBACK_HOSTS or host.startswith("127.")
+
+
+def serve(
+    sock: socket.socket,
+    make_document,
+    threads: int | None = None,
+    on_ready=None,
+    limits: Limits | None = None,
+    token: str | None = None,
+) -> None:
+    """Run the server on a bound socket until it is stopped (Ctrl-C, or server.should_exit). A socket bound beyond
+    loopback needs a `token` (the page's link carries it)."""
     import uvicorn
 
     from implgen.view.protocol import MAX_MESSAGE
     from implgen.view.server import LOOPBACK_HOSTS, create_app
 
     host = sock.getsockname()[0]
-    loopback = host in LOOPBACK_HOSTS or host.startswith("127.")
-    app = create_app(make_document, threads=threads, allowed_hosts=(*LOOPBACK_HOSTS, host) if loopback else None)
-    config = uvicorn.Config(app, log_level="warning", ws_max_size=MAX_MESSAGE, lifespan="off")
-    server = uvicorn.Server(config)
+    loopback = is_loopback(host)
+    if not loopback and not token:
+        raise ValueError(f"a server listening on {host} needs a token")
+    limits = limits or Limits()
+    app = create_app(
+        make_document,
+        threads=threads,
+        allowed_hosts=(*LOOPBACK_HOSTS, host) if loopback else None,
+        limits=limits,
+        token=None if loopback else token,
+    )
+    config = uvicorn.Config(
+        app,
+        log_level="warning",
+        ws_max_size=MAX_MESSAGE,
+        ws_ping_interval=limits.ping,
+        ws_ping_timeout=limits.ping,
+        lifespan="off",
+        timeout_graceful_shutdown=SHUTDOWN_GRACE,
+    )
+    work = app.state.work
+    # the event loop's turn at the GIL comes sooner while SymPy parses on the parse pool (5 ms by default: a page
+    # orbiting beside three pages sending heavy equations measured 20 frames/s at 5 ms, 42 at 1 ms)
+    switch = sys.getswitchinterval()
+    sys.setswitchinterval(0.001)
+
+    class Server(uvicorn.Server):
+        def handle_exit(self, sig, frame) -> None:
+            """Ctrl-C: every render is cancelled at once and no page waits for its C threads to finish their
+            row (on the event loop: this is a signal handler, which must not take the pools' locks)."""
+            super().handle_exit(sig, frame)
+            try:
+                asyncio.get_running_loop().call_soon_threadsafe(work.shutdown)
+            except RuntimeError:  # no loop running in this thread: the `finally` below does it
+                pass
+
+    server = Server(config)
     if on_ready is not None:
         on_ready(server)
-    server.run(sockets=[sock])
+    try:
+        server.run(sockets=[sock])  # uvicorn then closes every socket, and waits SHUTDOWN_GRACE at most
+    finally:
+        work.shutdown()
+        sys.setswitchinterval(switch)
 
 
 EXAMPLES = (
@@ -94,13 +160,26 @@ def main(argv: Sequence[str]) -> int:
     args = ap.parse_args(list(argv))
     if not 0 <= args.port <= 65535:
         raise UserError("--port", f"{args.port} is outside [0, 65535]")
+    limits = Limits.from_env()
     make_document = document_factory(args.file)
     make_document()  # a scene's shapes are checked now, not when the first page connects
     sock = bind(args.host, args.port)
     host, port = sock.getsockname()[:2]
-    url = f"http://{'[' + host + ']' if ':' in host else host}:{port}/"
+    token = None
+    shown = host
+    if not is_loopback(host):
+        token = secrets.token_urlsafe(24)
+        if host in ("0.0.0.0", "::"):  # every address: the link names the machine
+            shown = socket.gethostname()
+        print(
+            f"implgen view: warning: listening on {host}:{port}, beyond this machine: anyone who can reach the "
+            "port and has the link (its token) can use the page and this machine's CPU",
+            file=sys.stderr,
+            flush=True,
+        )
+    url = f"http://{'[' + shown + ']' if ':' in shown else shown}:{port}/" + (f"?token={token}" if token else "")
     print(f"implgen view: {url}  (Ctrl-C stops)", flush=True)
     if not args.no_browser:
         threading.Timer(0.5, webbrowser.open, args=(url,)).start()
-    serve(sock, make_document)
+    serve(sock, make_document, limits=limits, token=token)
     return 0

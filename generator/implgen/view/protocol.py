@@ -10,7 +10,9 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
     {"type": "save_yaml"} / {"type": "show_c"}                        the spec or scene / the generated C
 
 Bad values raise UserError naming the message field; the session sends the line back to the page. Every
-error reply, whatever failed, is built here (`error`, `error_for`):
+error reply, whatever failed, is built here (`error`, `error_for`). An equation's parse (seconds of SymPy at
+high degree) is remembered, refusal included, for the last PARSE_CACHE mappings of text, params and bounds: the
+session runs it on its parse pool, never on the event loop.
 
     {"type": "error", "field": "equation" | "message", "message": "..."}
 """
@@ -18,6 +20,8 @@ error reply, whatever failed, is built here (`error`, `error_for`):
 from __future__ import annotations
 
 import json
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Any
 
@@ -33,6 +37,10 @@ MAX_SAVE = (8192, 8192)  # the largest saved picture
 MAX_SAVE_PIXELS = 8192 * 4608  # 8K at 16:9
 MAX_SAVE_SPP = 64
 TYPES = ("shape", "render", "save_png", "save_yaml", "show_c")
+PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
+
+_parsed: OrderedDict[str, Spec | UserError] = OrderedDict()
+_parsed_lock = threading.Lock()
 
 
 @dataclass
@@ -89,6 +97,27 @@ def _bounds_text(spec: Spec) -> dict[str, list[str]] | None:
     return {a: [format_expression(lo, names), format_expression(hi, names)] for a, (lo, hi) in spec.bounds.items()}
 
 
+def _parse(mapping: dict[str, Any]) -> Spec:
+    """parse_spec(mapping, "equation"), remembered by the mapping's JSON text (an LRU, thread-safe)."""
+    key = json.dumps(mapping, sort_keys=True)
+    with _parsed_lock:
+        hit = _parsed.get(key)
+        if hit is not None:
+            _parsed.move_to_end(key)
+    if hit is None:
+        try:
+            hit = parse_spec(mapping, "equation")
+        except UserError as err:
+            hit = err
+        with _parsed_lock:
+            _parsed[key] = hit
+            while len(_parsed) > PARSE_CACHE:
+                _parsed.popitem(last=False)
+    if isinstance(hit, UserError):
+        raise UserError(hit.source, hit.message)
+    return hit
+
+
 def parse_shape(data: dict, current: Spec) -> Spec:
     """A new equation and param defaults, through the spec parser. The current shape's name is kept, and its
     bounds while the equation stays the same (new defaults only): a box made for one surface would cut
@@ -97,12 +126,12 @@ def parse_shape(data: dict, current: Spec) -> Spec:
     if data.get("params"):
         mapping["params"] = _mapping("params", data["params"])
     if data.get("bounds") is not None:  # given: checked like a spec file's
-        return parse_spec({**mapping, "bounds": data["bounds"]}, "equation")
-    spec = parse_spec(mapping, "equation")
+        return _parse({**mapping, "bounds": data["bounds"]})
+    spec = _parse(mapping)
     bounds = _bounds_text(current)
     if bounds is not None and spec.equation == current.equation:
         try:
-            return parse_spec({**mapping, "bounds": bounds}, "equation")
+            return _parse({**mapping, "bounds": bounds})
         except UserError:
             pass  # a param the bounds need was removed: unbounded
     return spec

@@ -18,6 +18,7 @@
     home: null, // the orbit to go back to
   };
   let ws = null;
+  let lastError = ""; // the server's last error line, kept when the socket closes after it
   let seq = 0;
   let drawnSeq = -1;
   let drawnKind = -1;
@@ -162,6 +163,7 @@
     const fseq = view.getUint32(0), kind = view.getUint8(4);
     const w = view.getUint16(8), h = view.getUint16(10);
     const bytes = new Uint8Array(buf, HEADER);
+    lastError = "";
     if (kind === KIND_SAVE) {
       download(new Blob([bytes], { type: "image/png" }), "implgen-view.png");
       $("message").textContent = `saved ${w} x ${h} PNG`;
@@ -210,7 +212,7 @@
         $("equation").classList.add("bad");
         $("equation-error").textContent = msg.message;
       } else {
-        $("message").textContent = msg.message;
+        $("message").textContent = lastError = msg.message;
       }
     } else if (msg.type === "yaml") {
       download(new Blob([msg.text], { type: "application/yaml" }), msg.mode === "scene" ? "scene.yaml" : "shape.yaml");
@@ -222,10 +224,17 @@
 
   function connect() {
     const proto = location.protocol === "https:" ? "wss" : "ws";
-    ws = new WebSocket(`${proto}://${location.host}/ws`);
+    // a server listening beyond this machine gave its link a token: the socket asks for it too
+    const token = new URLSearchParams(location.search).get("token");
+    const query = token ? `?token=${encodeURIComponent(token)}` : "";
+    ws = new WebSocket(`${proto}://${location.host}/ws${query}`);
     ws.binaryType = "arraybuffer";
     ws.addEventListener("message", onMessage);
-    ws.addEventListener("close", () => { $("message").textContent = "disconnected from the server (reload to reconnect)"; });
+    ws.addEventListener("close", (e) => {
+      const why = e.reason ? `: ${e.reason}` : " (reload to reconnect)";
+      // the error the server closed after stays in view (a scene file that no longer reads)
+      $("message").textContent = `${lastError ? lastError + " - " : ""}disconnected from the server${why}`;
+    });
   }
 
   // ---------------------------------------------------------------- the picture: orbit, pan, zoom
@@ -285,6 +294,7 @@
   });
   $("save-png").addEventListener("click", () => {
     $("message").textContent = "rendering...";
+    lastError = "";
     send({ type: "save_png", width: parseInt($("save-width").value, 10), height: parseInt($("save-height").value, 10),
       spp: parseInt($("save-spp").value, 10) });
   });
