@@ -61,6 +61,11 @@ COMMANDS: dict[str, Command] = {
     "view": Command(
         "view [SPEC.yaml | SCENE.yaml] [options]", "the interactive viewer, in the browser", "implgen.view.command:main"
     ),
+    "share": Command(
+        "share SPEC.yaml -o PAGE.html [options]",
+        "one HTML file that draws the shape in any WebGL2 browser, from disk",
+        "implgen.share.command:main",
+    ),
     "bench": Command(
         "bench COMMAND [options]",
         "measurements: each prints a table and writes it, with the machine, to a results file (bench/README.md).",

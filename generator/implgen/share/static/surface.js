@@ -1,0 +1,422 @@
+// implgen share: the surface renderer. One object, IgSurface, with no page in it, so any page can draw a
+// generated shape with it: the shared page (implgen share) now, the viewer's GPU preview later.
+//
+//   const r = new IgSurface.Renderer(canvas);              // WebGL2; throws an Error saying why if there is none
+//   r.setEquationProgram({name, shape, runtime, params})   // '' or the compiler's log
+//   r.setParams([1.0, 0.25]);  r.setCamera({eye, target, up, fov});  r.setClip({kind: "sphere", size: 2});
+//   r.setColours({outside, inside, background});  r.setMarkUnsure(true);  r.setSize(640, 480);
+//   r.draw({scale: 1, rows: [y0, y1]});                     // draw now (all of it, or a band); milliseconds
+//   const p = new IgSurface.Progressive(r, {onIdle});      // redraw on change only, coarse first, in bands
+//   p.invalidate(moving);
+//
+// docs/share.md describes the API and the picture it draws; docs/glsl.md the shader it is built from. Plain
+// JavaScript, no build step, nothing fetched: the shape's and the runtime's GLSL come in as strings.
+"use strict";
+
+const IgSurface = (() => {
+  const NAME = /^[A-Za-z][A-Za-z0-9_]{0,63}$/;
+  const VERTEX = "#version 300 es\nin vec2 p;\nvoid main() { gl_Position = vec4(p, 0.0, 1.0); }\n";
+  const HEADER = "#version 300 es\nprecision highp float;\nprecision highp int;\n";
+  const CLIPS = { none: 0, sphere: 1, box: 2 };
+  const MATERIAL = "0.12, 0.75, 0.45, 40.0"; // ambient, diffuse, specular, shininess: the viewer's material
+  const LIGHT = [-0.6, 0.8, 1.0]; // towards the key light, in the camera's right, up and back
+
+  // The page's main: camera ray, clip, the shape's solid cut by the clip (its cut face in the inside colour),
+  // two-sided shading, the flagged pixels marked. SHAPE is the shape's name (checked against NAME first).
+  const MAIN = `
+uniform vec2 ig_page_size;
+uniform vec3 ig_page_eye;
+uniform vec3 ig_page_look;
+uniform vec3 ig_page_up;
+uniform float ig_page_fov;
+uniform int ig_page_clip;        // 0 none, 1 sphere of radius ig_page_clip_size, 2 box [-size, size]^3
+uniform float ig_page_clip_size;
+uniform vec3 ig_page_outside;
+uniform vec3 ig_page_inside;
+uniform vec3 ig_page_background;
+uniform vec3 ig_page_light;      // towards the light, in the camera's right, up and back
+uniform int ig_page_mark;        // 1: pixels flagged IG_UNSURE get the magenta checker
+out vec4 ig_page_colour;
+
+// The sign of f where the ray enters the clip, certified (+1 outside the solid, -1 inside, 0 float cannot
+// tell); outside the shape's box the solid is not there (a leaf is its solid cut by its box).
+int ig_page_side(vec3 o, vec3 d, float t0, out float guess)
+{
+    vec3 p = o + t0 * d;
+    vec3 lo, hi;
+    SHAPE_bounds(lo, hi);
+    guess = 1.0;
+    if (any(lessThan(p, lo)) || any(greaterThan(p, hi))) {
+        return 1;
+    }
+    vec3 e = (IG_ULP * (abs(t0 * d) + abs(p))) * (1.0 + IG_UP_REL) + IG_TINY;
+    vec3 f = SHAPE_raa(ig_raa_var(p.x, 0.0, e.x), ig_raa_var(p.y, 0.0, e.y), ig_raa_var(p.z, 0.0, e.z));
+    guess = f.x;
+    return ig_raa_sign(f);
+}
+
+vec3 ig_page_clip_normal(vec3 p)
+{
+    if (ig_page_clip == 1) {
+        return normalize(p);
+    }
+    vec3 a = abs(p);
+    vec3 axis = a.x >= a.y && a.x >= a.z ? vec3(1.0, 0.0, 0.0) : (a.y >= a.z ? vec3(0.0, 1.0, 0.0) : vec3(0.0, 0.0, 1.0));
+    return axis * sign(p);
+}
+
+void main()
+{
+    vec2 pixel = vec2(gl_FragCoord.x, ig_page_size.y - gl_FragCoord.y);
+    IgCamera cam = ig_camera(ig_page_eye, ig_page_look, ig_page_up, ig_page_fov, ig_page_size);
+    vec3 d = ig_camera_dir(cam, pixel, ig_page_size);
+    vec3 to_light = ig_page_light.x * cam.u + ig_page_light.y * cam.v + ig_page_light.z * cam.w;
+    IgMaterial m = IgMaterial(ig_page_outside, ig_page_inside, MATERIAL);
+    float t0 = 0.0;
+    float t1 = ig_inf();
+    bool open = true;
+    if (ig_page_clip == 1) {
+        open = ig_clip_sphere(cam.eye, d, vec3(0.0), ig_page_clip_size, t0, t1);
+    } else if (ig_page_clip == 2) {
+        open = ig_clip_box(cam.eye, d, vec3(-ig_page_clip_size), vec3(ig_page_clip_size), t0, t1);
+    }
+    int status = 0;
+    vec3 rgb = ig_page_background;
+    if (open) {
+        int side = 1;
+        float guess = 1.0;
+        if (ig_page_clip != 0 && t0 > 0.0) {
+            side = ig_page_side(cam.eye, d, t0, guess);
+        }
+        if (side < 0 || (side == 0 && guess < 0.0)) { // the cut face: the solid's inside, flat on the clip
+            status = IG_HIT | (side == 0 ? IG_UNSURE : 0);
+            vec3 n = ig_page_clip_normal(cam.eye + t0 * d);
+            rgb = ig_shade(IgMaterial(ig_page_inside, ig_page_inside, MATERIAL), n, d, to_light);
+        } else {
+            float t;
+            vec3 n;
+            status = SHAPE_hit(cam.eye, d, t0, t1, t, n) | (side == 0 ? IG_UNSURE : 0);
+            if ((status & IG_HIT) != 0) {
+                rgb = ig_shade(m, n, d, to_light);
+            }
+        }
+    }
+    if (ig_page_mark != 0 && (status & IG_UNSURE) != 0) {
+        rgb = ig_mark_unsure(rgb, pixel);
+    }
+    ig_page_colour = vec4(clamp(rgb, 0.0, 1.0), 1.0);
+}
+`;
+
+  /** The fragment shader for a shape: header, runtime, shape, main (docs/glsl.md, "A program"). */
+  function fragmentSource(name, shape, runtime) {
+    if (!NAME.test(name)) throw new Error(`not a shape name: ${JSON.stringify(name)}`);
+    const main = MAIN.replaceAll("SHAPE", name).replaceAll("MATERIAL", MATERIAL);
+    return HEADER + runtime + "\n" + shape + "\n" + main;
+  }
+
+  const finite3 = (v, what) => {
+    if (!Array.isArray(v) || v.length !== 3 || !v.every(Number.isFinite)) throw new Error(`${what}: three numbers`);
+    return v.map(Number);
+  };
+
+  class Renderer {
+    constructor(canvas) {
+      this.canvas = canvas;
+      // preserveDrawingBuffer: a frame drawn in bands over several animation frames stays on the canvas
+      const gl = canvas.getContext("webgl2", { antialias: false, preserveDrawingBuffer: true, alpha: false });
+      if (!gl) throw new Error("this browser has no WebGL2");
+      this.gl = gl;
+      this.prog = null;
+      this.name = "";
+      this.nparams = 0;
+      this.params = [];
+      this.camera = { eye: [3, 2, 4], target: [0, 0, 0], up: [0, 1, 0], fov: 40 };
+      this.clip = { kind: "none", size: 1 };
+      this.colours = { outside: [0.95, 0.75, 0.3], inside: [0.35, 0.55, 0.95], background: [0.12, 0.12, 0.14] };
+      this.markUnsure = true;
+      this.width = canvas.width;
+      this.height = canvas.height;
+      this.coarse = null; // {fbo, rb, w, h}: the target of scaled-down draws
+      const vbo = gl.createBuffer();
+      gl.bindBuffer(gl.ARRAY_BUFFER, vbo);
+      gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-1, -1, 3, -1, -1, 3]), gl.STATIC_DRAW);
+      gl.enableVertexAttribArray(0);
+      gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 0, 0);
+    }
+
+    /** Which WebGL2 this is: [version, renderer]. */
+    info() {
+      const gl = this.gl;
+      const e = gl.getExtension("WEBGL_debug_renderer_info");
+      return [gl.getParameter(gl.VERSION), e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER)];
+    }
+
+    /** A new shape: `name` (an identifier), `shape` (its generated GLSL), `runtime` (runtime_glsl/, concatenated),
+     * `params` (how many it takes). Returns '' or the compiler's log; on failure the old program stays. */
+    setEquationProgram({ name, shape, runtime, params }) {
+      const gl = this.gl;
+      let src;
+      try {
+        src = fragmentSource(name, shape, runtime);
+      } catch (err) {
+        return String(err.message || err);
+      }
+      const compile = (type, text) => {
+        const s = gl.createShader(type);
+        gl.shaderSource(s, text);
+        gl.compileShader(s);
+        if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) {
+          const log = gl.getShaderInfoLog(s) || "the shader did not compile";
+          gl.deleteShader(s);
+          throw new Error(log);
+        }
+        return s;
+      };
+      try {
+        const prog = gl.createProgram();
+        gl.attachShader(prog, compile(gl.VERTEX_SHADER, VERTEX));
+        gl.attachShader(prog, compile(gl.FRAGMENT_SHADER, src));
+        gl.bindAttribLocation(prog, 0, "p");
+        gl.linkProgram(prog);
+        if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) {
+          const log = gl.getProgramInfoLog(prog) || "the program did not link";
+          gl.deleteProgram(prog);
+          throw new Error(log);
+        }
+        if (this.prog) gl.deleteProgram(this.prog);
+        this.prog = prog;
+      } catch (err) {
+        return String(err.message || err);
+      }
+      this.name = name;
+      this.nparams = params | 0;
+      this.params = new Array(this.nparams).fill(0);
+      this.uniforms = {};
+      return "";
+    }
+
+    /** The params' values, in the order the spec declares them. */
+    setParams(values) {
+      const v = Array.from(values, Number);
+      if (v.length !== this.nparams || !v.every(Number.isFinite)) {
+        throw new Error(`setParams: ${this.nparams} finite numbers`);
+      }
+      this.params = v;
+    }
+
+    /** Pinhole camera: eye, target, up (world), vertical field of view in degrees. */
+    setCamera({ eye, target, up, fov }) {
+      if (!(fov > 0 && fov < 180)) throw new Error("setCamera: fov in (0, 180) degrees");
+      this.camera = { eye: finite3(eye, "eye"), target: finite3(target, "target"), up: finite3(up, "up"), fov: +fov };
+    }
+
+    /** kind: "none", "sphere" (radius size, about the origin) or "box" ([-size, size]^3). */
+    setClip({ kind, size }) {
+      if (!(kind in CLIPS)) throw new Error(`setClip: kind is one of ${Object.keys(CLIPS).join(", ")}`);
+      if (!(size > 0 && Number.isFinite(size))) throw new Error("setClip: size > 0");
+      this.clip = { kind, size: +size };
+    }
+
+    /** outside (f > 0 side), inside (f < 0 side, and the clip's cut faces), background: RGB in [0, 1]. */
+    setColours({ outside, inside, background }) {
+      this.colours = {
+        outside: finite3(outside ?? this.colours.outside, "outside"),
+        inside: finite3(inside ?? this.colours.inside, "inside"),
+        background: finite3(background ?? this.colours.background, "background"),
+      };
+    }
+
+    /** Whether pixels float could not decide (IG_UNSURE) get the runtime's magenta checker. */
+    setMarkUnsure(on) {
+      this.markUnsure = !!on;
+    }
+
+    /** The drawing buffer's size in pixels (the canvas's CSS size is the page's business). */
+    setSize(width, height) {
+      width = Math.max(1, Math.min(8192, Math.round(width)));
+      height = Math.max(1, Math.min(8192, Math.round(height)));
+      if (width !== this.canvas.width) this.canvas.width = width;
+      if (height !== this.canvas.height) this.canvas.height = height;
+      this.width = width;
+      this.height = height;
+    }
+
+    _uniforms(w, h) {
+      const gl = this.gl;
+      const prog = this.prog;
+      const loc = (n) => gl.getUniformLocation(prog, n);
+      const c = this.camera;
+      gl.uniform2f(loc("ig_page_size"), w, h);
+      gl.uniform3fv(loc("ig_page_eye"), c.eye);
+      gl.uniform3fv(loc("ig_page_look"), c.target);
+      gl.uniform3fv(loc("ig_page_up"), c.up);
+      gl.uniform1f(loc("ig_page_fov"), c.fov);
+      gl.uniform1i(loc("ig_page_clip"), CLIPS[this.clip.kind]);
+      gl.uniform1f(loc("ig_page_clip_size"), this.clip.size);
+      gl.uniform3fv(loc("ig_page_outside"), this.colours.outside);
+      gl.uniform3fv(loc("ig_page_inside"), this.colours.inside);
+      gl.uniform3fv(loc("ig_page_background"), this.colours.background);
+      gl.uniform3fv(loc("ig_page_light"), LIGHT);
+      gl.uniform1i(loc("ig_page_mark"), this.markUnsure ? 1 : 0);
+      if (this.nparams > 0) gl.uniform1fv(loc(`${this.name}_params`), this.params);
+    }
+
+    /** Draw now. scale > 1 draws (width/scale) x (height/scale) pixels and stretches them over the canvas;
+     * rows = [y0, y1] draws only those rows (image rows, 0 at the top) at full size. Returns the milliseconds
+     * it took, the GPU's work included (it waits for it). */
+    draw({ scale = 1, rows = null } = {}) {
+      const gl = this.gl;
+      if (!this.prog) return 0;
+      const start = performance.now();
+      const w = this.width;
+      const h = this.height;
+      gl.useProgram(this.prog);
+      if (scale > 1) {
+        const cw = Math.max(1, Math.ceil(w / scale));
+        const ch = Math.max(1, Math.ceil(h / scale));
+        this._coarseTarget(cw, ch);
+        gl.bindFramebuffer(gl.FRAMEBUFFER, this.coarse.fbo);
+        gl.disable(gl.SCISSOR_TEST);
+        gl.viewport(0, 0, cw, ch);
+        this._uniforms(cw, ch);
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+        gl.bindFramebuffer(gl.READ_FRAMEBUFFER, this.coarse.fbo);
+        gl.bindFramebuffer(gl.DRAW_FRAMEBUFFER, null);
+        gl.blitFramebuffer(0, 0, cw, ch, 0, 0, w, h, gl.COLOR_BUFFER_BIT, gl.NEAREST);
+        gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+      } else {
+        gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+        gl.viewport(0, 0, w, h);
+        this._uniforms(w, h);
+        if (rows) {
+          const y0 = Math.max(0, Math.min(h, rows[0] | 0));
+          const y1 = Math.max(y0, Math.min(h, rows[1] | 0));
+          gl.enable(gl.SCISSOR_TEST);
+          gl.scissor(0, h - y1, w, y1 - y0);
+        } else {
+          gl.disable(gl.SCISSOR_TEST);
+        }
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+        gl.disable(gl.SCISSOR_TEST);
+      }
+      gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4)); // wait for the GPU
+      return performance.now() - start;
+    }
+
+    _coarseTarget(w, h) {
+      const gl = this.gl;
+      if (this.coarse && this.coarse.w === w && this.coarse.h === h) return;
+      if (this.coarse) {
+        gl.deleteFramebuffer(this.coarse.fbo);
+        gl.deleteRenderbuffer(this.coarse.rb);
+      }
+      const rb = gl.createRenderbuffer();
+      gl.bindRenderbuffer(gl.RENDERBUFFER, rb);
+      gl.renderbufferStorage(gl.RENDERBUFFER, gl.RGBA8, w, h);
+      const fbo = gl.createFramebuffer();
+      gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
+      gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.RENDERBUFFER, rb);
+      this.coarse = { fbo, rb, w, h };
+    }
+
+    /** The canvas's pixels, RGBA, bottom row first (gl.readPixels). */
+    readPixels() {
+      const gl = this.gl;
+      gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+      const out = new Uint8Array(4 * this.width * this.height);
+      gl.readPixels(0, 0, this.width, this.height, gl.RGBA, gl.UNSIGNED_BYTE, out);
+      return out;
+    }
+  }
+
+  /** Redraws a Renderer only when something changed, one step per animation frame: a coarse frame first
+   * (as coarse as it takes to fit `budget` ms), then, unless the view is still moving, the full frame in
+   * bands of rows of about `budget` ms each, so the page stays responsive on a slow GPU. */
+  class Progressive {
+    constructor(renderer, { budget = 40, onStep = null, onIdle = null } = {}) {
+      this.r = renderer;
+      this.budget = budget;
+      this.onStep = onStep;
+      this.onIdle = onIdle;
+      this.msPerPixel = null; // measured
+      this.coarseDone = false;
+      this.moving = false;
+      this.row = 0;
+      this.pending = false;
+      this.idle = true;
+      this.generation = 0; // counts invalidations, for tests and pages
+    }
+
+    /** Something changed; `moving`: more changes are coming (a drag), so draw coarse frames only. */
+    invalidate(moving = false) {
+      this.generation += 1;
+      this.moving = !!moving;
+      this.coarseDone = false;
+      this.row = 0;
+      this.idle = false;
+      this._schedule();
+    }
+
+    /** The drag ended: finish the frame at full size. */
+    settle() {
+      if (!this.moving) return;
+      this.moving = false;
+      this.idle = false;
+      this._schedule();
+    }
+
+    _schedule() {
+      if (this.pending) return;
+      this.pending = true;
+      requestAnimationFrame(() => {
+        this.pending = false;
+        this._step();
+      });
+    }
+
+    _scale() {
+      if (this.msPerPixel === null) return 8;
+      const pixels = this.r.width * this.r.height;
+      for (const s of [1, 2, 4, 8, 16]) {
+        if ((this.msPerPixel * pixels) / (s * s) <= this.budget) return s;
+      }
+      return 16;
+    }
+
+    _measure(ms, pixels) {
+      const per = ms / Math.max(1, pixels);
+      this.msPerPixel = this.msPerPixel === null ? per : 0.5 * (this.msPerPixel + per);
+    }
+
+    _step() {
+      const r = this.r;
+      const w = r.width;
+      const h = r.height;
+      if (!this.coarseDone) {
+        const scale = this._scale();
+        const ms = r.draw({ scale });
+        this._measure(ms, Math.ceil(w / scale) * Math.ceil(h / scale));
+        this.coarseDone = true;
+        this.row = scale === 1 ? h : 0; // a full-size "coarse" frame is the frame
+      } else if (!this.moving && this.row < h) {
+        const rows = Math.max(1, Math.min(h - this.row, Math.floor(this.budget / (this.msPerPixel * w + 1e-9))));
+        const ms = r.draw({ rows: [this.row, this.row + rows] });
+        this._measure(ms, rows * w);
+        this.row += rows;
+      }
+      const done = this.coarseDone && (this.moving || this.row >= h);
+      if (this.onStep) this.onStep(this);
+      if (done) {
+        this.idle = !this.moving;
+        if (this.idle && this.onIdle) this.onIdle(this);
+      } else {
+        this._schedule();
+      }
+    }
+  }
+
+  return { Renderer, Progressive, fragmentSource, CLIPS, LIGHT };
+})();
+
+if (typeof window !== "undefined") window.IgSurface = IgSurface;
