@@ -110,7 +110,7 @@ def framing(spec: Spec, values: dict[str, float]) -> tuple[dict, float]:
 
 
 def _hex(rgb: tuple[float, float, float]) -> str:
-    return "#" + "".join(f"{round(max(0.0, min(1.0, c)) * 255):02x}" for c in rgb)
+    return "#" + "".join(f"{math.floor(max(0.0, min(1.0, c)) * 255 + 0.5):02x}" for c in rgb)
 
 
 def _number(v: float) -> str:
