@@ -132,7 +132,7 @@ def _b64(a: np.ndarray) -> str:
 class WebGL:
     """One headless Chromium with the harness page; use as a context manager (the browser is closed after)."""
 
-    def __init__(self, timeout: float = 900.0) -> None:
+    def __init__(self, timeout: float = 900.0, console_log: bool = False) -> None:
         from selenium import webdriver
         from selenium.webdriver.chrome.service import Service
 
@@ -140,13 +140,22 @@ class WebGL:
         opts.binary_location = shutil.which("chromium") or "chromium"
         for arg in FLAGS:
             opts.add_argument(arg)
+        if console_log:  # the pages' console, for driver.get_log("browser")
+            opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
         self.driver = webdriver.Chrome(service=Service(shutil.which("chromedriver") or "chromedriver"), options=opts)
         self.driver.set_script_timeout(timeout)
         self.driver.set_page_load_timeout(timeout)
+        try:
+            self.harness()
+        except RuntimeError:
+            self.close()
+            raise
+
+    def harness(self) -> None:
+        """Load the harness page (again, after the driver has visited another page, e.g. a shared page)."""
         self.driver.get("about:blank")
         err = self.driver.execute_script(_HARNESS)
         if err:
-            self.close()
             raise RuntimeError(f"headless Chromium has no usable WebGL2: {err}")
 
     def __enter__(self) -> WebGL:

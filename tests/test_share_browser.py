@@ -1,0 +1,310 @@
+"""`implgen share`'s page in a real browser: headless Chromium (WebGL2 on SwiftShader) opens the file from disk
+(file://, no server) and is used as a person would: it draws, a slider moves the picture, a drag turns it, the
+wheel zooms, the flagged pixels' marking switches on and off.
+
+The reference is the GLSL test harness (implgen.bench.webgl, as in tests/test_glsl_browser.py): the shape's
+generated GLSL and the runtime assembled by glslprogram.program with a main written here from docs/share.md's
+description of the picture (camera, clip, two-sided shading, the key light), at the page's camera and params.
+The page's canvas must equal it: colours within 2 of 255 on every pixel the reference did not flag, and on
+flagged pixels the reference's colour or the magenta checker. 160 x 120 pixels: SwiftShader is a CPU.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import math
+import time
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from conftest import SHAPES_DIR
+from implgen.cli import main
+from implgen.codegen.emit import generate
+from implgen.codegen.glslprogram import program
+from implgen.codegen.spec import load_spec, parse_spec
+
+pytestmark = pytest.mark.needs_program("chromium", "chromedriver")
+SIZE = (160, 120)
+WAIT = 300  # seconds; generous (a busy machine), nothing here is a timing
+LIGHT = [-0.6, 0.8, 1.0]  # docs/share.md: towards the key light in the camera's right, up, back
+MATERIAL = "0.12, 0.75, 0.45, 40.0"  # ambient, diffuse, specular, shininess
+
+REFERENCE_MAIN = """
+uniform vec2 size;
+uniform vec3 eye;
+uniform vec3 look;
+uniform vec3 up;
+uniform float fov;
+uniform float clip_r;
+uniform vec3 outside;
+uniform vec3 inside;
+uniform vec3 bg;
+uniform vec3 light;
+out vec4 ig_test_out;
+void main()
+{
+    vec2 pixel = vec2(gl_FragCoord.x, size.y - gl_FragCoord.y);
+    IgCamera cam = ig_camera(eye, look, up, fov, size);
+    vec3 d = ig_camera_dir(cam, pixel, size);
+    float t0 = 0.0, t1 = ig_inf(), t;
+    vec3 n;
+    int status = ig_clip_sphere(cam.eye, d, vec3(0.0), clip_r, t0, t1) ? NAME_hit(cam.eye, d, t0, t1, t, n) : 0;
+    vec3 to_light = light.x * cam.u + light.y * cam.v + light.z * cam.w;
+    vec3 rgb = (status & IG_HIT) != 0 ? ig_shade(IgMaterial(outside, inside, MATERIAL), n, d, to_light) : bg;
+    ig_test_out = vec4(clamp(rgb, 0.0, 1.0), float(status));
+}
+""".replace("MATERIAL", MATERIAL)
+
+
+@pytest.fixture(scope="module")
+def gl():
+    from implgen.bench.webgl import WebGL
+
+    with WebGL(console_log=True) as browser:
+        yield browser
+
+
+def make_page(tmp_path, spec_path, *args: str):
+    out = tmp_path / f"{spec_path.stem}.html"
+    assert main(["share", str(spec_path), "-o", str(out), "-q", *args]) == 0
+    return out
+
+
+def wait_idle(d) -> None:
+    deadline = time.monotonic() + WAIT
+    while not d.execute_script("return !!(window.implgenShare && window.implgenShare.idle && implgenShare.idle());"):
+        err = d.execute_script("return window.implgenShare && window.implgenShare.error;")
+        assert not err, err
+        assert time.monotonic() < deadline, "the page did not finish drawing"
+        time.sleep(0.05)
+
+
+def open_page(gl, path, size=SIZE):
+    d = gl.driver
+    d.get(path.as_uri())
+    deadline = time.monotonic() + WAIT
+    while not d.execute_script("return !!window.implgenShare;"):
+        assert time.monotonic() < deadline, "the page did not start"
+        time.sleep(0.05)
+    err = d.execute_script("return window.implgenShare.error || '';")
+    assert not err, err
+    d.execute_script("implgenShare.fixSize(arguments[0], arguments[1]);", *size)
+    wait_idle(d)
+    return d
+
+
+def canvas(d) -> np.ndarray:
+    """The canvas's pixels (h, w, 4) uint8, bottom row first (as gl.readPixels and the harness give them)."""
+    b64 = d.execute_script(
+        "const p = implgenShare.renderer.readPixels(); let s = '';"
+        "for (let i = 0; i < p.length; i += 32768) s += String.fromCharCode.apply(null, p.subarray(i, i + 32768));"
+        "return btoa(s);"
+    )
+    w, h = d.execute_script("return [implgenShare.renderer.width, implgenShare.renderer.height];")
+    return np.frombuffer(base64.b64decode(b64), np.uint8).reshape(h, w, 4)
+
+
+def shown(d) -> np.ndarray:
+    """What the canvas shows, through canvas.toDataURL (a PNG), top row first."""
+    url = d.execute_script("return document.getElementById('ig-canvas').toDataURL('image/png');")
+    return np.asarray(Image.open(io.BytesIO(base64.b64decode(url.split(",", 1)[1]))).convert("RGBA"))
+
+
+def page_state(d) -> dict:
+    return d.execute_script(
+        "const r = implgenShare.renderer;"
+        "return {camera: r.camera, params: r.params, clip: r.clip, colours: r.colours, mark: r.markUnsure,"
+        " orbit: {yaw: implgenShare.orbit.yaw, pitch: implgenShare.orbit.pitch,"
+        " distance: implgenShare.orbit.distance, target: implgenShare.orbit.target, fov: implgenShare.orbit.fov}};"
+    )
+
+
+def orbit_camera(o: dict) -> dict:
+    """The viewer's orbit (docs/viewer.md), computed here: yaw about +y, pitch above the x-z plane."""
+    y, p = math.radians(o["yaw"]), math.radians(o["pitch"])
+    back = np.array([math.cos(p) * math.sin(y), math.sin(p), math.cos(p) * math.cos(y)])
+    right = np.array([math.cos(y), 0.0, -math.sin(y)])
+    return {"eye": np.add(o["target"], o["distance"] * back), "up": np.cross(back, right)}
+
+
+def reference(gl, spec, state: dict, size=SIZE) -> np.ndarray:
+    """The harness's picture at the page's camera, params, clip sphere and colours: (h, w, 4) float32, bottom row
+    first; channel 3 is the status (1 hit, 2 flagged)."""
+    cam = state["camera"]
+    want = orbit_camera(state["orbit"])
+    assert np.allclose(cam["eye"], want["eye"], rtol=0, atol=1e-9) and np.allclose(cam["up"], want["up"], atol=1e-12)
+    assert state["clip"]["kind"] == "sphere"
+    uniforms = {
+        "size": [float(size[0]), float(size[1])],
+        "eye": cam["eye"],
+        "look": cam["target"],
+        "up": cam["up"],
+        "fov": [cam["fov"]],
+        "clip_r": [state["clip"]["size"]],
+        "outside": state["colours"]["outside"],
+        "inside": state["colours"]["inside"],
+        "bg": state["colours"]["background"],
+        "light": LIGHT,
+    }
+    if spec.params:
+        uniforms[f"{spec.name}_params"] = state["params"]
+    frag = program([generate(spec, ("glsl",))[f"{spec.name}.glsl"]], REFERENCE_MAIN.replace("NAME", spec.name))
+    gl.harness()
+    out, _ = gl.run(frag, size, uniforms)
+    return out
+
+
+def compare(page: np.ndarray, ref: np.ndarray, background, marked: bool = True) -> dict:
+    """The page equals the reference: colours within 2 of 255 where the reference did not flag; where it did, the
+    reference's colour or (marked) the magenta checker on odd pixels."""
+    h, w = ref.shape[:2]
+    status = ref[..., 3].astype(int)
+    flagged = (status & 2) != 0
+    hit = (status & 1) != 0
+    want = np.round(np.clip(ref[..., :3], 0, 1) * 255)
+    diff = np.abs(page[..., :3].astype(int) - want).max(-1)
+    assert (diff[~flagged] <= 2).all(), f"{(diff[~flagged] > 2).sum()} pixels differ, by up to {diff.max()}"
+    rows, cols = np.indices((h, w))
+    odd = (cols + (h - 1 - rows)) % 2 == 1  # the runtime's checker, in image coordinates (y down)
+    magenta = (page[..., :3] == (255, 0, 255)).all(-1)
+    if marked:
+        assert (magenta[flagged & odd]).all() and (diff[flagged & ~odd] <= 2).all()
+    else:
+        assert (diff[flagged] <= 2).all()
+    bg = np.round(np.asarray(background) * 255)
+    page_hit = (np.abs(page[..., :3].astype(int) - bg) > 2).any(-1)
+    assert (page_hit == hit)[~flagged].all()
+    return {"hit": hit, "flagged": flagged, "page_hit": page_hit}
+
+
+def test_the_page_draws_what_the_glsl_test_render_draws(gl, tmp_path):
+    spec = load_spec(SHAPES_DIR / "torus_y.yaml")
+    d = open_page(gl, make_page(tmp_path, SHAPES_DIR / "torus_y.yaml"))
+    page = canvas(d)
+    assert (shown(d)[::-1] == page).all()  # what readPixels gives is what the canvas shows
+    state = page_state(d)
+    assert state["params"] == [1.0, 0.25] and state["mark"] is True
+    assert d.execute_script("return IgSurface.LIGHT;") == LIGHT
+    r = compare(page, reference(gl, spec, state), state["colours"]["background"])
+    hit = r["page_hit"]
+    assert 0.1 < hit.mean() < 0.7  # the torus fills the middle of the picture
+    rows, cols = np.nonzero(hit)
+    assert abs(cols.mean() - SIZE[0] / 2) < 0.1 * SIZE[0] and abs(rows.mean() - SIZE[1] / 2) < 0.15 * SIZE[1]
+    assert not hit[:, :5].any() and not hit[:, -5:].any()  # the box is framed whole
+    severe = [e for e in d.get_log("browser") if e["level"] == "SEVERE"]
+    assert not severe, severe
+
+
+def test_a_slider_moves_the_picture(gl, tmp_path):
+    """b (the tube's radius) from 0.25 to 0.45 through the slider's own input and change events: the tube gets
+    thicker, the value is shown, and the picture is the reference's at b = 0.45."""
+    spec = load_spec(SHAPES_DIR / "torus_y.yaml")
+    d = open_page(gl, make_page(tmp_path, SHAPES_DIR / "torus_y.yaml"))
+    before = canvas(d)
+    d.execute_script(
+        "const s = document.querySelector('input[data-param=\"1\"]'); s.value = '0.45';"
+        "s.dispatchEvent(new Event('input')); s.dispatchEvent(new Event('change'));"
+    )
+    wait_idle(d)
+    assert d.execute_script("return document.getElementById('ig-value-1').textContent;") == "0.45"
+    state = page_state(d)
+    assert state["params"] == [1.0, 0.45]
+    after = canvas(d)
+    r = compare(after, reference(gl, spec, state), state["colours"]["background"])
+    bg = np.round(np.asarray(state["colours"]["background"]) * 255)
+    hit_before = (np.abs(before[..., :3].astype(int) - bg) > 2).any(-1)
+    assert r["page_hit"].sum() > 1.3 * hit_before.sum()
+
+
+def test_drag_turns_and_the_wheel_zooms(gl, tmp_path):
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.actions.wheel_input import ScrollOrigin
+    from selenium.webdriver.common.by import By
+
+    spec = load_spec(SHAPES_DIR / "torus_y.yaml")
+    d = open_page(gl, make_page(tmp_path, SHAPES_DIR / "torus_y.yaml"))
+    before = canvas(d)
+    yaw0, pitch0, dist0 = (page_state(d)["orbit"][k] for k in ("yaw", "pitch", "distance"))
+    el = d.find_element(By.ID, "ig-canvas")
+    ActionChains(d).move_to_element(el).click_and_hold().move_by_offset(25, 0).move_by_offset(
+        25, 10
+    ).release().perform()
+    wait_idle(d)
+    o = page_state(d)["orbit"]
+    assert o["yaw"] == pytest.approx(yaw0 - 50 * 0.4) and o["pitch"] == pytest.approx(pitch0 + 10 * 0.4)
+    turned = canvas(d)
+    assert (np.abs(turned.astype(int) - before).max(-1) > 2).mean() > 0.05
+    ActionChains(d).scroll_from_origin(ScrollOrigin.from_element(el), 0, 100).perform()
+    time.sleep(0.3)  # the wheel's rest timer (180 ms) settles the frame
+    wait_idle(d)
+    state = page_state(d)
+    assert state["orbit"]["distance"] == pytest.approx(dist0 * math.exp(100 * 0.002))
+    compare(canvas(d), reference(gl, spec, state), state["colours"]["background"])
+
+
+def test_flagged_pixels_are_marked_and_the_mark_switches_off(gl, tmp_path):
+    """z^2 = 0 touches the plane z = 0 with a double root: float cannot certify any crossing, so every ray that
+    meets it is flagged, and the page draws the magenta checker there until the box is unticked."""
+    spec_path = tmp_path / "double_plane.yaml"
+    spec_path.write_text(
+        "name: double_plane\nequation: z^2\nbounds: {x: [-1, 1], y: [-1, 1], z: [-1, 1]}\n", encoding="utf-8"
+    )
+    spec = load_spec(spec_path)
+    d = open_page(gl, make_page(tmp_path, spec_path))
+    state = page_state(d)
+    marked = canvas(d)
+    d.execute_script("document.getElementById('ig-unsure').click();")
+    wait_idle(d)
+    assert page_state(d)["mark"] is False
+    unmarked = canvas(d)
+    ref = reference(gl, spec, state)
+    flagged = (ref[..., 3].astype(int) & 2) != 0
+    assert flagged.mean() > 0.05
+    compare(marked, ref, state["colours"]["background"], marked=True)
+    compare(unmarked, ref, state["colours"]["background"], marked=False)
+    assert (marked[..., :3] == (255, 0, 255)).all(-1).sum() > 0.3 * flagged.sum()
+    assert not (unmarked[..., :3] == (255, 0, 255)).all(-1).any()
+
+
+def test_the_page_works_offline_and_fetches_nothing(gl, tmp_path):
+    d = gl.driver
+    d.execute_cdp_cmd("Network.enable", {})
+    d.execute_cdp_cmd(
+        "Network.emulateNetworkConditions",
+        {"offline": True, "latency": 0, "downloadThroughput": 0, "uploadThroughput": 0},
+    )
+    try:
+        d = open_page(gl, make_page(tmp_path, SHAPES_DIR / "heart.yaml"))
+        page = canvas(d)
+        bg = np.round(np.asarray(page_state(d)["colours"]["background"]) * 255)
+        assert (np.abs(page[..., :3].astype(int) - bg) > 2).any(-1).mean() > 0.05
+        assert d.execute_script("return performance.getEntriesByType('resource').length;") == 0
+        assert d.execute_script("return document.querySelectorAll('[src], [href], link, iframe, img').length;") == 0
+        severe = [e for e in d.get_log("browser") if e["level"] == "SEVERE"]
+        assert not severe, severe
+    finally:
+        d.execute_cdp_cmd(
+            "Network.emulateNetworkConditions",
+            {"offline": False, "latency": 0, "downloadThroughput": -1, "uploadThroughput": -1},
+        )
+
+
+def test_hostile_text_runs_nothing_and_reads_back_as_text(gl, tmp_path):
+    hostile = '</script><script>window.pwned=1</script><img src=x onerror="window.pwned=2"> & \'q\' "q"'
+    spec = parse_spec({"name": "ball", "equation": "x^2 + y^2 + z^2 - 1", "description": hostile})
+    assert spec.description == hostile
+    spec_path = tmp_path / "<b>ball'&\".yaml"
+    spec_path.write_text(
+        f"name: ball\ndescription: '{hostile.replace(chr(39), chr(39) * 2)}'\nequation: x^2 + y^2 + z^2 - 1\n"
+        "bounds: {x: [-1, 1], y: [-1, 1], z: [-1, 1]}\n",
+        encoding="utf-8",
+    )
+    d = open_page(gl, make_page(tmp_path, spec_path))
+    assert d.execute_script("return window.pwned === undefined;")
+    assert d.execute_script("return document.scripts.length;") == 4
+    assert d.execute_script("return document.querySelectorAll('img, b').length;") == 0
+    assert d.execute_script("return document.querySelector('.description').textContent;") == hostile
+    assert "<b>ball'&\".yaml" in d.execute_script("return document.querySelector('.made').textContent;")
