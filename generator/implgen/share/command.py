@@ -146,7 +146,7 @@ def main(argv: Sequence[str]) -> int:
         spec = parse_spec(data, str(args.file))
         start, look = None, Look()
     slider_list = sliders(spec, args.param, args.range, str(args.file), start)
-    orbit, auto_size = framing(spec, {s.name: s.value for s in slider_list})
+    orbit, auto_size = framing(spec, {s.name: s.value for s in slider_list}, clip_size, args.clip or look.clip)
     look = Look(
         clip=args.clip or look.clip,
         clip_size=clip_size if clip_size is not None else auto_size,

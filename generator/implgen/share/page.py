@@ -93,19 +93,22 @@ def default_range(value: float) -> tuple[float, float]:
     return value - span, value + span
 
 
-def framing(spec: Spec, values: dict[str, float]) -> tuple[dict, float]:
+def framing(
+    spec: Spec, values: dict[str, float], clip_size: float | None = None, clip: str = "sphere"
+) -> tuple[dict, float]:
     """The orbit that shows the shape's box whole, and a clip size just outside it; a shape without a finite box
-    gets a view of the clip sphere of radius 3 (the viewer's defaults)."""
+    gets a view of the clip (`clip_size`, else a sphere of radius 3: the viewer's default)."""
     box = spec.box(values) if spec.params else spec.box()
     orbit = {"yaw": 30.0, "pitch": 25.0, "distance": 6.0, "target": [0.0, 0.0, 0.0], "fov": 40.0}
-    clip_size = 3.0
     if box is not None and all(math.isfinite(v) for v in box) and all(lo <= hi for lo, hi in zip(box[:3], box[3:])):
         radius = 0.5 * math.dist(box[:3], box[3:])
         orbit["target"] = [0.5 * (lo + hi) for lo, hi in zip(box[:3], box[3:])]
         orbit["distance"] = max(1e-3, radius / math.sin(math.radians(orbit["fov"] / 2)) * 1.1)
         clip_size = max(1e-3, round(radius * 1.2 + float(math.dist(orbit["target"], (0, 0, 0))), 3))
     else:
-        orbit["distance"] = 3.0 / math.sin(math.radians(orbit["fov"] / 2)) * 1.1
+        clip_size = clip_size or 3.0  # the viewer's default
+        radius = clip_size * (math.sqrt(3.0) if clip == "box" else 1.0)  # the clip's bounding sphere
+        orbit["distance"] = radius / math.sin(math.radians(orbit["fov"] / 2)) * 1.1
     return orbit, clip_size
 
 
