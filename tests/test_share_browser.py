@@ -370,3 +370,34 @@ def test_a_clip_box_cuts_the_solid_and_shows_its_inside(gl, tmp_path):
     assert (np.abs(page - bg).max(-1)[miss] <= 2).all()
     for face in range(3):  # the picture shows cut faces on three sides of the box, each in its own shade
         assert (cut & (axis == face)).sum() > 50
+
+
+def test_a_frame_drawn_in_bands_is_the_frame_drawn_at_once(gl, tmp_path):
+    """The progressive redraw: with a tiny time budget the page draws a coarse frame, then the full frame a few
+    rows at a time over many animation frames; the result is the frame drawn in one go, pixel for pixel. While
+    something moves, only the coarse frame is drawn (blocks of equal pixels)."""
+    d = open_page(gl, make_page(tmp_path, SHAPES_DIR / "torus_z.yaml"))
+    at_once = canvas(d)
+    d.execute_script(
+        "const p = implgenShare.progressive; p.budget = 0.01; p.steps = 0; p.msPerPixel = 1; p.invalidate(false);"
+    )
+    wait_idle(d)
+    steps = d.execute_script("return implgenShare.progressive.steps;")
+    assert steps > SIZE[1] / 2  # a coarse frame, then a row or so at a time
+    assert (canvas(d) == at_once).all()
+    d.execute_script("const p = implgenShare.progressive; p.budget = 40; p.msPerPixel = 1; p.invalidate(true);")
+    deadline = time.monotonic() + WAIT
+    while d.execute_script("return implgenShare.progressive.steps;") == steps:
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    time.sleep(0.2)
+    assert not d.execute_script("return implgenShare.idle();")  # moving: waits for the view to rest
+    coarse = canvas(d)[::-1]  # top row first
+    assert (coarse != at_once[::-1]).any()
+    cw, ch = math.ceil(SIZE[0] / 16), math.ceil(SIZE[1] / 16)  # msPerPixel = 1 asks for the coarsest frame, 1/16
+    assert SIZE[0] % cw == 0 and SIZE[1] % ch == 0
+    blocks = coarse.reshape(ch, SIZE[1] // ch, cw, SIZE[0] // cw, 4)
+    assert (blocks == blocks[:, :1, :, :1]).all()  # each coarse pixel stretched over a block
+    d.execute_script("implgenShare.progressive.settle();")
+    wait_idle(d)
+    assert (canvas(d) == at_once).all()

@@ -111,6 +111,10 @@
     a.click();
   });
 
+  canvas.addEventListener("webglcontextlost", (e) => {
+    e.preventDefault();
+    fail("the browser took the GPU away from this page (WebGL context lost): reload the page to draw again.");
+  });
   orbit.attach(canvas, changed);
   window.addEventListener("resize", () => {
     if (!fixed) {

@@ -346,6 +346,7 @@ void main()
       this.pending = false;
       this.idle = true;
       this.generation = 0; // counts invalidations, for tests and pages
+      this.steps = 0; // draws made (coarse frames and bands)
     }
 
     /** Something changed; `moving`: more changes are coming (a drag), so draw coarse frames only. */
@@ -391,6 +392,7 @@ void main()
 
     _step() {
       const r = this.r;
+      this.steps += 1;
       const w = r.width;
       const h = r.height;
       if (!this.coarseDone) {
