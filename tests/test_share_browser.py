@@ -7,6 +7,7 @@ generated GLSL and the runtime assembled by glslprogram.program with a main writ
 description of the picture (camera, clip, two-sided shading, the key light), at the page's camera and params.
 The page's canvas must equal it: colours within 2 of 255 on every pixel the reference did not flag, and on
 flagged pixels the reference's colour or the magenta checker. 160 x 120 pixels: SwiftShader is a CPU.
+With IMPLGEN_SHARE_SCREENSHOT=path set, a screenshot of a shared page is saved there (docs/gallery/share.png).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from __future__ import annotations
 import base64
 import io
 import math
+import os
 import time
 
 import numpy as np
@@ -196,6 +198,13 @@ def test_the_page_draws_what_the_glsl_test_render_draws(gl, tmp_path):
     assert not hit[:, :5].any() and not hit[:, -5:].any()  # the box is framed whole
     severe = [e for e in d.get_log("browser") if e["level"] == "SEVERE"]
     assert not severe, severe
+
+    shot = os.environ.get("IMPLGEN_SHARE_SCREENSHOT")
+    if shot:  # the Chmutov octic at the window's size, for docs/share.md and the README (make screenshot)
+        d.set_window_size(1000, 640)
+        d.get(make_page(tmp_path, SHAPES_DIR / "chmutov8.yaml").as_uri())
+        wait_idle(d)
+        assert d.save_screenshot(shot)
 
 
 def test_a_slider_moves_the_picture(gl, tmp_path):
