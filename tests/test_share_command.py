@@ -216,3 +216,34 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, argv, messag
     assert code == 2
     assert err.count("\n") == 1 and err.startswith("implgen: error: ") and message in err, err
     assert sorted(tmp_path.rglob("*")) == before
+
+
+def _page_fragment(html: str) -> tuple[str, str]:
+    """The fragment shader a page compiles, assembled as surface.js's fragmentSource does: the header, the
+    runtime and the shape from the JSON block, the main from surface.js's MAIN (SHAPE and MATERIAL replaced)."""
+    p = Elements()
+    p.feed(html)
+    data = page_data(p)
+    surface = p.raw["script"][1]
+    main_src = re.search(r"const MAIN = `(.*?)`;", surface, re.S).group(1)
+    material = re.search(r'const MATERIAL = "([^"]+)";', surface).group(1)
+    header = "#version 300 es\nprecision highp float;\nprecision highp int;\n"
+    main_src = main_src.replace("SHAPE", data["name"]).replace("MATERIAL", material)
+    return data["name"], header + data["runtime"] + "\n" + data["shape"] + "\n" + main_src
+
+
+@pytest.mark.needs_program("glslangValidator")
+@pytest.mark.parametrize("spec_path", sorted(SHAPES_DIR.glob("*.yaml")), ids=lambda p: p.stem)
+def test_every_example_page_shader_compiles_as_es300(tmp_path, capsys, spec_path):
+    """What the page compiles, for every example shape, through Khronos' reference compiler (the browser tests
+    compile a few shapes in Chromium; this covers them all)."""
+    import subprocess
+
+    out = tmp_path / "page.html"
+    assert share(tmp_path, str(spec_path), "-o", str(out), capsys=capsys)[0] == 0
+    name, fragment = _page_fragment(out.read_text(encoding="utf-8"))
+    assert name == spec_path.stem
+    source = tmp_path / "page.frag"
+    source.write_text(fragment)
+    proc = subprocess.run(["glslangValidator", str(source)], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
