@@ -228,10 +228,11 @@ def test_a_slider_moves_the_picture(gl, tmp_path):
     assert r["page_hit"].sum() > 1.3 * hit_before.sum()
 
 
-def test_drag_turns_and_the_wheel_zooms(gl, tmp_path):
+def test_drag_turns_the_wheel_zooms_and_the_keys_turn(gl, tmp_path):
     from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.actions.wheel_input import ScrollOrigin
     from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
 
     spec = load_spec(SHAPES_DIR / "torus_y.yaml")
     d = open_page(gl, make_page(tmp_path, SHAPES_DIR / "torus_y.yaml"))
@@ -251,6 +252,12 @@ def test_drag_turns_and_the_wheel_zooms(gl, tmp_path):
     wait_idle(d)
     state = page_state(d)
     assert state["orbit"]["distance"] == pytest.approx(dist0 * math.exp(100 * 0.002))
+    el.send_keys(Keys.ARROW_LEFT, Keys.ARROW_UP)  # the keyboard: each arrow as a 12.5-pixel drag that way
+    time.sleep(0.3)
+    wait_idle(d)
+    state = page_state(d)
+    assert state["orbit"]["yaw"] == pytest.approx(yaw0 - 50 * 0.4 + 5)
+    assert state["orbit"]["pitch"] == pytest.approx(pitch0 + 10 * 0.4 - 5)
     compare(canvas(d), reference(gl, spec, state), state["colours"]["background"])
 
 
@@ -394,7 +401,7 @@ def test_a_frame_drawn_in_bands_is_the_frame_drawn_at_once(gl, tmp_path):
     steps = d.execute_script("return implgenShare.progressive.steps;")
     assert steps > SIZE[1] / 2  # a coarse frame, then a row or so at a time
     assert (canvas(d) == at_once).all()
-    d.execute_script("const p = implgenShare.progressive; p.budget = 40; p.msPerPixel = 1; p.invalidate(true);")
+    d.execute_script("const p = implgenShare.progressive; p.budget = 40; p.framePerPixel = 1; p.invalidate(true);")
     deadline = time.monotonic() + WAIT
     while d.execute_script("return implgenShare.progressive.steps;") == steps:
         assert time.monotonic() < deadline
@@ -403,7 +410,7 @@ def test_a_frame_drawn_in_bands_is_the_frame_drawn_at_once(gl, tmp_path):
     assert not d.execute_script("return implgenShare.idle();")  # moving: waits for the view to rest
     coarse = canvas(d)[::-1]  # top row first
     assert (coarse != at_once[::-1]).any()
-    cw, ch = math.ceil(SIZE[0] / 16), math.ceil(SIZE[1] / 16)  # msPerPixel = 1 asks for the coarsest frame, 1/16
+    cw, ch = math.ceil(SIZE[0] / 16), math.ceil(SIZE[1] / 16)  # framePerPixel = 1: the coarsest frame, 1/16
     assert SIZE[0] % cw == 0 and SIZE[1] % ch == 0
     blocks = coarse.reshape(ch, SIZE[1] // ch, cw, SIZE[0] // cw, 4)
     assert (blocks == blocks[:, :1, :, :1]).all()  # each coarse pixel stretched over a block

@@ -4,7 +4,8 @@
 //   const orbit = new IgOrbit({yaw, pitch, distance, target, fov});
 //   orbit.camera()                        // {eye, target, up, fov} for IgSurface.Renderer.setCamera
 //   orbit.attach(canvas, onChange)        // drag turns, shift-drag (or two fingers) moves the target, the wheel
-//                                         // (or a pinch) zooms; onChange(moving): moving is false at rest
+//                                         // (or a pinch) zooms, arrow keys turn, + and - zoom;
+//                                         // onChange(moving): moving is false at rest
 "use strict";
 
 class IgOrbit {
@@ -102,14 +103,29 @@ class IgOrbit {
     };
     canvas.addEventListener("pointerup", up);
     canvas.addEventListener("pointercancel", up);
+    const rest = () => {
+      clearTimeout(restTimer);
+      restTimer = setTimeout(() => onChange(false), 180);
+    };
+    // the keyboard, once the canvas has the focus: an arrow turns as a 12.5-pixel drag that way (5 degrees), + and - zoom
+    if (canvas.tabIndex < 0) canvas.tabIndex = 0;
+    canvas.addEventListener("keydown", (e) => {
+      const turns = { ArrowLeft: [-12.5, 0], ArrowRight: [12.5, 0], ArrowUp: [0, -12.5], ArrowDown: [0, 12.5] };
+      if (e.key in turns) this.turn(...turns[e.key]);
+      else if (e.key === "+" || e.key === "=") this.zoom(1 / 1.1);
+      else if (e.key === "-") this.zoom(1.1);
+      else return;
+      e.preventDefault();
+      onChange(true);
+      rest();
+    });
     canvas.addEventListener(
       "wheel",
       (e) => {
         e.preventDefault();
         this.zoom(Math.exp(Math.max(-200, Math.min(200, e.deltaY)) * 0.002));
         onChange(true);
-        clearTimeout(restTimer);
-        restTimer = setTimeout(() => onChange(false), 180);
+        rest();
       },
       { passive: false },
     );

@@ -339,7 +339,9 @@ void main()
       this.budget = budget;
       this.onStep = onStep;
       this.onIdle = onIdle;
-      this.msPerPixel = null; // measured
+      this.msPerPixel = null; // measured: the recent draws' cost per pixel (sizes the next band)
+      this.framePerPixel = null; // measured: the last whole frame's cost per pixel (sizes the coarse frame)
+      this.frameMs = 0;
       this.coarseDone = false;
       this.moving = false;
       this.row = 0;
@@ -377,17 +379,20 @@ void main()
     }
 
     _scale() {
-      if (this.msPerPixel === null) return 8;
+      const per = this.framePerPixel ?? this.msPerPixel;
+      if (per === null) return 8;
       const pixels = this.r.width * this.r.height;
       for (const s of [1, 2, 4, 8, 16]) {
-        if ((this.msPerPixel * pixels) / (s * s) <= this.budget) return s;
+        if ((per * pixels) / (s * s) <= this.budget) return s;
       }
       return 16;
     }
 
+    // cost per pixel: up at once when a draw was dearer (the next band is no longer than budget allows), down
+    // by halves (pixels differ in cost: rows through the surface are dearer than rows of background)
     _measure(ms, pixels) {
       const per = ms / Math.max(1, pixels);
-      this.msPerPixel = this.msPerPixel === null ? per : 0.5 * (this.msPerPixel + per);
+      this.msPerPixel = this.msPerPixel === null || per > this.msPerPixel ? per : 0.5 * (this.msPerPixel + per);
     }
 
     _step() {
@@ -398,14 +403,19 @@ void main()
       if (!this.coarseDone) {
         const scale = this._scale();
         const ms = r.draw({ scale });
-        this._measure(ms, Math.ceil(w / scale) * Math.ceil(h / scale));
+        const pixels = Math.ceil(w / scale) * Math.ceil(h / scale);
+        this._measure(ms, pixels);
+        if (this.framePerPixel === null || scale === 1) this.framePerPixel = ms / pixels;
         this.coarseDone = true;
         this.row = scale === 1 ? h : 0; // a full-size "coarse" frame is the frame
+        this.frameMs = 0;
       } else if (!this.moving && this.row < h) {
         const rows = Math.max(1, Math.min(h - this.row, Math.floor(this.budget / (this.msPerPixel * w + 1e-9))));
         const ms = r.draw({ rows: [this.row, this.row + rows] });
         this._measure(ms, rows * w);
         this.row += rows;
+        this.frameMs += ms;
+        if (this.row >= h) this.framePerPixel = this.frameMs / (w * h);
       }
       const done = this.coarseDone && (this.moving || this.row >= h);
       if (this.onStep) this.onStep(this);
