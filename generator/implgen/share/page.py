@@ -184,8 +184,8 @@ def render_page(spec: Spec, sliders: list[Slider], look: Look, source_name: str,
                     "min": _number(s.lo),
                     "max": _number(s.hi),
                     "step": _number((s.hi - s.lo) / 1000),
-                "min_text": f"{s.lo:.6g}",
-                "max_text": f"{s.hi:.6g}",
+                    "min_text": f"{s.lo:.6g}",
+                    "max_text": f"{s.hi:.6g}",
                 }
                 for s in sliders
             ],
