@@ -203,12 +203,15 @@ BAD = [
     (["{torus}", "--object", "torus_y", "-o", "{tmp}/page.html"], "is a shape spec, not a scene"),
     (["{scene}", "-o", "{tmp}/page.html"], "--object NAME"),
     (["{scene}", "--object", "cube", "-o", "{tmp}/page.html"], "no shape of that name"),
+    (["{tmp}/in/webgl_ball.yaml", "-o", "{tmp}/page.html"], "cannot name GLSL functions"),
 ]
 
 
 @pytest.mark.parametrize("argv,message", BAD, ids=[" ".join(a[1:])[:50] for a, _ in BAD])
 def test_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, argv, message):
     values = {"torus": str(SHAPES_DIR / "torus_y.yaml"), "scene": str(SCENES_DIR / "torus_shadow.yaml")}
+    (tmp_path / "in").mkdir()
+    (tmp_path / "in" / "webgl_ball.yaml").write_text("name: webgl_ball\nequation: x^2 + y^2 + z^2 - 1\n")
     argv = [a.format(tmp=tmp_path, **values) for a in argv]
     before = sorted(tmp_path.rglob("*"))
     code = main(["share", *argv])
