@@ -92,15 +92,15 @@ def report(rows: dict, size, renderer: str, rounds: int, seconds: float, argv) -
         f"Whole run {seconds / 60:.1f} min.",
         "",
         f"Browser: headless Chromium ({' '.join(FLAGS)}), WebGL renderer `{renderer}`: **SwiftShader is a CPU "
-        "emulation of a GPU**; these times are not a GPU's. They show how the page behaves on a slow GPU: it never "
-        "draws for long in one go.",
+        "emulation of a GPU**; these times are not a GPU's. They show how the page behaves on a slow GPU: it draws "
+        "in steps and answers input between them.",
         "",
         f"Each example shape shared with the defaults (`implgen share SPEC -o page.html`) and drawn at {w}×{h}; "
         f"medians of {rounds} rounds interleaved over the shapes. *full frame*: one draw of every pixel. *coarse*: "
-        "the page's first frame after a change, at the scale its measured cost per pixel allows within its 40 ms "
-        "budget (1/s of the size each way). *bands*: how many draws finish the frame; *longest step*: the longest "
-        "single draw of the redraw (the page answers input between draws). *to full frame*: from the change to "
-        "the last band.",
+        "the page's first frame after a change, at the scale the last whole frame's cost per pixel allows within "
+        "its 40 ms budget (1/s of the size each way). *bands*: how many draws finish the frame; *longest step*: "
+        "the longest single draw of the redraw (the page answers input between draws). *to full frame*: from the "
+        "change to the last band.",
         "",
         "| shape | full frame | coarse | coarse frame | bands | longest step | to full frame |",
         "|---|---:|---:|---:|---:|---:|---:|",

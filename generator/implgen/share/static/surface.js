@@ -410,11 +410,18 @@ void main()
         this.row = scale === 1 ? h : 0; // a full-size "coarse" frame is the frame
         this.frameMs = 0;
       } else if (!this.moving && this.row < h) {
-        const rows = Math.max(1, Math.min(h - this.row, Math.floor(this.budget / (this.msPerPixel * w + 1e-9))));
-        const ms = r.draw({ rows: [this.row, this.row + rows] });
-        this._measure(ms, rows * w);
-        this.row += rows;
-        this.frameMs += ms;
+        // bands until about the budget is spent (an animation frame per band would leave most of it idle)
+        let spent = 0;
+        do {
+          // never below the whole frame's average: rows of background must not make the next band too tall
+          const per = Math.max(this.msPerPixel, this.framePerPixel ?? 0);
+          const rows = Math.max(1, Math.min(h - this.row, Math.floor((this.budget - spent) / (per * w + 1e-9))));
+          const ms = r.draw({ rows: [this.row, this.row + rows] });
+          this._measure(ms, rows * w);
+          this.row += rows;
+          this.frameMs += ms;
+          spent += ms;
+        } while (this.row < h && spent < 0.5 * this.budget);
         if (this.row >= h) this.framePerPixel = this.frameMs / (w * h);
       }
       const done = this.coarseDone && (this.moving || this.row >= h);
