@@ -53,7 +53,7 @@ def f_of(name: str, **values: float) -> sp.Expr:
     ],
 )
 def test_node_counts_are_the_literatures(name, values, nodes, affine):
-    found = real_nodes(f_of(name, **values))
+    found = real_nodes(f_of(name, **values), grid=11)
     assert len(found) == nodes
     assert sum(1 for v, _ in found if abs(v[3]) > 1e-9) == affine
     assert all(cond > 1e-8 for _, cond in found)  # ordinary double points: Hessian of rank 3
