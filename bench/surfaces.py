@@ -66,7 +66,7 @@ def contact_sheet(tiles: list[tuple[str, np.ndarray]], w: int, h: int) -> Image.
     for i, (title, pixels) in enumerate(tiles):
         x, y = (i % cols) * w, (i // cols) * (h + LABEL)
         sheet.paste(Image.fromarray(pixels), (x, y))
-        draw.text((x + 6, y + h + 3), title, fill=(230, 230, 230))
+        draw.text((x + 6, y + h + 3), title.replace("ß", "ss"), fill=(230, 230, 230))  # Pillow's own font is ASCII
     return sheet
 
 

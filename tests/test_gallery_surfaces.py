@@ -59,12 +59,17 @@ def test_node_counts_are_the_literatures(name, values, nodes, affine):
     assert all(cond > 1e-8 for _, cond in found)  # ordinary double points: Hessian of rank 3
 
 
-def test_cayley_nodes_exactly():
+def test_cayley_nodes_and_the_edges_joining_them_exactly():
     f = f_of("cayley")
     grad = [sp.diff(f, v) for v in (X, Y, Z)]
-    for p in [(1, 1, -1), (1, -1, 1), (-1, 1, 1), (-1, -1, -1)]:
+    nodes = [(1, 1, -1), (1, -1, 1), (-1, 1, 1), (-1, -1, -1)]
+    for p in nodes:
         at = dict(zip((X, Y, Z), p))
         assert f.subs(at) == 0 and all(g.subs(at) == 0 for g in grad)
+    t = sp.Symbol("t")
+    for p, q in itertools.combinations(nodes, 2):  # the six edges lie on the surface
+        line = {c: a + t * (b - a) for c, a, b in zip((X, Y, Z), p, q)}
+        assert sp.expand(f.subs(line, simultaneous=True)) == 0
 
 
 def test_clebsch_holds_its_fifteen_rational_lines():
@@ -79,12 +84,12 @@ def test_clebsch_holds_its_fifteen_rational_lines():
         rest = [i for i in range(5) if i != m]
         for a in rest[1:]:
             i, j = rest[0], a
-            k, l = [r for r in rest if r not in (i, j)]
+            k, n = [r for r in rest if r not in (i, j)]
             forms = [X, Y, Z, W, -(X + Y + Z + W)]
-            eqs = [forms[i] + forms[j], forms[k] + forms[l], forms[m]]
+            eqs = [forms[i] + forms[j], forms[k] + forms[n], forms[m]]
             basis = sp.Matrix([[e.coeff(c) for c in coords] for e in eqs]).nullspace()
             assert len(basis) == 2  # the three planes meet in a line
-            point = {c: s * basis[0][n] + t * basis[1][n] for n, c in enumerate(coords)}
+            point = {c: s * basis[0][q] + t * basis[1][q] for q, c in enumerate(coords)}
             assert sp.expand(F.subs(point, simultaneous=True)) == 0
             lines.add(tuple(sorted(map(tuple, sp.Matrix.hstack(*basis).T.rref()[0].tolist()))))
     assert len(lines) == 15

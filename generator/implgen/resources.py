@@ -1,5 +1,5 @@
-"""Where the package data (templates, C and GLSL runtime sources, the gallery's shape specs) lives once installed, and which runtime sources make
-which library.
+"""Where the package data (templates, C and GLSL runtime sources, the gallery's shape specs) lives once
+installed, and which runtime sources make which library.
 
 The lists are explicit: a scene library links the solvers, the shape layer and the tracer -- never the
 benchmark timing code, which only the solver library behind `implgen.roots` carries. A test checks that every

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+
 from implgen.codegen.speccache import parse_spec
 from implgen.codegen.specmodel import Spec
 from implgen.errors import UserError
 from implgen.resources import gallery_dir
 from implgen.yamlfile import read_yaml
-
 
 FRAME_RADIUS = 2.0  # an open axis of a gallery spec, in a picture: [-2, 2]
 

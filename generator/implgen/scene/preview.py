@@ -24,7 +24,8 @@ YAW, PITCH, FOV = 30.0, 25.0, 40.0  # degrees
 
 def _ball() -> Spec:
     box = {a: ["-r", "r"] for a in "xyz"}
-    return parse_spec({"name": "preview_ball", "equation": "x^2 + y^2 + z^2 - r^2", "params": {"r": 1.0}, "bounds": box})
+    ball = {"name": "preview_ball", "equation": "x^2 + y^2 + z^2 - r^2", "params": {"r": 1.0}, "bounds": box}
+    return parse_spec(ball)
 
 
 def frame(spec: Spec, values: dict[str, float] | None = None) -> tuple[np.ndarray, float]:
@@ -36,9 +37,7 @@ def frame(spec: Spec, values: dict[str, float] | None = None) -> tuple[np.ndarra
     return 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
 
 
-def preview_scene(
-    spec: Spec, width: int, height: int, spp: int = 1, values: dict[str, float] | None = None
-) -> Scene:
+def preview_scene(spec: Spec, width: int, height: int, spp: int = 1, values: dict[str, float] | None = None) -> Scene:
     """The scene of `spec` alone (param `values` over its defaults), framed by frame()."""
     params = {**spec.params, **(values or {})}
     centre, radius = frame(spec, params)
