@@ -18,18 +18,46 @@ import sympy as sp
 X, Y, Z, W = sp.symbols("x y z w", real=True)
 
 
+class _Poly:
+    """A polynomial in three variables as exponents and double coefficients, evaluated on many points at once."""
+
+    def __init__(self, exps: np.ndarray, coeffs: np.ndarray):
+        keep = coeffs != 0
+        self.exps, self.coeffs = exps[keep], coeffs[keep]
+
+    def diff(self, v: int) -> _Poly:
+        e = self.exps.copy()
+        c = self.coeffs * e[:, v]
+        e[:, v] = np.maximum(e[:, v] - 1, 0)
+        return _Poly(e, c)
+
+    def __call__(self, powers: list[np.ndarray]) -> np.ndarray:
+        """Values at the points whose coordinates' powers 0..degree are `powers` (powers_of)."""
+        if len(self.coeffs) == 0:
+            return np.zeros(len(powers[0]))
+        e = self.exps
+        return (powers[0][:, e[:, 0]] * powers[1][:, e[:, 1]] * powers[2][:, e[:, 2]]) @ self.coeffs
+
+
+def powers_of(p: np.ndarray, degree: int) -> list[np.ndarray]:
+    """[x^0..x^degree, y^0.., z^0..] for every point, by repeated products."""
+    return [np.cumprod(np.column_stack([np.ones(len(p))] + [p[:, v]] * degree), axis=1) for v in range(3)]
+
+
 def _chart_points(F: sp.Expr, k: int, seeds: np.ndarray, iters: int) -> list[tuple[np.ndarray, float]]:
     variables = [X, Y, Z, W]
     free = [v for i, v in enumerate(variables) if i != k]
-    g = sp.expand(F.subs(variables[k], 1))
-    grad = [sp.diff(g, v) for v in free]
-    hess = [[sp.diff(gi, v) for v in free] for gi in grad]
-    fg, fgrad, fhess = (sp.lambdify(free, e, "numpy") for e in (g, grad, hess))
-    n = len(seeds)
+    poly = sp.Poly(F.subs(variables[k], 1), *free)
+    g = _Poly(np.array(poly.monoms(), dtype=int), np.array([float(c) for c in poly.coeffs()]))
+    grad = [g.diff(v) for v in range(3)]
+    hess = [[gi.diff(v) for v in range(3)] for gi in grad]
+
+    degree = int(g.exps.max())
 
     def grad_hess(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        G = np.array([np.broadcast_to(e, n) for e in fgrad(*p.T)], dtype=float).T
-        H = np.array([[np.broadcast_to(e, n) for e in row] for row in fhess(*p.T)], dtype=float).transpose(2, 0, 1)
+        pw = powers_of(p, degree)
+        G = np.stack([gi(pw) for gi in grad], axis=1)
+        H = np.stack([np.stack([h(pw) for h in row], axis=1) for row in hess], axis=1)
         return G, H
 
     p = seeds.copy()
@@ -41,8 +69,8 @@ def _chart_points(F: sp.Expr, k: int, seeds: np.ndarray, iters: int) -> list[tup
         length = np.linalg.norm(step, axis=1)
         p = np.clip(p - np.minimum(1.0, 0.25 / np.maximum(length, 1e-300))[:, None] * step, -9.0, 9.0)
     G, H = grad_hess(p)
-    value = np.broadcast_to(fg(*p.T), n)
-    scale = max(abs(float(c)) for c in sp.Poly(g, *free).coeffs()) * (1 + np.abs(p).sum(axis=1)) ** sp.total_degree(F)
+    value = g(powers_of(p, degree))
+    scale = np.abs(g.coeffs).max() * (1 + np.abs(p).sum(axis=1)) ** sp.total_degree(F)
     tiny = 1e-9 * scale
     good = (np.abs(value) < tiny) & (np.linalg.norm(G, axis=1) < tiny) & (np.abs(p) <= 1.0 + 1e-9).all(axis=1)
     out = []
