@@ -72,9 +72,10 @@ tools:
 regen: install
 	$(BIN)/implgen examples/shapes/*.yaml --lang all -o generated
 
-# Render every example scene into docs/gallery/ (images + times.md).
+# Render every example scene into docs/gallery/ (images + times.md), and the famous surfaces' contact sheet.
 gallery: install
 	$(BIN)/python bench/gallery.py
+	$(BIN)/python bench/surfaces.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info
