@@ -43,6 +43,7 @@ def test_the_gallery_is_package_data_one_copy_of_examples_shapes():
     tree = {p.name: p.read_bytes() for p in (ROOT / "examples" / "shapes").glob("*.yaml")}
     assert shipped == tree
     assert gallery.entry("kummer").title == "Kummer quartic"
+    assert set(gallery.entry("kummer").as_dict()) == {"name", "title", "description", "reference"}
     with pytest.raises(KeyError):
         gallery.entry("no_such_surface")
 

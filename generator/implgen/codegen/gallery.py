@@ -38,6 +38,11 @@ class Entry:
         """The spec file as written (for the viewer's 'show the YAML', a download)."""
         return self.path.read_text(encoding="utf-8")
 
+    def as_dict(self) -> dict[str, str]:
+        """The entry as plain text for a page's picker (JSON): name, title, description, reference. Text, to be
+        shown as text (never as markup)."""
+        return {"name": self.name, "title": self.title, "description": self.description, "reference": self.reference}
+
     def load(self) -> Spec:
         """The checked `Spec`, through the spec cache (codegen/speccache.py: a second load needs no SymPy)."""
         return parse_spec(self.data, self.source)
@@ -58,8 +63,9 @@ def _text(data: dict, key: str) -> str:
 
 
 def entries(folder: str | Path | None = None) -> list[Entry]:
-    """Every gallery spec, by title. A file that is not a readable spec mapping with a name and a reference is
-    not in the gallery; a bad one that names a reference is a UserError (one line naming the file)."""
+    """Every gallery spec, by title. A YAML file that is not a mapping naming a `reference` is not in the gallery;
+    an unreadable file, or a gallery spec without a name, is a UserError (one line naming the file). The
+    equations are checked by load()."""
     base = Path(folder) if folder is not None else gallery_dir()
     out = []
     for path in sorted(base.glob("*.yaml")):
