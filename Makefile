@@ -5,7 +5,8 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.implgen-installed
-SOURCES := pyproject.toml $(shell find generator templates runtime_c runtime_glsl -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' -o -name '*.glsl' \
+SOURCES := pyproject.toml $(wildcard examples/shapes/*.yaml) \
+           $(shell find generator templates runtime_c runtime_glsl -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' -o -name '*.glsl' \
                        -o -name '*.html' -o -name '*.js' -o -name '*.css' \) 2>/dev/null)
 C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c)
 
