@@ -5,7 +5,8 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.implgen-installed
-SOURCES := pyproject.toml $(shell find generator templates runtime_c runtime_glsl -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' -o -name '*.glsl' \
+SOURCES := pyproject.toml $(wildcard examples/shapes/*.yaml) \
+           $(shell find generator templates runtime_c runtime_glsl -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' -o -name '*.glsl' \
                        -o -name '*.html' -o -name '*.js' -o -name '*.css' \) 2>/dev/null)
 C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c)
 
@@ -72,9 +73,10 @@ tools:
 regen: install
 	$(BIN)/implgen examples/shapes/*.yaml --lang all -o generated
 
-# Render every example scene into docs/gallery/ (images + times.md).
+# Render every example scene into docs/gallery/ (images + times.md), and the famous surfaces' contact sheet.
 gallery: install
 	$(BIN)/python bench/gallery.py
+	$(BIN)/python bench/surfaces.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -49,7 +49,7 @@ def test_hit_mask_matches_the_exact_answer(gl, case):
     """No pixel is wrong without its flag; at most 1 % of the object's pixels are flagged; the certified hits'
     t agree with C's within float resolution."""
     r = _compare(gl, case)
-    assert r.object_pixels > 0.1 * r.pixels  # the shape fills the picture
+    assert r.object_pixels > 0.05 * r.pixels  # the shape is in the picture (the slim Zitrus covers 8 %)
     assert r.glsl_wrong_unflagged == 0, r.examples
     assert r.glsl_wrong <= 0.001 * r.object_pixels, r.examples
     assert r.flagged <= 0.01 * r.object_pixels

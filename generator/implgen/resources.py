@@ -1,5 +1,5 @@
-"""Where the package data (templates, C and GLSL runtime sources) lives once installed, and which runtime sources make
-which library.
+"""Where the package data (templates, C and GLSL runtime sources, the gallery's shape specs) lives once
+installed, and which runtime sources make which library.
 
 The lists are explicit: a scene library links the solvers, the shape layer and the tracer -- never the
 benchmark timing code, which only the solver library behind `implgen.roots` carries. A test checks that every
@@ -42,6 +42,13 @@ def runtime_dir() -> Path:
 def runtime_glsl_dir() -> Path:
     """Folder holding the hand-written GLSL runtime (`*.glsl`, concatenated in GLSL_RUNTIME_SOURCES order)."""
     return _PACKAGE_DIR / "runtime_glsl" if (_PACKAGE_DIR / "runtime_glsl").is_dir() else _TREE / "runtime_glsl"
+
+
+def gallery_dir() -> Path:
+    """Folder holding the gallery's shape specs: the repository's examples/shapes/, installed as
+    `implgen.gallery` (one copy: pyproject maps the folder into the package)."""
+    installed = _PACKAGE_DIR / "gallery"
+    return installed if installed.is_dir() else _TREE / "examples" / "shapes"
 
 
 def runtime_sources(*groups: tuple[str, ...]) -> list[Path]:
