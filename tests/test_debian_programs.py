@@ -5,6 +5,7 @@ fails instead; as root `make` installs it. Run in child processes with PATH cut 
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -122,3 +123,15 @@ def test_make_does_nothing_when_the_programs_are_there(tmp_path):
     (path / "find").symlink_to(shutil.which("find"))
     p = _make(["browser", "povray", "tools"], path, require_all=True)
     assert (p.returncode, p.stdout, p.stderr) == (0, "", "") and not log.exists()
+
+
+def test_the_embree_tests_carry_the_library_marker(tmp_path):
+    """Without a C compiler that links libembree3 (here: none on PATH) every Embree test is skipped with one
+    reason naming libembree-dev; with IMPLGEN_REQUIRE_ALL each is an error."""
+    empty = _bin(tmp_path / "empty")
+    p = _pytest(["tests/test_embree.py"], empty, ROOT, require_all=False)
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert "passed" not in p.stdout and re.search(r"\d+ skipped", p.stdout)
+    assert "libembree3 not installed (Debian: apt-get install libembree-dev)" in p.stdout
+    p = _pytest(["tests/test_embree.py"], empty, ROOT, require_all=True)
+    assert p.returncode == 1 and "skipped" not in p.stdout and "passed" not in p.stdout
