@@ -162,3 +162,12 @@ def test_the_example_builds_with_make_and_runs_clean_under_sanitizers(tmp_path):
     assert proc.returncode == 0, proc.stderr
     small = np.asarray(Image.open(tmp_path / "small.ppm"))
     assert small.shape == (90, 160, 3)
+
+
+def test_the_benchmark_mode_runs_clean(driver, scene_file):
+    """bench/embree.py's timing loop (its figures are the benchmark's business, not a test's)."""
+    line = run(driver, "bench", scene_file, 32, 18, 1)
+    m = re.match(
+        r"bench: rays 576 tracer \S+ embree1 \S+ embree8 \S+ tracer_shadow \S+ embree_shadow \S+ hits (\d+)", line
+    )
+    assert m and int(m[1]) > 0, line

@@ -799,7 +799,11 @@ static int mode_bench(const scene_in *s, int W, int H, int reps)
         for (k = 0; k + 8 <= n; k += 8) {
             struct RTCRayHit8 rh;
             ig_embree_context ctx;
-            int valid[8], i;
+            union {
+                struct RTCRay8 align; /* rtcIntersect8 loads the valid mask aligned */
+                int v[8];
+            } va;
+            int *valid = va.v, i;
             for (i = 0; i < 8; ++i) {
                 valid[i] = -1;
                 rh.ray.org_x[i] = rays[k + i][0], rh.ray.org_y[i] = rays[k + i][1], rh.ray.org_z[i] = rays[k + i][2];
