@@ -9,7 +9,7 @@ SOURCES := pyproject.toml $(shell find generator templates runtime_c runtime_gls
                        -o -name '*.html' -o -name '*.js' -o -name '*.css' \) 2>/dev/null)
 C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c examples/embree/*.c)
 
-.PHONY: demo test lint tools browser povray glslang embree embree-example screenshot install regen gallery bench clean
+.PHONY: demo test lint tools browser povray glslang embree embree-example embree-picture screenshot install regen gallery bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -67,6 +67,10 @@ embree-example: embree
 	$${CC:-cc} -std=c99 -Wall -Wextra -Werror -pedantic -O2 -Iruntime_c -Igenerated -o $(EMBREE_OUT)/scene \
 	  $(EMBREE_SOURCES) -lembree3 -lm
 	$(EMBREE_OUT)/scene $(EMBREE_OUT)/scene.ppm
+
+# The README's picture of it (docs/embree.md).
+embree-picture: install embree-example
+	$(BIN)/python -c "from PIL import Image; Image.open('$(EMBREE_OUT)/scene.ppm').save('docs/gallery/embree.png', optimize=True)"
 
 # The README's picture of `implgen view`, taken by the browser test.
 screenshot: install browser
