@@ -12,7 +12,8 @@
  *   agree OUT inst   per pixel, into OUT: ray, tracer object and t, Embree object and t, and a shadow ray's
  *                    answers (occluded or not); inst = 1 places the shapes by Embree instances (float)
  *                    instead of the adapter's double transforms
- *   packets          rtcIntersect4/8/16 and rtcOccluded4/8/16, some lanes invalid, against rtcIntersect1
+ *   packets [K]      rtcIntersect4/8/16 and rtcOccluded4/8/16, some lanes invalid, against rtcIntersect1 (with
+ *                    K: all through a context filter that rejects object K)
  *   surface          rays leaving the tracer's hit points (tnear = 1e-4) through both
  *   masks            geometry masks: algebraic 2, ground 1; rays of mask 1, 2, 3 against tracers without the rest
  *   filter K         context, geometry and occlusion filters that reject object K against a tracer without K
@@ -221,13 +222,14 @@ static unsigned add_mesh(emb *e, int ntri)
     return id;
 }
 
-static void embree_scene(const scene_in *s, emb *e, int inst)
+static void embree_scene(const scene_in *s, emb *e, int inst, enum RTCSceneFlags flags)
 {
     int i;
     memset(e, 0, sizeof *e);
     e->inst = inst;
     e->dev = rtcNewDevice(NULL);
     e->scene = rtcNewScene(e->dev);
+    rtcSetSceneFlags(e->scene, flags); /* before the first commit: Embree picks its traversal kernels there */
     e->prims = calloc((size_t)s->n + 1, sizeof *e->prims);
     if (!e->dev || !e->scene || !e->prims)
         fail("cannot start Embree");
@@ -432,7 +434,7 @@ static int mode_agree(const scene_in *s, int W, int H, const char *out, int inst
     FILE *f;
     if (!ray || !ids || !ts)
         fail("out of memory");
-    embree_scene(s, &e, inst);
+    embree_scene(s, &e, inst, RTC_SCENE_FLAG_NONE);
     for (k = 0; k < n; ++k) {
         float *o = ray + 12 * k, *d = o + 3, *so = o + 6, *sd = o + 9;
         rt_hit h;
@@ -467,7 +469,27 @@ static int mode_agree(const scene_in *s, int W, int H, const char *out, int inst
 #define LANE_F(base, N, k, i) (((float *)(base))[(k) * (N) + (i)])
 #define LANE_U(base, N, k, i) (((unsigned *)(base))[(k) * (N) + (i)])
 
-static int mode_packets(const scene_in *s, int W, int H)
+/* Filters that reject every hit on scene object `reject_k` (a geometry user pointer cannot say which scene it
+ * is, so the object to reject travels in a global-free way: the primID, compared with a value in the context). */
+typedef struct reject_context {
+    ig_embree_context ig; /* first: the adapter reads its hits table */
+    unsigned prim;
+    int calls;
+} reject_context;
+
+static void reject_prim(const struct RTCFilterFunctionNArguments *args)
+{
+    reject_context *c = (reject_context *)args->context;
+    unsigned i;
+    for (i = 0; i < args->N; ++i)
+        if (args->valid[i] != 0) {
+            ++c->calls;
+            if (LANE_U(args->hit, args->N, 5, i) == c->prim && LANE_U(args->hit, args->N, 6, i) == 0)
+                args->valid[i] = 0;
+        }
+}
+
+static int mode_packets(const scene_in *s, int W, int H, int K)
 {
     emb e;
     int n = W * H, widths[3] = {4, 8, 16}, wi, bad = 0, checked = 0, k;
@@ -477,27 +499,33 @@ static int mode_packets(const scene_in *s, int W, int H)
     ig_embree_hit *rec1 = malloc(sizeof *rec1 * (size_t)n), *recn = malloc(sizeof *recn * (size_t)n);
     if (!rays || !one || !occ1 || !rec1 || !recn)
         fail("out of memory");
-    embree_scene(s, &e, 0);
-    ig_embree_context ctx1; /* double records of every ray, by its id (= its index) */
-    ig_embree_context_init(&ctx1, rec1, (unsigned)n);
+    /* with K: a context filter that rejects object K, in every call below */
+    embree_scene(s, &e, 0, K >= 0 ? RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION : RTC_SCENE_FLAG_NONE);
+    reject_context ctx1; /* double records of every ray, by its id (= its index) */
+    ig_embree_context_init(&ctx1.ig, rec1, (unsigned)n);
+    ctx1.prim = (unsigned)K;
+    ctx1.calls = 0;
+    ctx1.ig.rtc.filter = K >= 0 ? reject_prim : NULL;
     for (k = 0; k < n; ++k) {
-        ig_embree_context ctx;
+        reject_context ctx = ctx1;
         struct RTCRay r;
         camera_ray(s, W, H, k % W, k / W, rays[k], rays[k] + 3);
         set_ray(&one[k].ray, rays[k], rays[k] + 3, 0.0f, INFINITY, ~0u, (unsigned)k);
         one[k].hit.geomID = one[k].hit.primID = one[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(e.scene, &ctx1.rtc, &one[k]);
+        rtcIntersect1(e.scene, &ctx1.ig.rtc, &one[k]);
         /* a shadow-like ray: from 40 % of the way to the hit (or far out) toward the light */
         set_ray(&r, rays[k], rays[k] + 3, 0.0f, isfinite(one[k].ray.tfar) ? 0.999f * one[k].ray.tfar : 20.0f, ~0u,
                 (unsigned)k);
-        ig_embree_context_init(&ctx, NULL, 0);
-        rtcOccluded1(e.scene, &ctx.rtc, &r);
+        ig_embree_context_init(&ctx.ig, NULL, 0);
+        ctx.ig.rtc.filter = ctx1.ig.rtc.filter;
+        rtcOccluded1(e.scene, &ctx.ig.rtc, &r);
         occ1[k] = r.tfar < 0.0f;
     }
     for (wi = 0; wi < 3; ++wi) {
         int N = widths[wi];
-        ig_embree_context ctx;
-        ig_embree_context_init(&ctx, recn, (unsigned)n);
+        reject_context ctx = ctx1;
+        ig_embree_context_init(&ctx.ig, recn, (unsigned)n); /* (which clears the filter) */
+        ctx.ig.rtc.filter = ctx1.ig.rtc.filter;
         for (k = 0; k + N <= n; k += N) {
             union { /* Embree's aligned packet types; LANE_F indexes them as RTCRayHitN / RTCRayN */
                 struct RTCRayHit4 r4;
@@ -533,14 +561,14 @@ static int mode_packets(const scene_in *s, int W, int H)
                     RTC_INVALID_GEOMETRY_ID;
             }
             if (N == 4) {
-                rtcIntersect4(valid, e.scene, &ctx.rtc, &rh.r4);
-                rtcOccluded4(valid, e.scene, &ctx.rtc, &orr.r4);
+                rtcIntersect4(valid, e.scene, &ctx.ig.rtc, &rh.r4);
+                rtcOccluded4(valid, e.scene, &ctx.ig.rtc, &orr.r4);
             } else if (N == 8) {
-                rtcIntersect8(valid, e.scene, &ctx.rtc, &rh.r8);
-                rtcOccluded8(valid, e.scene, &ctx.rtc, &orr.r8);
+                rtcIntersect8(valid, e.scene, &ctx.ig.rtc, &rh.r8);
+                rtcOccluded8(valid, e.scene, &ctx.ig.rtc, &orr.r8);
             } else {
-                rtcIntersect16(valid, e.scene, &ctx.rtc, &rh.r16);
-                rtcOccluded16(valid, e.scene, &ctx.rtc, &orr.r16);
+                rtcIntersect16(valid, e.scene, &ctx.ig.rtc, &rh.r16);
+                rtcOccluded16(valid, e.scene, &ctx.ig.rtc, &orr.r16);
             }
             for (i = 0; i < N; ++i) {
                 int j = k + i, same;
@@ -571,7 +599,8 @@ static int mode_packets(const scene_in *s, int W, int H)
             }
         }
     }
-    printf("packets: %d lanes of width 4, 8, 16 checked, %d differ\n", checked, bad);
+    printf("packets: %d lanes of width 4, 8, 16 checked, %d differ; filter rejecting object %d: %d calls\n", checked,
+           bad, K, ctx1.calls);
     free(rays);
     free(one);
     free(occ1);
@@ -587,7 +616,7 @@ static int mode_surface(const scene_in *s, int W, int H)
     emb e;
     int n = W * H, k, rays = 0, idbad = 0, tbad = 0, early = 0;
     const float tnear = 1e-4f;
-    embree_scene(s, &e, 0);
+    embree_scene(s, &e, 0, RTC_SCENE_FLAG_NONE);
     for (k = 0; k < n; ++k) {
         float o[3], d[3], so[3], sd[3];
         double dd[3], r[3], len;
@@ -630,7 +659,7 @@ static int mode_masks(const scene_in *s, int W, int H)
     emb e;
     int n = W * H, k, bad[4] = {0, 0, 0, 0}, hits[4] = {0, 0, 0, 0}, total = 0;
     unsigned masks[4] = {1, 2, 3, 4};
-    embree_scene(s, &e, 0);
+    embree_scene(s, &e, 0, RTC_SCENE_FLAG_NONE);
     for (k = 0; k < n; ++k) {
         float o[3], d[3];
         rt_hit h;
@@ -657,33 +686,12 @@ static int mode_masks(const scene_in *s, int W, int H)
     return (bad[0] + bad[1] + bad[2]) * 10000 > 3 * total || hits[3] != 0 || hits[1] == 0 || hits[0] == 0;
 }
 
-/* Filters that reject every hit on scene object `reject_k` (a geometry user pointer cannot say which scene it
- * is, so the object to reject travels in a global-free way: the primID, compared with a value in the context). */
-typedef struct reject_context {
-    ig_embree_context ig; /* first: the adapter reads its hits table */
-    unsigned prim;
-    int calls;
-} reject_context;
-
-static void reject_prim(const struct RTCFilterFunctionNArguments *args)
-{
-    reject_context *c = (reject_context *)args->context;
-    unsigned i;
-    for (i = 0; i < args->N; ++i)
-        if (args->valid[i] != 0) {
-            ++c->calls;
-            if (LANE_U(args->hit, args->N, 5, i) == c->prim && LANE_U(args->hit, args->N, 6, i) == 0)
-                args->valid[i] = 0;
-        }
-}
-
 static int mode_filter(const scene_in *s, int W, int H, int K)
 {
     rt_scene *t = tracer_scene(s, K, 1, 1), *tall = tracer_scene(s, -1, 1, 1);
     emb e;
     int n = W * H, k, variant, bad[2] = {0, 0}, obad[2] = {0, 0}, tbad = 0, changed = 0, shadows = 0, calls = 0;
-    embree_scene(s, &e, 0);
-    rtcSetSceneFlags(e.scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION); /* Embree runs context filters only then */
+    embree_scene(s, &e, 0, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION); /* Embree runs context filters only then */
     if (e.alg_geom != 0)
         fail("the shapes' geometry must be geometry 0");
     for (variant = 0; variant < 2; ++variant) {
@@ -752,7 +760,7 @@ static int mode_bench(const scene_in *s, int W, int H, int reps)
     double sink = 0.0;
     if (!rays || !sh)
         fail("out of memory");
-    embree_scene(s, &e, 0);
+    embree_scene(s, &e, 0, RTC_SCENE_FLAG_NONE);
     for (k = 0; k < n; ++k) {
         ig_embree_context ctx;
         struct RTCRayHit rh;
@@ -855,7 +863,7 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "agree") && argc > 6)
         rc = mode_agree(&s, W, H, argv[5], atoi(argv[6]));
     else if (!strcmp(argv[1], "packets"))
-        rc = mode_packets(&s, W, H);
+        rc = mode_packets(&s, W, H, argc > 5 ? atoi(argv[5]) : -1);
     else if (!strcmp(argv[1], "surface"))
         rc = mode_surface(&s, W, H);
     else if (!strcmp(argv[1], "masks"))
