@@ -54,8 +54,9 @@ glslang:
 	@$(call debian,glslangValidator,glslang-tools,the GLSL validation tests will be skipped)
 
 # Embree 3 (its header and library) for the adapter's tests, examples/embree/ and bench/embree.py (docs/embree.md).
+EMBREE_HEADER ?= /usr/include/embree3/rtcore.h
 embree:
-	@$(call debian_if,test -e,/usr/include/embree3/rtcore.h,libembree-dev,the Embree tests will be skipped)
+	@$(call debian_if,test -e,$(EMBREE_HEADER),libembree-dev,the Embree tests will be skipped)
 
 # examples/embree/scene.c: generated shapes as Embree user geometry beside a triangle mesh, rendered to a PPM.
 EMBREE_OUT ?= out/embree
