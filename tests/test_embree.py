@@ -181,3 +181,17 @@ def test_the_benchmark_mode_runs_clean(driver, scene_file):
         r"bench: rays 576 tracer \S+ embree1 \S+ embree8 \S+ tracer_shadow \S+ embree_shadow \S+ hits (\d+)", line
     )
     assert m and int(m[1]) > 0, line
+
+
+def test_the_snippet_in_the_docs_compiles(tmp_path):
+    """docs/embree.md's C block, as a user copies it, with the project's warnings."""
+    from implgen.compile.clib import WARNING_FLAGS, compiler
+
+    text = (ROOT / "docs/embree.md").read_text()
+    blocks = re.findall(r"```c\n(.*?)```", text, re.S)
+    assert len(blocks) == 1 and "ig_embree_new_geometry" in blocks[0]
+    src = tmp_path / "snippet.c"
+    src.write_text(blocks[0])
+    cmd = [compiler(), *WARNING_FLAGS, f"-I{ROOT / 'runtime_c'}", f"-I{ROOT / 'generated'}", "-c", str(src)]
+    proc = subprocess.run([*cmd, "-o", str(tmp_path / "snippet.o")], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
