@@ -12,6 +12,7 @@ import re
 import shutil
 import subprocess
 import sys
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -85,12 +86,20 @@ def test_every_pixel_against_the_tracer_with_the_exact_judge(driver, scene_file,
         assert e_right or t_right, f"pixel {k}: neither {tracer} nor {embree} holds exactly"
         wrong_embree += not e_right
     assert wrong_embree == 0
+    # shadow rays the two answer differently, decided too: does any object truly meet the ray in [0, 1]?
+    for k in np.flatnonzero(occ_differ):
+        truth = any(judge.has_root(j, a["so"][k], a["sd"][k], Fraction(0), Fraction(1)) for j in range(nshapes + 1))
+        assert bool(a["occ_embree"][k]) == truth, f"shadow ray of pixel {k}: Embree says {a['occ_embree'][k]}"
     # the judge itself, on pixels the two agree on: the answer holds, a miss or a distance 1 % off does not
     rng = np.random.default_rng(5)
     for k in rng.choice(np.flatnonzero(both), 12, replace=False):
         o, d, hit = a["o"][k], a["d"][k], (int(ot[k]), float(tt[k]))
         assert judge.right(hit, (-1, np.inf), o, d) and not judge.right((-1, np.inf), hit, o, d)
         assert not judge.right((hit[0], 1.01 * hit[1]), hit, o, d)
+    lit, dark = np.flatnonzero(shadow & (a["occ_tracer"] == 0)), np.flatnonzero(a["occ_tracer"] == 1)
+    for k in [*rng.choice(lit, 4, replace=False), *rng.choice(dark, 4, replace=False)]:
+        truth = any(judge.has_root(j, a["so"][k], a["sd"][k], Fraction(0), Fraction(1)) for j in range(nshapes + 1))
+        assert truth == bool(a["occ_tracer"][k])
 
 
 def test_instances_place_shapes_in_float(driver, scene_file, tmp_path):
