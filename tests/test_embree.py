@@ -123,6 +123,11 @@ def test_packets_of_4_8_16_answer_as_single_rays(driver, scene_file, k):
     assert (int(m[3]) > 0) == (k >= 0), line
 
 
+def test_threads_tracing_at_once_answer_as_one(driver, scene_file):
+    line = run(driver, "threads", scene_file, 64, 36, 3)
+    assert line.strip() == f"threads: 3 threads x {64 * 36} rays against one thread, 0 differ", line
+
+
 def test_rays_leaving_a_surface_do_not_hit_it_again(driver, scene_file):
     line = run(driver, "surface", scene_file, 96, 54)
     rays, early, ids, dist = numbers(line)[:4]

@@ -17,6 +17,7 @@
  *   surface          rays leaving the tracer's hit points (tnear = 1e-4) through both
  *   masks            geometry masks: algebraic 2, ground 1; rays of mask 1, 2, 3 against tracers without the rest
  *   filter K         context, geometry and occlusion filters that reject object K against a tracer without K
+ *   threads T        T threads tracing the camera rays at once (each its own double-hit table) against one
  *   bench REPS       rays/s of the tracer and of Embree (1 and 8 wide), primary and shadow rays, one thread
  * Prints one summary line per check; exit status 1 when a check fails.
  */
@@ -33,6 +34,7 @@
 #include "torus_z.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -744,6 +746,74 @@ static int mode_filter(const scene_in *s, int W, int H, int K)
     return changed == 0 || calls == 0 || (bad[0] + bad[1]) * 10000 > 2 * n || tbad != 0 || obad[0] + obad[1] != 0;
 }
 
+/* Several threads tracing the same rays at once, each with its own double-hit table, against one thread. */
+typedef struct thread_job {
+    const scene_in *s;
+    const emb *e;
+    int W, H;
+    float *tfar;
+    unsigned *ids;
+    ig_embree_hit *rec;
+} thread_job;
+
+static void *trace_all(void *arg)
+{
+    thread_job *j = (thread_job *)arg;
+    int n = j->W * j->H, k;
+    ig_embree_context ctx;
+    ig_embree_context_init(&ctx, j->rec, (unsigned)n);
+    for (k = 0; k < n; ++k) {
+        float o[3], d[3];
+        struct RTCRayHit rh;
+        camera_ray(j->s, j->W, j->H, k % j->W, k / j->W, o, d);
+        set_ray(&rh.ray, o, d, 0.0f, INFINITY, ~0u, (unsigned)k);
+        rh.hit.geomID = rh.hit.primID = rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(j->e->scene, &ctx.rtc, &rh);
+        j->tfar[k] = rh.ray.tfar;
+        j->ids[2 * k] = rh.hit.geomID;
+        j->ids[2 * k + 1] = rh.hit.primID;
+    }
+    return NULL;
+}
+
+static int mode_threads(const scene_in *s, int W, int H, int nthreads)
+{
+    emb e;
+    int n = W * H, t, k, bad = 0;
+    thread_job jobs[9];
+    pthread_t th[8];
+    if (nthreads < 1 || nthreads > 8)
+        fail("1 to 8 threads");
+    embree_scene(s, &e, 0, RTC_SCENE_FLAG_NONE);
+    for (t = 0; t <= nthreads; ++t) { /* job 0: alone, first; jobs 1..nthreads: at once */
+        jobs[t].s = s, jobs[t].e = &e, jobs[t].W = W, jobs[t].H = H;
+        jobs[t].tfar = malloc(sizeof(float) * (size_t)n);
+        jobs[t].ids = malloc(sizeof(unsigned) * 2 * (size_t)n);
+        jobs[t].rec = malloc(sizeof(ig_embree_hit) * (size_t)n);
+        if (!jobs[t].tfar || !jobs[t].ids || !jobs[t].rec)
+            fail("out of memory");
+    }
+    trace_all(&jobs[0]);
+    for (t = 1; t <= nthreads; ++t)
+        if (pthread_create(&th[t - 1], NULL, trace_all, &jobs[t]) != 0)
+            fail("cannot start a thread");
+    for (t = 1; t <= nthreads; ++t)
+        pthread_join(th[t - 1], NULL);
+    for (t = 1; t <= nthreads; ++t)
+        for (k = 0; k < n; ++k)
+            bad += memcmp(&jobs[t].tfar[k], &jobs[0].tfar[k], sizeof(float)) != 0 ||
+                   jobs[t].ids[2 * k] != jobs[0].ids[2 * k] || jobs[t].ids[2 * k + 1] != jobs[0].ids[2 * k + 1] ||
+                   (jobs[0].ids[2 * k] == e.alg_geom && jobs[t].rec[k].t != jobs[0].rec[k].t);
+    printf("threads: %d threads x %d rays against one thread, %d differ\n", nthreads, n, bad);
+    for (t = 0; t <= nthreads; ++t) {
+        free(jobs[t].tfar);
+        free(jobs[t].ids);
+        free(jobs[t].rec);
+    }
+    embree_free(s, &e);
+    return bad != 0;
+}
+
 static double now(void)
 {
     struct timespec ts;
@@ -870,6 +940,8 @@ int main(int argc, char **argv)
         rc = mode_masks(&s, W, H);
     else if (!strcmp(argv[1], "filter") && argc > 5)
         rc = mode_filter(&s, W, H, atoi(argv[5]));
+    else if (!strcmp(argv[1], "threads") && argc > 5)
+        rc = mode_threads(&s, W, H, atoi(argv[5]));
     else if (!strcmp(argv[1], "bench") && argc > 5)
         rc = mode_bench(&s, W, H, atoi(argv[5]));
     else
