@@ -25,6 +25,9 @@ SOLVER_SOURCES = (
 BENCH_SOURCES = ("roots_bench.c",)  # clock_gettime around every solve: `implgen bench solvers`
 SHAPE_SOURCES = ("shape.c",)
 TRACER_SOURCES = ("tracer_scene.c", "tracer_hit.c", "tracer_csg.c", "tracer_shade.c", "tracer_render.c")
+# The Embree 3 adapter (docs/embree.md): in no library implgen builds, so nothing here needs Embree; compiled by
+# whoever links Embree (examples/embree/, tests/test_embree.py, bench/embree.py)
+EMBREE_SOURCES = ("embree_shape.c",)
 # The GLSL runtime, in the order a program concatenates it (before the generated shapes: docs/glsl.md)
 GLSL_RUNTIME_SOURCES = ("raa.glsl", "clip.glsl", "ray.glsl", "camera.glsl", "shade.glsl")
 
