@@ -5,11 +5,12 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.implgen-installed
-SOURCES := pyproject.toml $(shell find generator templates runtime_c runtime_glsl -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' -o -name '*.glsl' \
+SOURCES := pyproject.toml $(wildcard examples/shapes/*.yaml) \
+           $(shell find generator templates runtime_c runtime_glsl -type f \( -name '*.py' -o -name '*.j2' -o -name '*.c' -o -name '*.h' -o -name '*.glsl' \
                        -o -name '*.html' -o -name '*.js' -o -name '*.css' \) 2>/dev/null)
-C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c)
+C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c examples/embree/*.c)
 
-.PHONY: demo test lint tools browser povray glslang screenshot install regen gallery bench clean
+.PHONY: demo test lint tools browser povray glslang embree embree-example embree-picture screenshot install regen gallery bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -26,18 +27,20 @@ install: $(STAMP)
 demo: install
 	$(BIN)/implgen demo
 
-test: install browser povray glslang
+test: install browser povray glslang embree
 	$(BIN)/python -m pytest -q tests
 
 # $(call debian,PROGRAMS,PACKAGES,WHAT IS SKIPPED): when a program is missing, install the Debian packages as
 # root (CI runs as root); as anyone else say in one line what is skipped and how to install it, and go on --
 # unless IMPLGEN_REQUIRE_ALL is set (CI sets it): then stop. The tests skip or fail alike (tests/needs_program.py).
-debian = missing=; for p in $(1); do command -v $$p >/dev/null || missing="$$missing $$p"; done; \
+debian = $(call debian_if,command -v,$(1),$(2),$(3))
+# $(call debian_if,CHECK,NAMES,PACKAGES,WHAT): the same with any check run on each name (`test -e` for a header).
+debian_if = missing=; for p in $(2); do $(1) $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
   if [ -z "$$missing" ]; then :; \
-  elif [ "$$(id -u)" = 0 ]; then apt-get update -qq && apt-get install -y -qq $(2) >/dev/null; \
+  elif [ "$$(id -u)" = 0 ]; then apt-get update -qq && apt-get install -y -qq $(3) >/dev/null; \
   elif [ -n "$$IMPLGEN_REQUIRE_ALL" ]; then \
-    echo "make:$$missing not installed and IMPLGEN_REQUIRE_ALL is set (as root: apt-get install $(2))" >&2; exit 1; \
-  else echo "make:$$missing not installed: $(3) (as root: apt-get install $(2))"; fi
+    echo "make:$$missing not installed and IMPLGEN_REQUIRE_ALL is set (as root: apt-get install $(3))" >&2; exit 1; \
+  else echo "make:$$missing not installed: $(4) (as root: apt-get install $(3))"; fi
 
 # Headless Chromium and its driver for the viewer's browser test.
 browser:
@@ -50,6 +53,26 @@ povray:
 # Khronos' reference compiler, which validates every generated shader as GLSL ES 3.00 and as GLSL 4.50.
 glslang:
 	@$(call debian,glslangValidator,glslang-tools,the GLSL validation tests will be skipped)
+
+# Embree 3 (its header and library) for the adapter's tests, examples/embree/ and bench/embree.py (docs/embree.md).
+EMBREE_HEADER ?= /usr/include/embree3/rtcore.h
+embree:
+	@$(call debian_if,test -e,$(EMBREE_HEADER),libembree-dev,the Embree tests will be skipped)
+
+# examples/embree/scene.c: generated shapes as Embree user geometry beside a triangle mesh, rendered to a PPM.
+EMBREE_OUT ?= out/embree
+EMBREE_SHAPES := torus_y heart chmutov8 sphere
+EMBREE_SOURCES := examples/embree/scene.c runtime_c/embree_shape.c runtime_c/shape.c \
+  $(filter-out runtime_c/roots_bench.c,$(wildcard runtime_c/roots*.c)) $(EMBREE_SHAPES:%=generated/%.c)
+embree-example: embree
+	@mkdir -p $(EMBREE_OUT)
+	$${CC:-cc} -std=c99 -Wall -Wextra -Werror -pedantic -O2 -Iruntime_c -Igenerated -o $(EMBREE_OUT)/scene \
+	  $(EMBREE_SOURCES) -lembree3 -lm
+	$(EMBREE_OUT)/scene $(EMBREE_OUT)/scene.ppm
+
+# The README's picture of it (docs/embree.md).
+embree-picture: install embree-example
+	$(BIN)/python -c "from PIL import Image; Image.open('$(EMBREE_OUT)/scene.ppm').save('docs/gallery/embree.png', optimize=True)"
 
 # The README's picture of `implgen view`, taken by the browser test.
 screenshot: install browser
@@ -73,9 +96,10 @@ tools:
 regen: install
 	$(BIN)/implgen examples/shapes/*.yaml --lang all -o generated
 
-# Render every example scene into docs/gallery/ (images + times.md).
+# Render every example scene into docs/gallery/ (images + times.md), and the famous surfaces' contact sheet.
 gallery: install
 	$(BIN)/python bench/gallery.py
+	$(BIN)/python bench/surfaces.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -56,7 +56,7 @@ bool heart_bounds(out vec3 lo, out vec3 hi)
 
 // f over a segment of a ray in reduced affine arithmetic: x, y, z are affine forms vec3(centre, slope,
 // radius) of the coordinates on the segment, and so is the result; every rounding is in its radius.
-// Evaluated in the tree's own form (not expanded).
+// Evaluated in the tree as written (not expanded).
 vec3 heart_raa(vec3 x, vec3 y, vec3 z)
 {
     vec3 a0 = ig_raa_sqr(x);

@@ -4,7 +4,9 @@
  *
  * - error-free transformations: a + b and a * b as an unevaluated sum of two doubles, exactly;
  * - Horner's rule, plain and compensated (as accurate as Horner in twice the working precision);
- * - one axis of the slab test of a ray against an axis-aligned box.
+ * - one axis of the slab test of a ray against an axis-aligned box;
+ * - affine 3x4 maps (row-major, as tracer.h): a point, a vector, the inverse (the tracer and the Embree adapter
+ *   move rays into object space with these, so both see the same object-space ray to the last bit).
  */
 #ifndef IMPLGEN_NUMERICS_H
 #define IMPLGEN_NUMERICS_H
@@ -85,6 +87,66 @@ static inline int ig_slab(double lo, double hi, double o, double inv, double *ta
     *ta = a;
     *tb = b;
     return 0;
+}
+
+/* out = M p + translation (out may alias p). */
+static inline void ig_affine_point(const double m[12], const double p[3], double out[3])
+{
+    double r[3];
+    int i;
+    for (i = 0; i < 3; ++i)
+        r[i] = m[4 * i] * p[0] + m[4 * i + 1] * p[1] + m[4 * i + 2] * p[2] + m[4 * i + 3];
+    out[0] = r[0];
+    out[1] = r[1];
+    out[2] = r[2];
+}
+
+/* out = M v, the linear part only (out may alias v). */
+static inline void ig_affine_vector(const double m[12], const double v[3], double out[3])
+{
+    double r[3];
+    int i;
+    for (i = 0; i < 3; ++i)
+        r[i] = m[4 * i] * v[0] + m[4 * i + 1] * v[1] + m[4 * i + 2] * v[2];
+    out[0] = r[0];
+    out[1] = r[1];
+    out[2] = r[2];
+}
+
+/* inv = M^-1 by cofactors. Returns 0 (inv untouched) when M's linear part is zero, not finite, or singular to
+ * within 1e-12 of its scale cubed. */
+static inline int ig_affine_invert(const double m[12], double inv[12])
+{
+    double a = m[0], b = m[1], c = m[2], d = m[4], e = m[5], f = m[6], g = m[8], h = m[9], k = m[10];
+    double c00 = e * k - f * h, c01 = c * h - b * k, c02 = b * f - c * e;
+    double c10 = f * g - d * k, c11 = a * k - c * g, c12 = c * d - a * f;
+    double c20 = d * h - e * g, c21 = b * g - a * h, c22 = a * e - b * d;
+    double det = a * c00 + b * c10 + c * c20;
+    double scale = 0.0, t[3];
+    int i;
+    for (i = 0; i < 12; ++i)
+        if (i % 4 != 3 && fabs(m[i]) > scale)
+            scale = fabs(m[i]);
+    if (!(scale > 0.0) || !isfinite(det) || fabs(det) <= 1e-12 * scale * scale * scale)
+        return 0;
+    inv[0] = c00 / det;
+    inv[1] = c01 / det;
+    inv[2] = c02 / det;
+    inv[4] = c10 / det;
+    inv[5] = c11 / det;
+    inv[6] = c12 / det;
+    inv[8] = c20 / det;
+    inv[9] = c21 / det;
+    inv[10] = c22 / det;
+    inv[3] = inv[7] = inv[11] = 0.0;
+    t[0] = m[3];
+    t[1] = m[7];
+    t[2] = m[11];
+    ig_affine_vector(inv, t, t);
+    inv[3] = -t[0];
+    inv[7] = -t[1];
+    inv[11] = -t[2];
+    return 1;
 }
 
 #endif

@@ -15,23 +15,9 @@
 
 /* ------------------------------------------------------------------ small helpers */
 
-void rt_xform_point(const double m[12], const double p[3], double out[3])
-{
-    double r[3];
-    int i;
-    for (i = 0; i < 3; ++i)
-        r[i] = m[4 * i] * p[0] + m[4 * i + 1] * p[1] + m[4 * i + 2] * p[2] + m[4 * i + 3];
-    memcpy(out, r, sizeof r);
-}
+void rt_xform_point(const double m[12], const double p[3], double out[3]) { ig_affine_point(m, p, out); }
 
-void rt_xform_vector(const double m[12], const double v[3], double out[3])
-{
-    double r[3];
-    int i;
-    for (i = 0; i < 3; ++i)
-        r[i] = m[4 * i] * v[0] + m[4 * i + 1] * v[1] + m[4 * i + 2] * v[2];
-    memcpy(out, r, sizeof r);
-}
+void rt_xform_vector(const double m[12], const double v[3], double out[3]) { ig_affine_vector(m, v, out); }
 
 void rt_to_object(const rt_node *n, const double o[3], const double d[3], double oo[3], double od[3])
 {
@@ -68,40 +54,6 @@ static int fail(rt_scene *s, const char *msg)
 }
 
 /* Inverse of an affine 3x4 map. Returns 0 when the linear part is singular (relative to its size). */
-static int invert_affine(const double m[12], double inv[12])
-{
-    double a = m[0], b = m[1], c = m[2], d = m[4], e = m[5], f = m[6], g = m[8], h = m[9], k = m[10];
-    double c00 = e * k - f * h, c01 = c * h - b * k, c02 = b * f - c * e;
-    double c10 = f * g - d * k, c11 = a * k - c * g, c12 = c * d - a * f;
-    double c20 = d * h - e * g, c21 = b * g - a * h, c22 = a * e - b * d;
-    double det = a * c00 + b * c10 + c * c20;
-    double scale = 0.0, t[3];
-    int i;
-    for (i = 0; i < 12; ++i)
-        if (i % 4 != 3 && fabs(m[i]) > scale)
-            scale = fabs(m[i]);
-    if (!(scale > 0.0) || !isfinite(det) || fabs(det) <= 1e-12 * scale * scale * scale)
-        return 0;
-    inv[0] = c00 / det;
-    inv[1] = c01 / det;
-    inv[2] = c02 / det;
-    inv[4] = c10 / det;
-    inv[5] = c11 / det;
-    inv[6] = c12 / det;
-    inv[8] = c20 / det;
-    inv[9] = c21 / det;
-    inv[10] = c22 / det;
-    inv[3] = inv[7] = inv[11] = 0.0;
-    t[0] = m[3];
-    t[1] = m[7];
-    t[2] = m[11];
-    rt_xform_vector(inv, t, t);
-    inv[3] = -t[0];
-    inv[7] = -t[1];
-    inv[11] = -t[2];
-    return 1;
-}
-
 /* ------------------------------------------------------------------ building */
 
 rt_scene *rt_scene_new(void)
@@ -212,7 +164,7 @@ int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, 
     if (nparams > 0)
         memcpy(n->params, params, (size_t)nparams * sizeof(double));
     memcpy(n->m, m, sizeof n->m);
-    if (!invert_affine(n->m, n->minv)) {
+    if (!ig_affine_invert(n->m, n->minv)) {
         free(n->params);
         s->nnodes--;
         return fail(s, "transform is singular");

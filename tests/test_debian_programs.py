@@ -5,6 +5,7 @@ fails instead; as root `make` installs it. Run in child processes with PATH cut 
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -122,3 +123,40 @@ def test_make_does_nothing_when_the_programs_are_there(tmp_path):
     (path / "find").symlink_to(shutil.which("find"))
     p = _make(["browser", "povray", "tools"], path, require_all=True)
     assert (p.returncode, p.stdout, p.stderr) == (0, "", "") and not log.exists()
+
+
+def test_the_embree_tests_carry_the_library_marker(tmp_path):
+    """Without a C compiler that links libembree3 (here: none on PATH) every Embree test is skipped with one
+    reason naming libembree-dev; with IMPLGEN_REQUIRE_ALL each is an error."""
+    empty = _bin(tmp_path / "empty")
+    p = _pytest(["tests/test_embree.py"], empty, ROOT, require_all=False)
+    assert p.returncode == 0, p.stdout + p.stderr
+    assert "passed" not in p.stdout and re.search(r"\d+ skipped", p.stdout)
+    assert "libembree3 not installed (Debian: apt-get install libembree-dev)" in p.stdout
+    p = _pytest(["tests/test_embree.py"], empty, ROOT, require_all=True)
+    assert p.returncode == 1 and "skipped" not in p.stdout and "passed" not in p.stdout
+
+
+@pytest.mark.needs_program("make")
+@pytest.mark.parametrize("uid", ["1000", "0"])
+def test_make_embree_checks_the_header(tmp_path, uid):
+    """`make embree` looks for Embree's header (a library has no program to find): missing, root installs
+    libembree-dev, anyone else gets one line, and IMPLGEN_REQUIRE_ALL stops."""
+    log = tmp_path / "apt.log"
+    path = _bin(tmp_path / "bin", id=f"echo {uid}", **{"apt-get": f'echo "$*" >> {log}'})
+    for tool in ("find", "test"):
+        if shutil.which(tool):
+            (path / tool).symlink_to(shutil.which(tool))
+    gone = f"EMBREE_HEADER={tmp_path / 'none' / 'rtcore.h'}"
+    p = _make(["embree", gone], path)
+    assert p.returncode == 0, p.stderr
+    if uid == "0":
+        assert [x for x in log.read_text().splitlines() if x.startswith("install")] == ["install -y -qq libembree-dev"]
+        return
+    assert not log.exists()
+    assert p.stdout.splitlines() == [
+        f"make: {tmp_path / 'none' / 'rtcore.h'} not installed: the Embree tests will be skipped "
+        "(as root: apt-get install libembree-dev)"
+    ]
+    p = _make(["embree", gone], path, require_all=True)
+    assert p.returncode != 0 and "IMPLGEN_REQUIRE_ALL is set (as root: apt-get install libembree-dev)" in p.stderr

@@ -18,7 +18,7 @@ import pytest
 from conftest import SHAPES_DIR
 from implgen.bench import glslcases, glslcheck
 from implgen.codegen.glslprogram import program
-from implgen.codegen.spec import load_spec
+from implgen.codegen.spec import load_spec, parse_spec
 from implgen.roots import exactray
 
 pytestmark = pytest.mark.needs_program("chromium", "chromedriver")
@@ -49,20 +49,32 @@ def test_hit_mask_matches_the_exact_answer(gl, case):
     """No pixel is wrong without its flag; at most 1 % of the object's pixels are flagged; the certified hits'
     t agree with C's within float resolution."""
     r = _compare(gl, case)
-    assert r.object_pixels > 0.1 * r.pixels  # the shape fills the picture
+    assert r.object_pixels > 0.05 * r.pixels  # the shape is in the picture (the slim Zitrus covers 8 %)
     assert r.glsl_wrong_unflagged == 0, r.examples
     assert r.glsl_wrong <= 0.001 * r.object_pixels, r.examples
     assert r.flagged <= 0.01 * r.object_pixels
     assert r.t_rel_err_max < 2e-5
 
 
-def test_power_form_of_a_degree_16_surface_is_flagged_not_guessed(gl):
-    """The expanded Chebyshev polynomial cancels by ~6e5 near |x| = 1: float cannot certify the sign of f on
-    the surface, and the runtime says so (docs/glsl.md); no answer is wrong without its flag."""
-    case = glslcases.view_case("chmutov16", glslcases.chmutov(16, nested=False), SIZE)
+@pytest.mark.parametrize("n", [16, 24])
+def test_power_form_is_drawn_from_its_chebyshev_form(gl, n):
+    """The expanded Chebyshev polynomial cancels by ~(1 + sqrt 2)^n / 2 near |x| = 1; its box's Chebyshev form
+    (codegen/chebform.py) does not, and the surface is certified like the nested one."""
+    case = glslcases.view_case(f"chmutov{n}", glslcases.chmutov(n, nested=False), SIZE)
     r = _compare(gl, case)
+    assert r.object_pixels > 0.1 * r.pixels
+    assert r.glsl_wrong == 0, r.examples
+    assert r.flagged <= 0.01 * r.object_pixels
+
+
+def test_power_form_without_a_box_is_flagged_not_guessed(gl):
+    """With no box there is no Chebyshev form: float cannot certify the sign of f on the surface, and the
+    runtime says so (docs/glsl.md); no answer is wrong without its flag."""
+    power = glslcases.chmutov(16, nested=False)
+    spec = parse_spec({"name": "chmutov16", "equation": power.equation}, "<test>")
+    r = _compare(gl, glslcases.view_case("chmutov16 unbounded", spec, SIZE))
     assert r.glsl_wrong_unflagged == 0
-    assert r.flagged > 0.5 * r.object_pixels
+    assert r.flagged > 0.2 * r.object_pixels  # about half, where |x|, |y| or |z| is near 1
 
 
 def test_torus_from_a_thousand_units(gl):

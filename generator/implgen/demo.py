@@ -59,7 +59,7 @@ def main(argv: Sequence[str]) -> int:
         raise UserError(args.shapes, "no *.yaml shape specs here (run `make demo` from the repository)")
     gen_dir = args.output / "generated"
     print(f"Generating {len(specs)} example shapes into {gen_dir}/\n")
-    print(f"{'shape':<10} {'degree':>6} {'params':<18} {'coeff ops':>9} {'gen ms':>7} {'rays hit':>9}")
+    print(f"{'shape':<14} {'degree':>6} {'params':<18} {'coeff ops':>9} {'gen ms':>7} {'rays hit':>9}")
     rows = []
     for path in specs:
         start = time.perf_counter()
@@ -77,7 +77,7 @@ def main(argv: Sequence[str]) -> int:
         module = _import(gen_dir / f"{spec.name}.py")
         hits, total = _ray_fan(module, module.bounds())
         params = ", ".join(f"{k}={v:g}" for k, v in spec.params.items()) or "-"
-        print(f"{spec.name:<10} {spec.degree:>6} {params:<18} {ops:>9} {ms:>7.0f} {hits:>4}/{total}")
+        print(f"{spec.name:<14} {spec.degree:>6} {params:<18} {ops:>9} {ms:>7.0f} {hits:>4}/{total}")
     print(f"\nAll generated C compiled with {' '.join(WARNING_FLAGS)} against the runtime.")
     if SHOWCASE.exists():
         try:

@@ -1,5 +1,5 @@
-"""Where the package data (templates, C and GLSL runtime sources) lives once installed, and which runtime sources make
-which library.
+"""Where the package data (templates, C and GLSL runtime sources, the gallery's shape specs) lives once
+installed, and which runtime sources make which library.
 
 The lists are explicit: a scene library links the solvers, the shape layer and the tracer -- never the
 benchmark timing code, which only the solver library behind `implgen.roots` carries. A test checks that every
@@ -25,6 +25,9 @@ SOLVER_SOURCES = (
 BENCH_SOURCES = ("roots_bench.c",)  # clock_gettime around every solve: `implgen bench solvers`
 SHAPE_SOURCES = ("shape.c",)
 TRACER_SOURCES = ("tracer_scene.c", "tracer_hit.c", "tracer_csg.c", "tracer_shade.c", "tracer_render.c")
+# The Embree 3 adapter (docs/embree.md): in no library implgen builds, so nothing here needs Embree; compiled by
+# whoever links Embree (examples/embree/, tests/test_embree.py, bench/embree.py)
+EMBREE_SOURCES = ("embree_shape.c",)
 # The GLSL runtime, in the order a program concatenates it (before the generated shapes: docs/glsl.md)
 GLSL_RUNTIME_SOURCES = ("raa.glsl", "clip.glsl", "ray.glsl", "camera.glsl", "shade.glsl")
 
@@ -42,6 +45,13 @@ def runtime_dir() -> Path:
 def runtime_glsl_dir() -> Path:
     """Folder holding the hand-written GLSL runtime (`*.glsl`, concatenated in GLSL_RUNTIME_SOURCES order)."""
     return _PACKAGE_DIR / "runtime_glsl" if (_PACKAGE_DIR / "runtime_glsl").is_dir() else _TREE / "runtime_glsl"
+
+
+def gallery_dir() -> Path:
+    """Folder holding the gallery's shape specs: the repository's examples/shapes/, installed as
+    `implgen.gallery` (one copy: pyproject maps the folder into the package)."""
+    installed = _PACKAGE_DIR / "gallery"
+    return installed if installed.is_dir() else _TREE / "examples" / "shapes"
 
 
 def runtime_sources(*groups: tuple[str, ...]) -> list[Path]:

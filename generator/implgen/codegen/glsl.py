@@ -21,6 +21,7 @@ import sympy
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
+from implgen.codegen.chebform import ChebForm, better_form
 from implgen.codegen.derive import Derivation
 from implgen.codegen.spec import X, Y, Z
 from implgen.errors import UserError
@@ -186,6 +187,55 @@ class _AffineCode:
         return known[k]
 
 
+def chebyshev_affine_code(form: ChebForm) -> tuple[list[str], str]:
+    """(statements, result) computing f's affine form from x, y, z in the Chebyshev basis of its box
+    (codegen/chebform.py): u = (x - centre) / half-width, T_n(u) by doubling, then
+    sum_i T_i(u) (sum_j T_j(v) (sum_k c_ijk T_k(w)))."""
+    code = _AffineCode({})
+    tables = []
+    for axis, var in enumerate("xyz"):
+        centre, half = form.centre[axis], form.half[axis]
+        u = var if centre == 0 else code._new(f"ig_raa_sub({var}, {code.constant(centre)})")
+        u = u if half == 1 else code._new(f"ig_raa_mul({u}, {code.constant(1 / half)})")
+        table = {1: u}
+        for n in range(2, max(m[axis] for m in form.coeffs) + 1):  # T_m and T_m+1 come before T_2m, T_2m+1
+            m = n // 2
+            if n % 2 == 0:
+                double = code._new(f"ig_raa_mul({code._power(table[m], 2)}, {code.constant(Fraction(2))})")
+                table[n] = code._new(f"ig_raa_sub({double}, {code.constant(Fraction(1))})")
+            else:
+                product = code._new(f"ig_raa_mul({table[m]}, {table[m + 1]})")
+                double = code._new(f"ig_raa_mul({product}, {code.constant(Fraction(2))})")
+                table[n] = code._new(f"ig_raa_sub({double}, {u})")
+        tables.append(table)
+    nested: dict[int, dict[int, dict[int, Fraction]]] = {}
+    for (i, j, k), c in sorted(form.coeffs.items()):
+        nested.setdefault(i, {}).setdefault(j, {})[k] = c
+
+    def term(factor: int, axis: int, inner: str) -> str:
+        return inner if factor == 0 else code._new(f"ig_raa_mul({tables[axis][factor]}, {inner})")
+
+    def total(parts: list[str]) -> str:
+        acc = parts[0]
+        for part in parts[1:]:
+            acc = code._new(f"ig_raa_add({acc}, {part})")
+        return acc
+
+    result = total(
+        [
+            term(
+                i,
+                0,
+                total(
+                    [term(j, 1, total([term(k, 2, code.constant(c)) for k, c in zs.items()])) for j, zs in ys.items()]
+                ),
+            )
+            for i, ys in nested.items()
+        ]
+    )
+    return code.lines, result
+
+
 def affine_code(f: sympy.Expr, params: dict[sympy.Symbol, str]) -> tuple[list[str], str]:
     """(statements, result) computing f's affine form from x, y, z; `params` maps each param symbol to the
     GLSL float it is read from. Shared subtrees are computed once (one `cse`)."""
@@ -209,5 +259,11 @@ def glsl_extra(derivation: Derivation) -> dict:
         )
     uniform = f"{spec.name}_params"
     params = {s: f"{uniform}[{i}]" for i, s in enumerate(spec.param_symbols)}
-    lines, result = affine_code(spec.f, params)
-    return {"uniform": uniform, "raa": {"lines": lines, "result": result}}
+    form = None if params else better_form(spec.f, spec.bounds)
+    if form is None:
+        lines, result = affine_code(spec.f, params)
+        basis = "the tree as written (not expanded)"
+    else:
+        lines, result = chebyshev_affine_code(form)
+        basis = "the Chebyshev basis of the box, which float evaluates far better than the tree as written"
+    return {"uniform": uniform, "raa": {"lines": lines, "result": result, "basis": basis}}

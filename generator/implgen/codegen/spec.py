@@ -5,7 +5,8 @@
     params: {a: 1.0}                    # optional ordered mapping name -> default number
     bounds: {x: [0, 1], y: [-0.5, 0.5]} # optional object-space box; numbers or expressions in params;
                                         # an axis left out is unbounded
-    description: a peg top              # optional
+    description: a peg top              # optional; title, reference (a citation) too: text, never in generated code
+    ranges: {a: [0.5, 2]}               # optional: a slider's range per param (the viewer, the gallery)
 
 Inside is f < 0 with f = lhs - rhs; the outward normal is grad f / |grad f|.
 """
@@ -34,6 +35,7 @@ from implgen.yamlfile import read_yaml
 MAX_DEGREE = abi.value("IG_MAX_DEGREE")  # the solvers' limit, read from runtime_c/roots.h
 MAX_PARAMS = 64
 MAX_DESCRIPTION = 2_000
+MAX_TEXT = {"title": 80, "reference": 500, "description": MAX_DESCRIPTION}  # the spec's texts, in characters
 MAX_COEFF_BITS = paramvalues.MAX_COEFF_BITS  # |numerator|, |denominator| of every expanded coefficient
 # (2^900 ~ 8e270: room for the multinomial factors the ray coefficients multiply them by)
 # Generation time grows with the size of f as written times its degree (Taylor coefficients, then one cse):
@@ -41,7 +43,7 @@ MAX_COEFF_BITS = paramvalues.MAX_COEFF_BITS  # |numerator|, |denominator| of eve
 # polynomial of 1150 terms, size 169,000, took 8.5 minutes). The example shapes are below 400.
 MAX_SIZE_DEGREE = 10_000
 AXES = paramvalues.AXES
-KEYS = ("name", "equation", "params", "bounds", "description")
+KEYS = ("name", "title", "description", "reference", "equation", "params", "ranges", "bounds")
 X, Y, Z = sympy.symbols("x y z", real=True)
 VARIABLES = {"x": X, "y": Y, "z": Z}
 
@@ -76,7 +78,11 @@ class SymbolicForm:
             bounds = {a: (lo.subs(subs), hi.subs(subs)) for a, (lo, hi) in self.bounds.items()}
         rest = {k: v for k, v in spec.params.items() if k not in values}
         folded = {**spec.folded, **{k: float(v) for k, v in values.items()}}
-        return make_spec(new_name, self.f.subs(subs), rest, spec.degree, bounds, spec.description, spec.source, folded)
+        texts = {"title": spec.title, "reference": spec.reference}
+        ranges = {k: r for k, r in spec.ranges.items() if k in rest}
+        return make_spec(
+            new_name, self.f.subs(subs), rest, spec.degree, bounds, spec.description, spec.source, folded, texts, ranges
+        )
 
 
 def make_spec(
@@ -88,6 +94,8 @@ def make_spec(
     description: str,
     source: str,
     folded: dict[str, float] | None = None,
+    texts: Mapping[str, str] | None = None,
+    ranges: Mapping[str, tuple[float, float]] | None = None,
 ) -> Spec:
     """A `Spec` with its symbolic part at hand, and the plain data a scene reads computed from it."""
     symbols = [param_symbol(p) for p in params]
@@ -113,6 +121,9 @@ def make_spec(
         description=description,
         source=source,
         folded=folded,
+        title=(texts or {}).get("title", ""),
+        reference=(texts or {}).get("reference", ""),
+        ranges=dict(ranges or {}),
     )
     return spec
 
@@ -237,11 +248,43 @@ def parse_spec(data: Any, source: str = "<spec>") -> Spec:
     params = _parse_params(source, data.get("params"))
     f, degree = _parse_equation(source, data["equation"], params)
     bounds = _parse_bounds(source, data.get("bounds"), params)
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        raise UserError(source, "description: must be text")
-    if len(description) > MAX_DESCRIPTION:
-        raise UserError(source, f"description: longer than {MAX_DESCRIPTION} characters")
-    spec = make_spec(name, f, params, degree, bounds, " ".join(description.split()), source)
+    texts = {key: _parse_text(source, key, data.get(key, "")) for key in MAX_TEXT}
+    description = texts.pop("description")
+    ranges = _parse_ranges(source, data.get("ranges"), params)
+    spec = make_spec(name, f, params, degree, bounds, description, source, None, texts, ranges)
     spec.check_values({}, source, "params")  # the defaults
+    for key, (lo, hi) in ranges.items():  # every coefficient stays a finite double at both ends of a range
+        spec.check_values({key: lo}, source, f"ranges.{key}")
+        spec.check_values({key: hi}, source, f"ranges.{key}")
     return spec
+
+
+def _parse_text(source: str, key: str, value: Any) -> str:
+    """A title, description or reference: text of bounded length, its whitespace runs made single spaces. It is
+    shown (the viewer, the gallery's table), never written into generated code."""
+    if not isinstance(value, str):
+        raise UserError(source, f"{key}: must be text")
+    if len(value) > MAX_TEXT[key]:
+        raise UserError(source, f"{key}: longer than {MAX_TEXT[key]} characters")
+    return " ".join(value.split())
+
+
+def _parse_ranges(source: str, raw: Any, params: dict[str, float]) -> dict[str, tuple[float, float]]:
+    """`ranges: {param: [low, high]}`: the span a slider offers for a declared param, holding its default."""
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict):
+        raise UserError(source, "ranges: must be a mapping such as {a: [0.5, 2]}")
+    ranges: dict[str, tuple[float, float]] = {}
+    for key, pair in raw.items():
+        if key not in params:
+            raise UserError(source, f"ranges: {validate.describe(key)} is not a declared param")
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise UserError(source, f"ranges.{key}: must be a pair [low, high]")
+        lo, hi = (validate.number(source, f"ranges.{key}", v, text_ok=True) for v in pair)
+        if not lo < hi:
+            raise UserError(source, f"ranges.{key}: low must be below high")
+        if not lo <= params[key] <= hi:
+            raise UserError(source, f"ranges.{key}: does not hold the default {params[key]:g}")
+        ranges[key] = (lo, hi)
+    return ranges

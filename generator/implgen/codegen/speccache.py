@@ -38,7 +38,7 @@ from implgen.codegen.specmodel import Spec, Symbolic
 from implgen.errors import UserError
 from implgen.yamlfile import read_yaml
 
-FORMAT = 2
+FORMAT = 3
 MAX_ENTRY_BYTES = 8 << 20  # an entry holds the printed equation of a spec file of at most 1 MiB
 MAX_NESTING = 8  # a spec mapping is four levels deep (bounds -> axis -> pair -> end); deeper is never valid
 _ENTRY_KEYS = {
@@ -49,6 +49,9 @@ _ENTRY_KEYS = {
     "params",
     "degree",
     "description",
+    "title",
+    "reference",
+    "ranges",
     "box",
     "spec_key",
     "terms",
@@ -84,6 +87,9 @@ def _cached_spec(entry: dict, content: str, source: str) -> Spec:
         description=entry["description"],
         source=source,
         default_box=entry["box"],
+        title=entry["title"],
+        reference=entry["reference"],
+        ranges={k: (lo, hi) for k, lo, hi in entry["ranges"]},
     )
 
 
@@ -188,7 +194,9 @@ def _entry_ok(entry: Any, key: str, data: dict) -> bool:
         return False
     if not isinstance(entry["equation"], str) or not entry["equation"]:
         return False
-    if not isinstance(entry["description"], str):
+    if not all(isinstance(entry[k], str) for k in ("description", "title", "reference")):
+        return False
+    if not _ranges_ok(entry["ranges"], [p[0] for p in params]):
         return False
     if not isinstance(entry["spec_key"], str) or not _HEX24.match(entry["spec_key"]):
         return False
@@ -203,6 +211,13 @@ def _entry_ok(entry: Any, key: str, data: dict) -> bool:
     if not all(isinstance(v, float) and not math.isnan(v) for v in box):
         return False
     return all(box[i] < box[i + 3] for i in range(3))
+
+
+def _ranges_ok(ranges: Any, params: list[str]) -> bool:
+    return isinstance(ranges, list) and all(
+        isinstance(r, list) and len(r) == 3 and r[0] in params and _number(r[1]) and _number(r[2]) and r[1] < r[2]
+        for r in ranges
+    )
 
 
 def _terms_ok(terms: Any, nparams: int) -> bool:
@@ -244,6 +259,9 @@ def _write_entry(path: Path, key: str, spec: Spec) -> None:
         "params": [[k, v] for k, v in spec.params.items()],
         "degree": spec.degree,
         "description": spec.description,
+        "title": spec.title,
+        "reference": spec.reference,
+        "ranges": [[k, lo, hi] for k, (lo, hi) in spec.ranges.items()],
         "box": None if box is None else [float(v) for v in box],
         "spec_key": spec.spec_key,
         "terms": [[c, list(e)] for c, e in spec.param_terms],

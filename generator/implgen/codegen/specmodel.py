@@ -70,6 +70,9 @@ class Spec:
     source: str = "<spec>"
     folded: dict[str, float] = field(default_factory=dict)  # params folded into constants by specialise()
     default_box: list[float] | None = field(default=None, repr=False)
+    title: str = ""  # shown, never generated: the title, the literature reference, a slider's range per param
+    reference: str = ""
+    ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     @staticmethod
     def parsed(symbolic: Symbolic) -> _Once:

@@ -1,0 +1,377 @@
+/* Generated shapes as Embree 3 user geometry: bounds, intersect and occluded callbacks (see embree_shape.h).
+ *
+ * A lane's ray (float in Embree) is taken as the doubles it holds, moved into the primitive's object space
+ * (numerics.h's affine maps, as the tracer moves it) and solved along its unit object-space direction by
+ * ig_shape_solve, the one ray/shape solve of the runtime (box clip, origin shift, certified first root): the
+ * same steps as the tracer's top-level surfaces (tracer_csg.c), so both find the same roots. Each root in
+ * [tnear, tfar] is offered to Embree's filters for this lane alone; a rejected one makes way for the next root.
+ */
+#include "embree_shape.h"
+#include "numerics.h"
+
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+/* Field k of lane i of an N-wide structure-of-arrays ray or hit (rtcore_ray.h's RTCRayN_* / RTCHitN_* layout,
+ * which its C++-only accessors spell out): rays are org_x org_y org_z tnear dir_x dir_y dir_z time tfar mask id
+ * flags, hits Ng_x Ng_y Ng_z u v primID geomID instID[levels]. */
+enum { R_ORG = 0, R_TNEAR = 3, R_DIR = 4, R_TFAR = 8, R_MASK = 9, R_ID = 10, R_FIELDS = 12 };
+enum { H_NG = 0, H_U = 3, H_V = 4, H_PRIM = 5, H_GEOM = 6, H_INST = 7, H_FIELDS = 7 + RTC_MAX_INSTANCE_LEVEL_COUNT };
+
+static inline float *ray_f(void *ray, unsigned int N, int k, unsigned int i) { return (float *)ray + k * N + i; }
+static inline unsigned int *ray_u(void *ray, unsigned int N, int k, unsigned int i)
+{
+    return (unsigned int *)ray + k * N + i;
+}
+
+#if defined(__GNUC__)
+#define IG_ALIGNED __attribute__((aligned(64)))
+#else
+#define IG_ALIGNED
+#endif
+
+/* ------------------------------------------------------------------ primitives */
+
+static double round_down(double x)
+{
+    float f = (float)x;
+    return (double)f > x ? (double)nextafterf(f, -INFINITY) : (double)f;
+}
+
+static double round_up(double x)
+{
+    float f = (float)x;
+    return (double)f < x ? (double)nextafterf(f, INFINITY) : (double)f;
+}
+
+int ig_embree_prim_init(ig_embree_prim *prim, const ig_shape *shape, const double *params,
+                        const double *object_to_geometry)
+{
+    static const double eye[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    double obox[6] = {-INFINITY, -INFINITY, -INFINITY, INFINITY, INFINITY, INFINITY}, ext = 0.0, mag = 0.0, pad;
+    int a, i;
+    memset(prim, 0, sizeof *prim);
+    if (!shape || !shape->coeffs || !shape->bounds || (shape->nparams > 0 && !params))
+        return -1;
+    memcpy(prim->m, object_to_geometry ? object_to_geometry : eye, sizeof prim->m);
+    for (i = 0; i < 12; ++i)
+        if (!isfinite(prim->m[i]))
+            return -1;
+    if (!ig_affine_invert(prim->m, prim->minv))
+        return -1;
+    prim->identity = memcmp(prim->m, eye, sizeof eye) == 0;
+    if (!shape->bounds(params, obox))
+        return -1;
+    for (a = 0; a < 6; ++a)
+        if (!isfinite(obox[a]))
+            return -1;
+    prim->shape = shape;
+    prim->params = params;
+    ig_shape_prepare(shape, params, &prim->prep);
+    /* the box through m: its 8 corners, then padded by 1e-9 of its size (rounding of the corners' images is
+     * ~1e-16 relative); the bounds callback rounds it outward to float */
+    for (a = 0; a < 3; ++a) {
+        prim->box[a] = INFINITY;
+        prim->box[a + 3] = -INFINITY;
+    }
+    for (i = 0; i < 8; ++i) {
+        double c[3] = {obox[(i & 1) ? 3 : 0], obox[(i & 2) ? 4 : 1], obox[(i & 4) ? 5 : 2]}, w[3];
+        ig_affine_point(prim->m, c, w);
+        for (a = 0; a < 3; ++a) {
+            prim->box[a] = fmin(prim->box[a], w[a]);
+            prim->box[a + 3] = fmax(prim->box[a + 3], w[a]);
+        }
+    }
+    for (a = 0; a < 3; ++a) {
+        ext = fmax(ext, prim->box[a + 3] - prim->box[a]);
+        mag = fmax(mag, fmax(fabs(prim->box[a]), fabs(prim->box[a + 3])));
+    }
+    pad = 1e-9 * (ext + mag) + DBL_MIN;
+    for (a = 0; a < 3; ++a) {
+        prim->box[a] -= pad;
+        prim->box[a + 3] += pad;
+    }
+    return 0;
+}
+
+void ig_embree_bounds(const struct RTCBoundsFunctionArguments *args)
+{
+    const ig_embree_shapes *g = (const ig_embree_shapes *)args->geometryUserPtr;
+    const double *b = g->prims[args->primID].box;
+    struct RTCBounds *o = args->bounds_o;
+    o->lower_x = (float)round_down(b[0]);
+    o->lower_y = (float)round_down(b[1]);
+    o->lower_z = (float)round_down(b[2]);
+    o->upper_x = (float)round_up(b[3]);
+    o->upper_y = (float)round_up(b[4]);
+    o->upper_z = (float)round_up(b[5]);
+}
+
+/* ------------------------------------------------------------------ one lane */
+
+/* A lane's ray in the primitive's object space: origin oo and unit direction u; returns the length L of the
+ * object-space direction (the solve's parameter is s = t L), or 0 when it is not positive and finite. */
+static double lane_ray(const ig_embree_prim *p, const double o[3], const double d[3], double oo[3], double u[3])
+{
+    double od[3], L;
+    if (p->identity) {
+        memcpy(oo, o, sizeof od);
+        memcpy(od, d, sizeof od);
+    } else {
+        ig_affine_point(p->minv, o, oo);
+        ig_affine_vector(p->minv, d, od);
+    }
+    L = sqrt(od[0] * od[0] + od[1] * od[1] + od[2] * od[2]);
+    if (!(L > 0.0) || !isfinite(L))
+        return 0.0;
+    u[0] = od[0] / L;
+    u[1] = od[1] / L;
+    u[2] = od[2] / L;
+    return L;
+}
+
+/* The first root t of the lane's ray with lo <= t <= hi (lo excluded when open): 1, or 0. */
+static int next_root(const ig_embree_prim *p, const double oo[3], const double u[3], double L, double lo, int open,
+                     double hi, double *t)
+{
+    double s0 = lo * L, r[IG_MAX_DEGREE + 2];
+    int nr, i;
+    if (open)
+        s0 = nextafter(s0, INFINITY);
+    if (!(s0 <= hi * L))
+        return 0;
+    nr = ig_shape_solve(p->shape, p->params, &p->prep, oo, u, s0, hi * L, IG_ROOTS_AUTO, 1, r, NULL);
+    for (i = 0; i < nr; ++i) {
+        double x = r[i] / L;
+        if (x >= lo && x <= hi && (!open || x > lo)) {
+            *t = x;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* The unit normal at the lane's hit in the geometry's space (grad f through m's inverse transpose), in
+ * double; facing the ray where grad f vanishes (a cone's apex). */
+static void hit_normal(const ig_embree_prim *p, const double oo[3], const double u[3], double L, double t,
+                       const double d[3], double n[3])
+{
+    double po[3], no[3], len;
+    int i;
+    for (i = 0; i < 3; ++i)
+        po[i] = oo[i] + (t * L) * u[i];
+    if (ig_shape_normal(p->shape, p->params, po, no)) {
+        for (i = 0; i < 3; ++i)
+            n[i] = p->minv[i] * no[0] + p->minv[4 + i] * no[1] + p->minv[8 + i] * no[2];
+    } else {
+        for (i = 0; i < 3; ++i)
+            n[i] = -d[i];
+    }
+    len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (len > 0.0 && isfinite(len))
+        for (i = 0; i < 3; ++i)
+            n[i] /= len;
+}
+
+static void lane_in(void *ray, unsigned int N, unsigned int i, double o[3], double d[3])
+{
+    int k;
+    for (k = 0; k < 3; ++k) {
+        o[k] = *ray_f(ray, N, R_ORG + k, i);
+        d[k] = *ray_f(ray, N, R_DIR + k, i);
+    }
+}
+
+/* The double record of ray lane i, when the context carries one. */
+static ig_embree_hit *record(const ig_embree_shapes *g, struct RTCIntersectContext *ctx, void *ray, unsigned int N,
+                             unsigned int i)
+{
+    ig_embree_context *c = (ig_embree_context *)ctx;
+    unsigned int id;
+    if (!g->double_hits || !c->hits)
+        return NULL;
+    id = *ray_u(ray, N, R_ID, i);
+    return id < c->nhits ? &c->hits[id] : NULL;
+}
+
+/* A candidate hit in lane i of an N-wide hit buffer. */
+static void put_hit(void *hit, unsigned int N, unsigned int i, const double n[3], unsigned int primID,
+                    unsigned int geomID, unsigned int instID)
+{
+    int k;
+    for (k = 0; k < 3; ++k)
+        *ray_f(hit, N, H_NG + k, i) = (float)n[k];
+    *ray_f(hit, N, H_U, i) = 0.0f;
+    *ray_f(hit, N, H_V, i) = 0.0f;
+    *ray_u(hit, N, H_PRIM, i) = primID;
+    *ray_u(hit, N, H_GEOM, i) = geomID;
+    *ray_u(hit, N, H_INST, i) = instID;
+}
+
+/* ------------------------------------------------------------------ the callbacks */
+
+void ig_embree_intersect(const struct RTCIntersectFunctionNArguments *args)
+{
+    const ig_embree_shapes *g = (const ig_embree_shapes *)args->geometryUserPtr;
+    const ig_embree_prim *p = &g->prims[args->primID];
+    unsigned int N = args->N, i, instID = args->context->instID[0];
+    void *ray = args->rayhit, *hits = (float *)args->rayhit + R_FIELDS * N;
+    union {
+        float f;
+        unsigned int u;
+    } cand[IG_EMBREE_MAX_N * H_FIELDS] IG_ALIGNED;
+    int fvalid[IG_EMBREE_MAX_N] IG_ALIGNED;
+    struct RTCFilterFunctionNArguments fa;
+    if (N > IG_EMBREE_MAX_N)
+        return;
+    fa.valid = fvalid;
+    fa.geometryUserPtr = args->geometryUserPtr;
+    fa.context = args->context;
+    fa.ray = (struct RTCRayN *)ray;
+    fa.hit = (struct RTCHitN *)cand;
+    fa.N = N;
+    memset(fvalid, 0, sizeof fvalid);
+    memset(cand, 0, sizeof cand);
+    for (i = 0; i < N; ++i) {
+        double o[3], d[3], oo[3], u[3], L, lo, hi, t, n[3];
+        float *tfar = ray_f(ray, N, R_TFAR, i);
+        ig_embree_hit *rec;
+        int open = 0, tries;
+        if (args->valid[i] == 0)
+            continue;
+        lane_in(ray, N, i, o, d);
+        lo = *ray_f(ray, N, R_TNEAR, i);
+        hi = *tfar;
+        rec = record(g, args->context, ray, N, i);
+        /* the current hit is one of ours: its double distance orders the surfaces, not the float tfar */
+        if (rec && rec->geomID == *ray_u(hits, N, H_GEOM, i) && rec->primID == *ray_u(hits, N, H_PRIM, i) &&
+            rec->instID == *ray_u(hits, N, H_INST, i) && rec->t < hi)
+            hi = rec->t;
+        L = lane_ray(p, o, d, oo, u);
+        if (!(L > 0.0) || !(lo <= hi))
+            continue;
+        for (tries = 0; tries <= p->prep.degree && next_root(p, oo, u, L, lo, open, hi, &t); ++tries) {
+            float old = *tfar;
+            hit_normal(p, oo, u, L, t, d, n);
+            put_hit(cand, N, i, n, args->primID, args->geomID, instID);
+            fvalid[i] = -1;
+            *tfar = (float)t;
+            rtcFilterIntersection(args, &fa);
+            if (fvalid[i] != 0) {
+                unsigned int k;
+                for (k = 0; k < H_FIELDS; ++k)
+                    *ray_u(hits, N, (int)k, i) = cand[k * N + i].u;
+                if (rec) {
+                    rec->t = t;
+                    memcpy(rec->n, n, sizeof rec->n);
+                    rec->geomID = args->geomID;
+                    rec->primID = args->primID;
+                    rec->instID = instID;
+                }
+                fvalid[i] = 0;
+                break;
+            }
+            *tfar = old; /* rejected by a filter: the next root along the ray */
+            lo = t;
+            open = 1;
+        }
+    }
+}
+
+void ig_embree_occluded(const struct RTCOccludedFunctionNArguments *args)
+{
+    const ig_embree_shapes *g = (const ig_embree_shapes *)args->geometryUserPtr;
+    const ig_embree_prim *p = &g->prims[args->primID];
+    unsigned int N = args->N, i, instID = args->context->instID[0];
+    void *ray = args->ray;
+    union {
+        float f;
+        unsigned int u;
+    } cand[IG_EMBREE_MAX_N * H_FIELDS] IG_ALIGNED;
+    int fvalid[IG_EMBREE_MAX_N] IG_ALIGNED;
+    struct RTCFilterFunctionNArguments fa;
+    if (N > IG_EMBREE_MAX_N)
+        return;
+    fa.valid = fvalid;
+    fa.geometryUserPtr = args->geometryUserPtr;
+    fa.context = args->context;
+    fa.ray = (struct RTCRayN *)ray;
+    fa.hit = (struct RTCHitN *)cand;
+    fa.N = N;
+    memset(fvalid, 0, sizeof fvalid);
+    memset(cand, 0, sizeof cand);
+    for (i = 0; i < N; ++i) {
+        double o[3], d[3], oo[3], u[3], L, lo, hi, t, n[3];
+        float *tfar = ray_f(ray, N, R_TFAR, i);
+        int open = 0, tries;
+        if (args->valid[i] == 0)
+            continue;
+        lane_in(ray, N, i, o, d);
+        lo = *ray_f(ray, N, R_TNEAR, i);
+        hi = *tfar;
+        L = lane_ray(p, o, d, oo, u);
+        if (!(L > 0.0) || !(lo <= hi))
+            continue;
+        for (tries = 0; tries <= p->prep.degree && next_root(p, oo, u, L, lo, open, hi, &t); ++tries) {
+            float old = *tfar;
+            hit_normal(p, oo, u, L, t, d, n);
+            put_hit(cand, N, i, n, args->primID, args->geomID, instID);
+            fvalid[i] = -1;
+            *tfar = (float)t;
+            rtcFilterOcclusion(args, &fa);
+            if (fvalid[i] != 0) {
+                *tfar = -INFINITY; /* Embree's mark of an occluded ray */
+                fvalid[i] = 0;
+                break;
+            }
+            *tfar = old;
+            lo = t;
+            open = 1;
+        }
+    }
+}
+
+RTCGeometry ig_embree_new_geometry(RTCDevice device, const ig_embree_shapes *shapes)
+{
+    RTCGeometry geom;
+    if (!device || !shapes || !shapes->prims || shapes->count == 0)
+        return NULL;
+    geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+    if (!geom)
+        return NULL;
+    rtcSetGeometryUserPrimitiveCount(geom, shapes->count);
+    rtcSetGeometryUserData(geom, (void *)shapes);
+    rtcSetGeometryBoundsFunction(geom, ig_embree_bounds, NULL);
+    rtcSetGeometryIntersectFunction(geom, ig_embree_intersect);
+    rtcSetGeometryOccludedFunction(geom, ig_embree_occluded);
+    return geom;
+}
+
+/* ------------------------------------------------------------------ double-precision records */
+
+void ig_embree_context_init(ig_embree_context *ctx, ig_embree_hit *hits, unsigned int nhits)
+{
+    unsigned int i;
+    rtcInitIntersectContext(&ctx->rtc);
+    ctx->hits = hits;
+    ctx->nhits = hits ? nhits : 0;
+    for (i = 0; i < ctx->nhits; ++i) {
+        memset(&hits[i], 0, sizeof hits[i]);
+        hits[i].t = INFINITY;
+        hits[i].geomID = hits[i].primID = hits[i].instID = RTC_INVALID_GEOMETRY_ID;
+    }
+}
+
+int ig_embree_double_t(const ig_embree_context *ctx, unsigned int id, unsigned int geomID, unsigned int primID,
+                       unsigned int instID, double *t)
+{
+    const ig_embree_hit *h;
+    if (!ctx->hits || id >= ctx->nhits || geomID == RTC_INVALID_GEOMETRY_ID)
+        return 0;
+    h = &ctx->hits[id];
+    if (h->geomID != geomID || h->primID != primID || h->instID != instID)
+        return 0;
+    *t = h->t;
+    return 1;
+}
