@@ -27,6 +27,7 @@ FLOORS = {
     "animation": 5,
     "view": 6,
     "export": 6,
+    "mesh": 6,
     "bench": 6,
     "demo": 6,
     "cli": 7,

@@ -23,7 +23,7 @@ SOLVER_SOURCES = (
     "roots_bernstein.c",
 )
 BENCH_SOURCES = ("roots_bench.c",)  # clock_gettime around every solve: `implgen bench solvers`
-SHAPE_SOURCES = ("shape.c",)
+SHAPE_SOURCES = ("shape.c", "shape_batch.c")
 TRACER_SOURCES = ("tracer_scene.c", "tracer_hit.c", "tracer_csg.c", "tracer_shade.c", "tracer_render.c")
 # The GLSL runtime, in the order a program concatenates it (before the generated shapes: docs/glsl.md)
 GLSL_RUNTIME_SOURCES = ("raa.glsl", "clip.glsl", "ray.glsl", "camera.glsl", "shade.glsl")

@@ -1,0 +1,128 @@
+"""The mesh of a solid f < 0 ∩ clips on a grid: vertex flags, exact crossings (crossings.py), sheets per cell
+(cells.py), one dual vertex per sheet (dual.py), one quad per active edge split into two triangles, oriented so
+the normal points to f > 0 (outside)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from implgen.mesh import cells
+from implgen.mesh.crossings import Crossings, axis_crossings, inside_flags
+from implgen.mesh.dual import project, qef_points
+from implgen.mesh.faces import Quads, triangulate
+from implgen.mesh.region import Clip, Grid
+from implgen.mesh.shapelib import ShapeLib
+
+# the four cells around an edge along a, counter-clockwise seen from +a in the (a + 1, a + 2) plane: how far
+# below the edge each cell's lower corner is along a + 1 and a + 2
+AROUND = ((1, 1), (0, 1), (0, 0), (1, 0))
+PROJECT_TOL = 1e-13  # Newton stops when a step is below this times the grid's size
+
+
+@dataclass
+class Mesh:
+    vertices: np.ndarray  # (V, 3)
+    faces: np.ndarray  # (F, 3) counter-clockwise seen from outside (f > 0)
+    grid: Grid
+    stats: dict = field(default_factory=dict)
+
+
+def _corner_offsets(strides: np.ndarray) -> np.ndarray:
+    return np.array([((c & 1) * strides[0] + (c >> 1 & 1) * strides[1] + (c >> 2 & 1) * strides[2]) for c in range(8)])
+
+
+def _face_bits(lib, clips, grid: Grid, cell_idx: np.ndarray, config: np.ndarray) -> np.ndarray:
+    """Bit f when face f of the cell is ambiguous and the solid's value at its centre is inside. The centre is
+    computed from the face's global index, so the two cells that share it read the same point."""
+    amb = cells.AMBIGUOUS[config]
+    bits = np.zeros(config.shape, dtype=np.int64)
+    for f in range(6):
+        sel = np.nonzero((amb >> f) & 1)[0]
+        if sel.size == 0:
+            continue
+        a, s = f // 2, f % 2
+        idx = cell_idx[sel].astype(np.float64) + 0.5
+        idx[:, a] += s - 0.5
+        inside, _ = inside_flags(lib, clips, grid.origin + grid.h * idx)
+        bits[sel] |= inside.astype(np.int64) << f
+    return bits
+
+
+def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
+    pts = grid.points()
+    inside, g = inside_flags(lib, clips, pts)
+    shape = inside.shape
+    strides = np.array([shape[1] * shape[2], shape[2], 1])
+    if inside[0].any() or inside[-1].any() or inside[:, 0].any() or inside[:, -1].any():
+        raise AssertionError("the grid's outer layer must lie outside every clip")
+    if inside[:, :, 0].any() or inside[:, :, -1].any():
+        raise AssertionError("the grid's outer layer must lie outside every clip")
+    cross: list[Crossings] = [axis_crossings(lib, clips, grid, a, inside, g, pts) for a in range(3)]
+
+    # cells: corner flags -> config; active ones get their sheets
+    ins = inside.astype(np.int64)
+    n0, n1, n2 = grid.n
+    config = np.zeros((n0, n1, n2), dtype=np.int64)
+    for c in range(8):
+        dx, dy, dz = c & 1, c >> 1 & 1, c >> 2 & 1
+        config |= ins[dx : dx + n0, dy : dy + n1, dz : dz + n2] << c
+    cidx = np.argwhere((config != 0) & (config != 255))
+    conf = config[tuple(cidx.T)]
+    cflat = np.ravel_multi_index(tuple(cidx.T), shape)
+    key = conf | _face_bits(lib, clips, grid, cidx, conf) << 8
+    row, table, nsheets = cells.cell_table(key)
+    sheets = table[row]  # (C, 12)
+    count = nsheets[row]
+    base = np.concatenate([[0], np.cumsum(count)[:-1]])
+    cellvert = np.where(sheets >= 0, base[:, None] + sheets, -1)
+    nverts = int(count.sum())
+
+    # every sheet's crossings -> QEF point -> onto the surface
+    corner = _corner_offsets(strides)
+    vids, cps, cns, cpieces = [], [], [], []
+    for e in range(12):
+        has = np.nonzero(cellvert[:, e] >= 0)[0]
+        a = e // 4
+        start, _ = cells.edge_corners(e)
+        edge = cflat[has] + corner[start]
+        k = np.searchsorted(cross[a].edges, edge)
+        vids.append(cellvert[has, e])
+        cps.append(cross[a].points[k])
+        cns.append(cross[a].normals[k])
+        cpieces.append(cross[a].piece[k])
+    vid, cp, cn, cpiece = (np.concatenate(x) for x in (vids, cps, cns, cpieces))
+    cell_of_vertex = np.repeat(np.arange(len(cidx)), count)
+    lower = grid.origin + grid.h * cidx[cell_of_vertex]
+    qef = qef_points(vid, cp, cn, nverts, lower, grid.h)
+    mask = np.zeros(nverts, dtype=np.int64)
+    np.bitwise_or.at(mask, vid, np.int64(1) << cpiece.astype(np.int64))
+    verts, projected = project(lib, clips, qef, mask, grid.h, PROJECT_TOL * grid.size)
+
+    # one quad per active edge, from the sheets of its four cells
+    rowof = np.full(int(np.prod(shape)), -1, dtype=np.int64)
+    rowof[cflat] = np.arange(len(cflat))
+    parts = []
+    for a in range(3):
+        b, c = (a + 1) % 3, (a + 2) % 3
+        lo_ax, _ = cells.other_axes(a)
+        edges = cross[a].edges
+        quad = np.empty((edges.size, 4), dtype=np.int64)
+        for q, (db, dc) in enumerate(AROUND):
+            r = rowof[edges - db * strides[b] - dc * strides[c]]
+            u, v = (db, dc) if lo_ax == b else (dc, db)  # the edge's offsets inside that cell
+            quad[:, q] = cellvert[r, 4 * a + u + 2 * v]
+        flip = ~inside.reshape(-1)[edges]  # outside below: the outside is toward -a
+        parts.append((quad, np.full(edges.size, a), edges, flip, cross[a].points, cross[a].piece))
+    quads = Quads(*(np.concatenate([p[i] for p in parts]) for i in range(6)))
+    verts, faces, split = triangulate(quads, verts, inside, grid, lib, clips, AROUND)
+    stats = {
+        "cells": list(grid.n),
+        "active_edges": int(sum(c.edges.size for c in cross)),
+        "fallback_crossings": int(sum(c.fallback for c in cross)),
+        "multi_sheet_cells": int((count > 1).sum()),
+        "unprojected_vertices": int((~projected).sum()),
+        "split_sides": split,
+    }
+    return Mesh(vertices=verts, faces=faces, grid=grid, stats=stats)

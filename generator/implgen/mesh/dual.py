@@ -1,0 +1,105 @@
+"""Dual vertices: the point of each sheet of a cell, from the exact crossings on its edges.
+
+First the QEF of dual contouring (Ju, Losasso, Schaefer and Warren 2002): the point nearest, in least squares,
+to the tangent planes at the sheet's crossings (exact points, unit normals from the generated gradient), with
+the small eigenvalues of the normal matrix dropped (a flat or curved piece keeps to the crossings' mass point
+along it; a crease or a corner is located), clamped to the cell. Then onto the surface itself: Newton steps of
+least norm on the pieces that bound the sheet (f alone on a smooth sheet; f and a clip on a cap's rim, two clip
+planes on a box's edge), so every vertex lies on the true boundary up to rounding. A projection that does not
+converge or strays beyond a cell keeps the QEF point; those are counted.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from implgen.mesh.crossings import clip_values
+from implgen.mesh.region import Clip
+from implgen.mesh.shapelib import ShapeLib
+
+DROP = 0.1  # eigenvalues below DROP x the largest are dropped (the usual truncation of the QEF's SVD)
+
+
+def qef_points(
+    vid: np.ndarray, points: np.ndarray, normals: np.ndarray, nverts: int, lower: np.ndarray, h: float
+) -> np.ndarray:
+    """Minimisers, one per vertex, of sum (n . (x - p))^2 over the crossings (vid[i], points[i], normals[i]),
+    about their mass point, clamped to each vertex's cell [lower, lower + h]."""
+    count = np.bincount(vid, minlength=nverts).astype(np.float64)
+    mass = np.stack([np.bincount(vid, points[:, k], minlength=nverts) for k in range(3)], axis=1)
+    mass /= np.maximum(count, 1.0)[:, None]
+    q = points - mass[vid]
+    ata = np.zeros((nverts, 3, 3))
+    atb = np.zeros((nverts, 3))
+    nq = (normals * q).sum(axis=1)
+    for i in range(3):
+        atb[:, i] = np.bincount(vid, normals[:, i] * nq, minlength=nverts)
+        for j in range(i, 3):
+            ata[:, i, j] = ata[:, j, i] = np.bincount(vid, normals[:, i] * normals[:, j], minlength=nverts)
+    w, v = np.linalg.eigh(ata)
+    top = w[:, -1:]
+    inv = np.where(w > DROP * top, 1.0 / np.where(w > 0, w, 1.0), 0.0)
+    x = np.einsum("nij,nj,nkj,nk->ni", v, inv, v, atb)
+    return np.clip(mass + x, lower, lower + h)
+
+
+def _pieces_eval(lib: ShapeLib, clips: list[Clip], ids: list[int], p: np.ndarray):
+    """Residuals (n, k) and gradients (n, k, 3) of the pieces `ids` (0: f, j: clips[j - 1]) at p."""
+    res, jac = [], []
+    for j in ids:
+        if j == 0:
+            f, g = lib.value_gradient(p)
+        else:
+            f, g = clips[j - 1].value(p), clips[j - 1].gradient(p)
+        res.append(f)
+        jac.append(g)
+    return np.stack(res, axis=1), np.stack(jac, axis=1)
+
+
+def project(
+    lib: ShapeLib,
+    clips: list[Clip],
+    start: np.ndarray,
+    mask: np.ndarray,
+    h: float,
+    tol: float,
+    steps: int = 40,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each start point moved onto every piece in its bit mask (bit j: piece j): (points, projected flags)."""
+    out = start.copy()
+    done = np.zeros(len(start), dtype=bool)
+    for m in np.unique(mask):
+        ids = [j for j in range(int(m).bit_length()) if (int(m) >> j) & 1]
+        sel = np.nonzero(mask == m)[0]
+        if not ids or len(ids) > 3:
+            continue
+        p = start[sel].copy()
+        ok = np.zeros(sel.size, dtype=bool)
+        live = np.arange(sel.size)
+        for _ in range(steps):
+            if live.size == 0:
+                break
+            r, jac = _pieces_eval(lib, clips, ids, p[live])
+            jjt = np.einsum("nki,nli->nkl", jac, jac)
+            jjt += 1e-300 * np.eye(len(ids))
+            with np.errstate(all="ignore"):
+                y = np.linalg.solve(jjt, r[..., None])[..., 0]
+                step = -np.einsum("nki,nk->ni", jac, y)
+            bad = ~np.isfinite(step).all(axis=1)
+            step[bad] = 0.0
+            p[live] += step
+            small = np.linalg.norm(step, axis=1) <= tol
+            ok[live[small & ~bad]] = True
+            live = live[~small & ~bad]
+        far = np.abs(p - start[sel]).max(axis=1) > 2 * h
+        ok &= ~far & np.isfinite(p).all(axis=1)
+        out[sel[ok]] = p[ok]
+        done[sel[ok]] = True
+    return out, done
+
+
+def on_boundary(lib: ShapeLib, clips: list[Clip], p: np.ndarray) -> np.ndarray:
+    """max(f, clips) at p: 0 on the solid's boundary."""
+    g = lib.value(p)
+    cv = clip_values(clips, p)
+    return np.maximum(g, cv.max(axis=0)) if len(cv) else g

@@ -1,0 +1,73 @@
+"""One shape → a mesh and what is known of it: the library, the region, the contour, the singular points, the
+mesh's own checks (edges each shared by two faces, Euler characteristic, volume), timings."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from implgen.codegen.specmodel import Spec
+from implgen.mesh.contour import Mesh, contour
+from implgen.mesh.crossings import clip_values
+from implgen.mesh.region import Clip, make_grid
+from implgen.mesh.shapelib import ShapeLib
+from implgen.mesh.singular import Singular, find_singular
+
+
+@dataclass
+class Result:
+    mesh: Mesh
+    lib: ShapeLib
+    clips: list[Clip]
+    singular: Singular | None
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+def closed_and_euler(faces: np.ndarray, nverts: int) -> tuple[bool, int]:
+    """(every edge in exactly two faces, each way once; V - E + F over the vertices faces use)."""
+    e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    directed = np.unique(e, axis=0)
+    und, counts = np.unique(np.sort(e, axis=1), axis=0, return_counts=True)
+    closed = bool((counts == 2).all()) and len(directed) == len(e)
+    used = np.unique(faces).size if len(faces) else 0
+    return closed, int(used - len(und) + len(faces))
+
+
+def signed_volume(verts: np.ndarray, faces: np.ndarray) -> float:
+    a, b, c = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+def mesh_spec(
+    spec: Spec,
+    values: Mapping[str, float],
+    cells: int,
+    user_clips: list[Clip],
+    singular: bool = True,
+    what: str = "",
+) -> Result:
+    """Mesh the solid f < 0 (∩ the spec's box, ∩ the user's clip) of `spec` with these param values."""
+    t0 = time.perf_counter()
+    full = {**spec.params, **values}
+    lib = ShapeLib(spec, [full[k] for k in spec.params])
+    t1 = time.perf_counter()
+    grid, clips = make_grid(spec.box(dict(values)), user_clips, cells, what or spec.source)
+    mesh = contour(lib, clips, grid)
+    t2 = time.perf_counter()
+    sing = None
+    if singular:
+        hi = grid.origin + grid.h * np.array(grid.n)
+        sing = find_singular(lib, grid.origin, hi)
+    t3 = time.perf_counter()
+    return Result(mesh, lib, clips, sing, {"build": t1 - t0, "mesh": t2 - t1, "singular": t3 - t2})
+
+
+def singular_in_solid(result: Result) -> np.ndarray:
+    """Which singular points lie in the clipped region (every clip <= 0 there)."""
+    if result.singular is None or not len(result.singular.points):
+        return np.zeros(0, dtype=bool)
+    cv = clip_values(result.clips, result.singular.points)
+    return (cv <= 0).all(axis=0) if len(cv) else np.ones(len(result.singular.points), dtype=bool)
