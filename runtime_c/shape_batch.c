@@ -28,3 +28,16 @@ void ig_shape_eval_many(const ig_shape *shape, const double *params, long n, con
             shape->gradient(p + 3 * (size_t)i, params, g + 3 * (size_t)i);
     }
 }
+
+void ig_shape_values_grid(const ig_shape *shape, const double *params, const double *x, long nx, const double *y,
+                          long ny, const double *z, long nz, double *f)
+{
+    if (!shape || !shape->value || !x || !y || !z || !f)
+        return;
+    for (long i = 0; i < nx; ++i)
+        for (long j = 0; j < ny; ++j)
+            for (long k = 0; k < nz; ++k) {
+                double p[3] = {x[i], y[j], z[k]};
+                f[((size_t)i * (size_t)ny + (size_t)j) * (size_t)nz + (size_t)k] = shape->value(p, params);
+            }
+}

@@ -15,4 +15,9 @@ void ig_shape_roots_many(const ig_shape *shape, const double *params, long n, co
 /* For each point i: f(p_i) into f[i] and grad f(p_i) into g[3 i ...] (g may be NULL: values only). */
 void ig_shape_eval_many(const ig_shape *shape, const double *params, long n, const double *p, double *f, double *g);
 
+/* f at every point (x[i], y[j], z[k]) of a grid into f[(i * ny + j) * nz + k] (C order): a grid's values
+ * without an array of its points. */
+void ig_shape_values_grid(const ig_shape *shape, const double *params, const double *x, long nx, const double *y,
+                          long ny, const double *z, long nz, double *f);
+
 #endif

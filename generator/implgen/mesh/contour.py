@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from implgen.mesh import cells
-from implgen.mesh.crossings import Crossings, axis_crossings, inside_flags
+from implgen.mesh.crossings import Crossings, axis_crossings, grid_flags, inside_flags
 from implgen.mesh.dual import project, qef_points
 from implgen.mesh.faces import Quads, triangulate
 from implgen.mesh.region import Clip, Grid
@@ -18,7 +18,6 @@ from implgen.mesh.shapelib import ShapeLib
 # the four cells around an edge along a, counter-clockwise seen from +a in the (a + 1, a + 2) plane: how far
 # below the edge each cell's lower corner is along a + 1 and a + 2
 AROUND = ((1, 1), (0, 1), (0, 0), (1, 0))
-PROJECT_TOL = 1e-13  # Newton stops when a step is below this times the grid's size
 
 
 @dataclass
@@ -51,25 +50,24 @@ def _face_bits(lib, clips, grid: Grid, cell_idx: np.ndarray, config: np.ndarray)
 
 
 def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
-    pts = grid.points()
-    inside, g = inside_flags(lib, clips, pts)
+    inside, g = grid_flags(lib, clips, grid)
     shape = inside.shape
     strides = np.array([shape[1] * shape[2], shape[2], 1])
     if inside[0].any() or inside[-1].any() or inside[:, 0].any() or inside[:, -1].any():
         raise AssertionError("the grid's outer layer must lie outside every clip")
     if inside[:, :, 0].any() or inside[:, :, -1].any():
         raise AssertionError("the grid's outer layer must lie outside every clip")
-    cross: list[Crossings] = [axis_crossings(lib, clips, grid, a, inside, g, pts) for a in range(3)]
+    cross: list[Crossings] = [axis_crossings(lib, clips, grid, a, inside, g) for a in range(3)]
 
     # cells: corner flags -> config; active ones get their sheets
-    ins = inside.astype(np.int64)
+    ins = inside.view(np.uint8)
     n0, n1, n2 = grid.n
-    config = np.zeros((n0, n1, n2), dtype=np.int64)
+    config = np.zeros((n0, n1, n2), dtype=np.uint8)
     for c in range(8):
         dx, dy, dz = c & 1, c >> 1 & 1, c >> 2 & 1
-        config |= ins[dx : dx + n0, dy : dy + n1, dz : dz + n2] << c
+        config |= ins[dx : dx + n0, dy : dy + n1, dz : dz + n2] << np.uint8(c)
     cidx = np.argwhere((config != 0) & (config != 255))
-    conf = config[tuple(cidx.T)]
+    conf = config[tuple(cidx.T)].astype(np.int64)
     cflat = np.ravel_multi_index(tuple(cidx.T), shape)
     key = conf | _face_bits(lib, clips, grid, cidx, conf) << 8
     row, table, nsheets = cells.cell_table(key)
@@ -98,7 +96,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     qef = qef_points(vid, cp, cn, nverts, lower, grid.h)
     mask = np.zeros(nverts, dtype=np.int64)
     np.bitwise_or.at(mask, vid, np.int64(1) << cpiece.astype(np.int64))
-    verts, projected = project(lib, clips, qef, mask, grid.h, PROJECT_TOL * grid.size)
+    verts, projected = project(lib, clips, qef, mask, grid.h, grid.size)
 
     # one quad per active edge, from the sheets of its four cells
     rowof = np.full(int(np.prod(shape)), -1, dtype=np.int64)
@@ -116,7 +114,8 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         flip = ~inside.reshape(-1)[edges]  # outside below: the outside is toward -a
         parts.append((quad, np.full(edges.size, a), edges, flip, cross[a].points, cross[a].piece))
     quads = Quads(*(np.concatenate([p[i] for p in parts]) for i in range(6)))
-    verts, faces, split = triangulate(quads, verts, inside, grid, lib, clips, AROUND)
+    near_amb = np.repeat(cells.AMBIGUOUS[conf] != 0, count)  # sheets of cells with an ambiguous face
+    verts, faces, split = triangulate(quads, verts, near_amb, inside, grid, lib, clips, AROUND)
     stats = {
         "cells": list(grid.n),
         "active_edges": int(sum(c.edges.size for c in cross)),

@@ -45,6 +45,15 @@ def inside_flags(lib: ShapeLib, clips: list[Clip], p: np.ndarray) -> tuple[np.nd
     return g < 0, g
 
 
+def grid_flags(lib: ShapeLib, clips: list[Clip], grid: Grid) -> tuple[np.ndarray, np.ndarray]:
+    """inside_flags at every vertex of the grid, without an array of its points."""
+    x, y, z = (grid.coords(a) for a in range(3))
+    g = lib.values_grid(x, y, z)
+    for c in clips:
+        np.maximum(g, c.on_grid(x, y, z), out=g)
+    return g < 0, g
+
+
 def unit(v: np.ndarray) -> np.ndarray:
     n = np.linalg.norm(v, axis=-1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -91,10 +100,9 @@ def _candidates(lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, starts:
 
 
 def axis_crossings(
-    lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, inside: np.ndarray, g: np.ndarray, pts: np.ndarray
+    lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, inside: np.ndarray, g: np.ndarray
 ) -> Crossings:
-    """The active edges along `axis` and their crossings. inside, g: per vertex (n0+1, n1+1, n2+1); pts the
-    vertices' coordinates."""
+    """The active edges along `axis` and their crossings. inside, g: per vertex (n0+1, n1+1, n2+1)."""
     shape = inside.shape
     strides = np.array([shape[1] * shape[2], shape[2], 1])
     lower = np.take(inside, np.arange(shape[axis] - 1), axis=axis)
@@ -104,7 +112,7 @@ def axis_crossings(
     # the lines: vertices with index 0 along the axis, in flat vertex numbering
     base_idx = np.indices(tuple(1 if a == axis else s for a, s in enumerate(shape))).reshape(3, -1)
     base = np.ravel_multi_index(tuple(base_idx), shape)
-    starts = pts.reshape(-1, 3)[base]
+    starts = grid.point(base)
     line, t, piece, p, nrm = _candidates(lib, clips, grid, axis, starts)
     step = np.clip(np.floor(t / grid.h).astype(np.int64), 0, shape[axis] - 2)
     key = base[line] + step * strides[axis]
@@ -127,7 +135,7 @@ def axis_crossings(
         hi_v = lo_v + strides[axis]
         gf = g.reshape(-1)
         end = np.where(np.abs(gf[lo_v]) <= np.abs(gf[hi_v]), lo_v, hi_v)
-        points[miss] = pts.reshape(-1, 3)[end]
+        points[miss] = grid.point(end)
         _, grad = lib.value_gradient(points[miss])
         normals[miss] = unit(grad)
     return Crossings(edges=active, points=points, normals=normals, piece=pieces, fallback=int(miss.size))

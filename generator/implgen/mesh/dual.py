@@ -18,29 +18,43 @@ from implgen.mesh.region import Clip
 from implgen.mesh.shapelib import ShapeLib
 
 DROP = 0.1  # eigenvalues below DROP x the largest are dropped (the usual truncation of the QEF's SVD)
+CREASE = 0.9  # a sheet whose crossing normals all lie within acos(0.9) = 26 degrees of their mean is smooth
+NOISE = 1e-10  # a Newton step still this large (times the box) after the last step: f's rounding, accepted
 
 
 def qef_points(
     vid: np.ndarray, points: np.ndarray, normals: np.ndarray, nverts: int, lower: np.ndarray, h: float
 ) -> np.ndarray:
     """Minimisers, one per vertex, of sum (n . (x - p))^2 over the crossings (vid[i], points[i], normals[i]),
-    about their mass point, clamped to each vertex's cell [lower, lower + h]."""
-    count = np.bincount(vid, minlength=nverts).astype(np.float64)
-    mass = np.stack([np.bincount(vid, points[:, k], minlength=nverts) for k in range(3)], axis=1)
-    mass /= np.maximum(count, 1.0)[:, None]
-    q = points - mass[vid]
-    ata = np.zeros((nverts, 3, 3))
-    atb = np.zeros((nverts, 3))
-    nq = (normals * q).sum(axis=1)
-    for i in range(3):
-        atb[:, i] = np.bincount(vid, normals[:, i] * nq, minlength=nverts)
-        for j in range(i, 3):
-            ata[:, i, j] = ata[:, j, i] = np.bincount(vid, normals[:, i] * normals[:, j], minlength=nverts)
-    w, v = np.linalg.eigh(ata)
-    top = w[:, -1:]
-    inv = np.where(w > DROP * top, 1.0 / np.where(w > 0, w, 1.0), 0.0)
-    x = np.einsum("nij,nj,nkj,nk->ni", v, inv, v, atb)
-    return np.clip(mass + x, lower, lower + h)
+    about their mass point, clamped to each vertex's cell [lower, lower + h]. Where the normals all lie
+    within CREASE of their mean (a smooth piece) the QEF would only slide the point along the surface, so the
+    mass point is kept and the eigen-solve is spent on creases, rims and singular points."""
+    count = np.maximum(np.bincount(vid, minlength=nverts).astype(np.float64), 1.0)
+    mass = np.stack([np.bincount(vid, points[:, k], minlength=nverts) for k in range(3)], axis=1) / count[:, None]
+    mean_n = np.stack([np.bincount(vid, normals[:, k], minlength=nverts) for k in range(3)], axis=1)
+    mean_n /= np.maximum(np.linalg.norm(mean_n, axis=1, keepdims=True), 1e-300)
+    spread = np.ones(nverts)
+    np.minimum.at(spread, vid, (normals * mean_n[vid]).sum(axis=1))
+    sharp = spread < CREASE
+    sel = np.nonzero(sharp[vid])[0]
+    out = mass.copy()
+    if sel.size:
+        verts = np.nonzero(sharp)[0]
+        local = np.searchsorted(verts, vid[sel])
+        n = normals[sel]
+        q = points[sel] - mass[vid[sel]]
+        nq = (n * q).sum(axis=1)
+        m = verts.size
+        ata = np.zeros((m, 3, 3))
+        atb = np.zeros((m, 3))
+        for i in range(3):
+            atb[:, i] = np.bincount(local, n[:, i] * nq, minlength=m)
+            for j in range(i, 3):
+                ata[:, i, j] = ata[:, j, i] = np.bincount(local, n[:, i] * n[:, j], minlength=m)
+        w, v = np.linalg.eigh(ata)
+        inv = np.where(w > DROP * w[:, -1:], 1.0 / np.where(w > 0, w, 1.0), 0.0)
+        out[verts] += np.einsum("nij,nj,nkj,nk->ni", v, inv, v, atb)
+    return np.clip(out, lower, lower + h)
 
 
 def _pieces_eval(lib: ShapeLib, clips: list[Clip], ids: list[int], p: np.ndarray):
@@ -62,10 +76,12 @@ def project(
     start: np.ndarray,
     mask: np.ndarray,
     h: float,
-    tol: float,
-    steps: int = 40,
+    scale: float,
+    steps: int = 16,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Each start point moved onto every piece in its bit mask (bit j: piece j): (points, projected flags)."""
+    """Each start point moved onto every piece in its bit mask (bit j: piece j): (points, projected flags).
+    Converged: a step below 1e-13 of `scale` (the box), or the last of `steps` below NOISE of it."""
+    tol = 1e-13 * scale
     out = start.copy()
     done = np.zeros(len(start), dtype=bool)
     for m in np.unique(mask):
@@ -76,6 +92,7 @@ def project(
         p = start[sel].copy()
         ok = np.zeros(sel.size, dtype=bool)
         live = np.arange(sel.size)
+        last = live_before = np.zeros(0)
         for _ in range(steps):
             if live.size == 0:
                 break
@@ -88,9 +105,14 @@ def project(
             bad = ~np.isfinite(step).all(axis=1)
             step[bad] = 0.0
             p[live] += step
-            small = np.linalg.norm(step, axis=1) <= tol
+            size = np.linalg.norm(step, axis=1)
+            small = size <= tol
             ok[live[small & ~bad]] = True
+            last = size
+            live_before = live
             live = live[~small & ~bad]
+        if live.size:  # still moving by f's rounding only: as near as f can tell
+            ok[live] = last[np.searchsorted(live_before, live)] <= NOISE * scale
         far = np.abs(p - start[sel]).max(axis=1) > 2 * h
         ok &= ~far & np.isfinite(p).all(axis=1)
         out[sel[ok]] = p[ok]

@@ -49,14 +49,25 @@ def _simple(q: np.ndarray, verts: np.ndarray, flip: np.ndarray) -> np.ndarray:
 
 
 def triangulate(
-    quads: Quads, verts: np.ndarray, inside: np.ndarray, grid: Grid, lib: ShapeLib, clips: list[Clip], around
+    quads: Quads,
+    verts: np.ndarray,
+    near_amb: np.ndarray,
+    inside: np.ndarray,
+    grid: Grid,
+    lib: ShapeLib,
+    clips: list[Clip],
+    around,
 ) -> tuple[np.ndarray, np.ndarray, int]:
-    """(vertices with any added, triangles, how many quad sides were split)."""
+    """(vertices with any added, triangles, how many quad sides were split). near_amb: per vertex, whether its
+    cell has an ambiguous face (only a quad with all its sides' cells so can hold a doubled side)."""
     q = quads.verts
+    dup = np.zeros((len(q), 4), dtype=bool)
     sides = np.stack([np.sort(np.stack([q[:, k], q[:, (k + 1) % 4]], axis=1), axis=1) for k in range(4)], axis=1)
-    flat = sides.reshape(-1, 2)
-    _, inv, cnt = np.unique(flat, axis=0, return_inverse=True, return_counts=True)
-    dup = (cnt[inv.reshape(-1)] > 2).reshape(-1, 4)
+    cand = np.nonzero(near_amb[q].any(axis=1))[0]
+    if cand.size:
+        key = sides[cand, :, 0] * len(verts) + sides[cand, :, 1]
+        _, inv, cnt = np.unique(key.reshape(-1), return_inverse=True, return_counts=True)
+        dup[cand] = (cnt[inv.reshape(-1)] > 2).reshape(-1, 4)
     hit = dup.any(axis=1)
     if not hit.any():
         return verts, _simple(q, verts, quads.flip), 0
@@ -89,7 +100,7 @@ def triangulate(
     mids /= np.bincount(mid_of, minlength=nmid)[:, None]
     mask = np.zeros(nmid, dtype=np.int64)
     np.bitwise_or.at(mask, mid_of, np.int64(1) << quads.piece[qi].astype(np.int64))
-    mids, _ = project(lib, clips, mids, mask, grid.h, 1e-13 * grid.size)
+    mids, _ = project(lib, clips, mids, mask, grid.h, grid.size)
     mid_id = np.full((len(q), 4), -1, dtype=np.int64)
     mid_id[qi, ks] = len(verts) + mid_of
     fan = np.nonzero(hit)[0]

@@ -33,6 +33,10 @@ class Sphere:
     def gradient(self, p: np.ndarray) -> np.ndarray:
         return 2.0 * p
 
+    def on_grid(self, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """The value at every (x[i], y[j], z[k]), by broadcasting."""
+        return (x * x)[:, None, None] + (y * y)[None, :, None] + (z * z)[None, None, :] - self.radius**2
+
     def crossings(self, axis: int, others: np.ndarray) -> np.ndarray:
         """Where lines along `axis` (through the points `others`, (n, 3), the axis' own column ignored) meet
         the sphere: (n, 2) coordinates along the axis, NaN where they miss."""
@@ -55,6 +59,10 @@ class HalfSpace:
 
     def value(self, p: np.ndarray) -> np.ndarray:
         return self.sign * (p[..., self.axis] - self.at)
+
+    def on_grid(self, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+        v = self.sign * ((x, y, z)[self.axis] - self.at)
+        return v.reshape(tuple(-1 if a == self.axis else 1 for a in range(3)))
 
     def gradient(self, p: np.ndarray) -> np.ndarray:
         g = np.zeros(p.shape)
@@ -113,10 +121,14 @@ class Grid:
     def coords(self, axis: int) -> np.ndarray:
         return self.origin[axis] + self.h * np.arange(self.n[axis] + 1)
 
-    def points(self) -> np.ndarray:
-        """Every vertex, (n0 + 1, n1 + 1, n2 + 1, 3)."""
-        x, y, z = np.meshgrid(self.coords(0), self.coords(1), self.coords(2), indexing="ij")
-        return np.stack([x, y, z], axis=-1)
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        return (self.n[0] + 1, self.n[1] + 1, self.n[2] + 1)
+
+    def point(self, flat: np.ndarray) -> np.ndarray:
+        """Coordinates of vertices given by flat (C order) index, (k, 3): the same doubles coords() holds."""
+        idx = np.stack(np.unravel_index(flat, self.shape), axis=1)
+        return self.origin + self.h * idx.astype(np.float64)
 
     @property
     def size(self) -> float:

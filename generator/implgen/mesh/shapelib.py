@@ -38,6 +38,8 @@ class ShapeLib:
         lib.ig_shape_roots_many.argtypes = [_VP, _DP, ctypes.c_long, _DP, _DP, _DP, _DP, ctypes.c_int, _DP, _IP]
         lib.ig_shape_eval_many.restype = None
         lib.ig_shape_eval_many.argtypes = [_VP, _DP, ctypes.c_long, _DP, _DP, _DP]
+        lib.ig_shape_values_grid.restype = None
+        lib.ig_shape_values_grid.argtypes = [_VP, _DP, _DP, ctypes.c_long, _DP, ctypes.c_long, _DP, ctypes.c_long, _DP]
         self._lib = lib
         self._shape = lib.rt_scene_shape(0)
         self._params = np.ascontiguousarray(np.asarray(list(params) or [0.0], dtype=np.float64))
@@ -74,3 +76,12 @@ class ShapeLib:
         g = np.empty(p.shape)
         self._lib.ig_shape_eval_many(self._shape, _ptr(self._params), f.size, _ptr(p), _ptr(f), _ptr(g))
         return f, g
+
+    def values_grid(self, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """f at every (x[i], y[j], z[k]), shape (len(x), len(y), len(z))."""
+        x, y, z = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, y, z))
+        f = np.empty((x.size, y.size, z.size))
+        self._lib.ig_shape_values_grid(
+            self._shape, _ptr(self._params), _ptr(x), x.size, _ptr(y), y.size, _ptr(z), z.size, _ptr(f)
+        )
+        return f
