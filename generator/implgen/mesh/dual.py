@@ -77,7 +77,7 @@ def project(
     mask: np.ndarray,
     h: float,
     scale: float,
-    steps: int = 16,
+    steps: int = 100,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Each start point moved onto every piece in its bit mask (bit j: piece j): (points, projected flags).
     Converged: a step below 1e-13 of `scale` (the box), or the last of `steps` below NOISE of it."""
@@ -98,7 +98,7 @@ def project(
                 break
             r, jac = _pieces_eval(lib, clips, ids, p[live])
             jjt = np.einsum("nki,nli->nkl", jac, jac)
-            jjt += 1e-300 * np.eye(len(ids))
+            jjt += (1e-14 * np.trace(jjt, axis1=1, axis2=2) + 1e-300)[:, None, None] * np.eye(len(ids))
             with np.errstate(all="ignore"):
                 y = np.linalg.solve(jjt, r[..., None])[..., 0]
                 step = -np.einsum("nki,nk->ni", jac, y)
