@@ -55,6 +55,21 @@ int main(void)
         }
     }
     ig_shape_eval_many(&shape_torus_fixture, params, NRAYS, o, f, NULL); /* values only */
+    {
+        const double gx[3] = {-1.0, 0.1, 1.3}, gy[2] = {-0.2, 0.05}, gz[4] = {-0.3, 0.0, 0.125, 2.0};
+        double gv[24];
+        ig_shape_values_grid(&shape_torus_fixture, params, gx, 3, gy, 2, gz, 4, gv);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 2; ++j)
+                for (int k = 0; k < 4; ++k) {
+                    double p[3] = {gx[i], gy[j], gz[k]};
+                    double v = shape_torus_fixture.value(p, params);
+                    if (memcmp(&v, gv + (i * 2 + j) * 4 + k, sizeof v) != 0) {
+                        printf("grid point (%d, %d, %d) differs\n", i, j, k);
+                        ++failures;
+                    }
+                }
+    }
     ig_shape_roots_many(&shape_torus_fixture, params, 0, o, d, t0, t1, IG_ROOTS_AUTO, roots, counts);
     free(o);
     free(d);

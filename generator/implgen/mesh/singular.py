@@ -98,7 +98,7 @@ def find_singular(lib: ShapeLib, lo: np.ndarray, hi: np.ndarray) -> Singular:
     complete = True
     for level in range(LEVELS + 1):
         widen = 2.0 if level < LEVELS - 1 else 1.0
-        kept = []
+        kept = [np.zeros((0, 3))]
         for at in range(0, len(cells), CHUNK):
             vals = _corners(lib, cells[at : at + CHUNK], h)
             if level == 0:

@@ -1,4 +1,4 @@
-"""A mesh to a file, written by trimesh (binary STL, OBJ, binary PLY, glTF binary), atomically; and the
+"""A mesh to a file, written by trimesh (binary STL, OBJ, binary PLY with doubles, glTF binary), atomically; the
 per-vertex normals the formats that hold them get: the gradient of the piece that bounds the solid there
 (f, or a clip), normalised; the faces' average where that gradient vanishes (a node)."""
 
@@ -44,6 +44,11 @@ def write_mesh(path: Path, verts: np.ndarray, faces: np.ndarray, normals: np.nda
     """Write in the format the suffix names (FORMATS); STL is binary."""
     mesh = to_trimesh(verts, faces, normals)
     kind = FORMATS[path.suffix.lower()]
-    data = mesh.export(file_type=kind, include_normals=True) if kind == "obj" else mesh.export(file_type=kind)
+    if kind == "obj":  # 17 significant digits: the doubles exactly (trimesh's default keeps 8 decimals)
+        data = mesh.export(file_type=kind, include_normals=True, digits=17)
+    elif kind == "ply":
+        data = mesh.export(file_type=kind, vertex_normal=True)
+    else:  # binary STL (float32, as the format holds), glTF binary (float32)
+        data = mesh.export(file_type=kind)
     blob = data.encode("utf-8") if isinstance(data, str) else bytes(data)
     atomic_write(path, lambda fh: fh.write(blob))  # type: ignore[attr-defined]
