@@ -73,7 +73,7 @@ def test_closed_manifold_outward(name):
     assert m.status() == manifold3d.Error.NoError
     closed, euler = closed_and_euler(f, len(v))
     assert closed and euler == tm.euler_number
-    assert result.mesh.stats["unprojected_vertices"] == 0
+    assert result.mesh.stats["fallback_crossings"] == 0
 
 
 @pytest.mark.parametrize("name", [n for n, c in CASES.items() if c[3] is not None])

@@ -141,10 +141,16 @@ def main(argv: Sequence[str]) -> int:
         f"{len(sing)} singular point(s) in the box, {rep['singular_in_clip']} in the solid's region"
         + (": " + " ".join(f"({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g})" for p in sing[:65]) if sing else "")
     )  # fmt: skip
+    hidden = rep["stats"]["hidden_crossing_edges"]
+    hidden_text = (
+        f"; {hidden} grid edges hold crossings their ends do not show (detail below the grid: raise --cells)"
+        if hidden
+        else ""
+    )
     print(
         f"implgen mesh: {spec.name}: {rep['vertices']} vertices, {rep['triangles']} triangles, "
         f"{'closed' if rep['closed'] else 'NOT closed'}, Euler characteristic {rep['euler_characteristic']}; "
-        f"{sing_text} -> {out}",
+        f"{sing_text}{hidden_text} -> {out}",
         file=sys.stderr,
     )
     return 0

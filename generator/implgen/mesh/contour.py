@@ -10,7 +10,7 @@ import numpy as np
 
 from implgen.mesh import cells
 from implgen.mesh.crossings import Crossings, axis_crossings, grid_flags, inside_flags
-from implgen.mesh.dual import project, qef_points
+from implgen.mesh.dual import outside_pieces, project, qef_points
 from implgen.mesh.faces import Quads, triangulate
 from implgen.mesh.region import Clip, Grid
 from implgen.mesh.shapelib import ShapeLib
@@ -97,6 +97,17 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     mask = np.zeros(nverts, dtype=np.int64)
     np.bitwise_or.at(mask, vid, np.int64(1) << cpiece.astype(np.int64))
     verts, projected = project(lib, clips, qef, mask, grid.h, grid.size)
+    extra = outside_pieces(lib, clips, verts, mask, grid.size)
+    if extra.any():  # on one piece but outside another (a cap vertex past the rim): onto both
+        redo = np.nonzero(extra)[0]
+        mask[redo] |= extra[redo]
+        verts[redo], projected[redo] = project(lib, clips, verts[redo], mask[redo], grid.h, grid.size)
+    failed = ~projected
+    if failed.any():  # Newton strayed (near a node, a thin neck): the sheet's crossing nearest the QEF point,
+        d = np.linalg.norm(cp - qef[vid], axis=1)  # which lies on the surface exactly
+        order = np.lexsort((d, vid))
+        first = order[np.unique(vid[order], return_index=True)[1]]
+        verts[failed] = cp[first][failed]
 
     # one quad per active edge, from the sheets of its four cells
     rowof = np.full(int(np.prod(shape)), -1, dtype=np.int64)
@@ -121,7 +132,8 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         "active_edges": int(sum(c.edges.size for c in cross)),
         "fallback_crossings": int(sum(c.fallback for c in cross)),
         "multi_sheet_cells": int((count > 1).sum()),
-        "unprojected_vertices": int((~projected).sum()),
+        "vertices_at_a_crossing": int(failed.sum()),
+        "hidden_crossing_edges": int(sum(c.hidden for c in cross)),
         "split_sides": split,
     }
     return Mesh(vertices=verts, faces=faces, grid=grid, stats=stats)

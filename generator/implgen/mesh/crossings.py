@@ -29,6 +29,7 @@ class Crossings:
     normals: np.ndarray
     piece: np.ndarray
     fallback: int
+    hidden: int  # edges whose two ends agree but that hold boundary points (a sheet poking through, a tangency)
 
 
 def clip_values(clips: list[Clip], p: np.ndarray) -> np.ndarray:
@@ -117,6 +118,7 @@ def axis_crossings(
     step = np.clip(np.floor(t / grid.h).astype(np.int64), 0, shape[axis] - 2)
     key = base[line] + step * strides[axis]
     on = np.isin(key, active)
+    hidden = int(np.unique(key[~on]).size)
     key, t, piece, p, nrm = key[on], t[on], piece[on], p[on], nrm[on]
     order = np.lexsort((t, key))
     key, piece, p, nrm = key[order], piece[order], p[order], nrm[order]
@@ -138,4 +140,4 @@ def axis_crossings(
         points[miss] = grid.point(end)
         _, grad = lib.value_gradient(points[miss])
         normals[miss] = unit(grad)
-    return Crossings(edges=active, points=points, normals=normals, piece=pieces, fallback=int(miss.size))
+    return Crossings(edges=active, points=points, normals=normals, piece=pieces, fallback=int(miss.size), hidden=hidden)

@@ -6,7 +6,7 @@ the small eigenvalues of the normal matrix dropped (a flat or curved piece keeps
 along it; a crease or a corner is located), clamped to the cell. Then onto the surface itself: Newton steps of
 least norm on the pieces that bound the sheet (f alone on a smooth sheet; f and a clip on a cap's rim, two clip
 planes on a box's edge), so every vertex lies on the true boundary up to rounding. A projection that does not
-converge or strays beyond a cell keeps the QEF point; those are counted.
+converge or strays beyond a cell is reported, and contour.py puts that vertex on the sheet's nearest crossing.
 """
 
 from __future__ import annotations
@@ -77,7 +77,7 @@ def project(
     mask: np.ndarray,
     h: float,
     scale: float,
-    steps: int = 100,
+    steps: int = 40,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Each start point moved onto every piece in its bit mask (bit j: piece j): (points, projected flags).
     Converged: a step below 1e-13 of `scale` (the box), or the last of `steps` below NOISE of it."""
@@ -118,6 +118,19 @@ def project(
         out[sel[ok]] = p[ok]
         done[sel[ok]] = True
     return out, done
+
+
+def outside_pieces(lib: ShapeLib, clips: list[Clip], p: np.ndarray, mask: np.ndarray, size: float) -> np.ndarray:
+    """Bit mask, per point, of the pieces not in `mask` that are positive there by more than 1e-12 of the box
+    (to first order): a cap vertex outside f, a surface vertex outside a clip."""
+    f, g = lib.value_gradient(p)
+    vals = [f / np.maximum(np.linalg.norm(g, axis=1), 1e-300)] + [c.value(p) for c in clips]
+    out = np.zeros(len(p), dtype=np.int64)
+    for j, v in enumerate(vals):
+        if j:
+            v = v / np.maximum(np.linalg.norm(clips[j - 1].gradient(p), axis=1), 1e-300)
+        out |= ((v > 1e-12 * size) & ~((mask >> j) & 1).astype(bool)).astype(np.int64) << j
+    return out
 
 
 def on_boundary(lib: ShapeLib, clips: list[Clip], p: np.ndarray) -> np.ndarray:
