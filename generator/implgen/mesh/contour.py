@@ -4,13 +4,14 @@ the normal points to f > 0 (outside)."""
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from implgen.mesh import cells
 from implgen.mesh.crossings import Crossings, axis_crossings, grid_flags, inside_flags
-from implgen.mesh.dual import outside_pieces, project, qef_points
+from implgen.mesh.dual import outside_pieces, piece_mask, project, qef_points
 from implgen.mesh.faces import Quads, triangulate
 from implgen.mesh.region import Clip, Grid
 from implgen.mesh.shapelib import ShapeLib
@@ -50,7 +51,9 @@ def _face_bits(lib, clips, grid: Grid, cell_idx: np.ndarray, config: np.ndarray)
 
 
 def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
+    clock = [time.perf_counter()]
     inside, g = grid_flags(lib, clips, grid)
+    clock.append(time.perf_counter())
     shape = inside.shape
     strides = np.array([shape[1] * shape[2], shape[2], 1])
     if inside[0].any() or inside[-1].any() or inside[:, 0].any() or inside[:, -1].any():
@@ -58,6 +61,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     if inside[:, :, 0].any() or inside[:, :, -1].any():
         raise AssertionError("the grid's outer layer must lie outside every clip")
     cross: list[Crossings] = [axis_crossings(lib, clips, grid, a, inside, g) for a in range(3)]
+    clock.append(time.perf_counter())
 
     # cells: corner flags -> config; active ones get their sheets
     ins = inside.view(np.uint8)
@@ -77,6 +81,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     cellvert = np.where(sheets >= 0, base[:, None] + sheets, -1)
     nverts = int(count.sum())
 
+    clock.append(time.perf_counter())
     # every sheet's crossings -> QEF point -> onto the surface
     corner = _corner_offsets(strides)
     vids, cps, cns, cpieces = [], [], [], []
@@ -94,8 +99,8 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     cell_of_vertex = np.repeat(np.arange(len(cidx)), count)
     lower = grid.origin + grid.h * cidx[cell_of_vertex]
     qef = qef_points(vid, cp, cn, nverts, lower, grid.h)
-    mask = np.zeros(nverts, dtype=np.int64)
-    np.bitwise_or.at(mask, vid, np.int64(1) << cpiece.astype(np.int64))
+    mask = piece_mask(vid, cpiece, nverts)
+    clock.append(time.perf_counter())
     verts, projected = project(lib, clips, qef, mask, grid.h, grid.size)
     extra = outside_pieces(lib, clips, verts, mask, grid.size)
     if extra.any():  # on one piece but outside another (a cap vertex past the rim): onto both
@@ -109,6 +114,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         first = order[np.unique(vid[order], return_index=True)[1]]
         verts[failed] = cp[first][failed]
 
+    clock.append(time.perf_counter())
     # one quad per active edge, from the sheets of its four cells
     rowof = np.full(int(np.prod(shape)), -1, dtype=np.int64)
     rowof[cflat] = np.arange(len(cflat))
@@ -127,7 +133,10 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     quads = Quads(*(np.concatenate([p[i] for p in parts]) for i in range(6)))
     near_amb = np.repeat(cells.AMBIGUOUS[conf] != 0, count)  # sheets of cells with an ambiguous face
     verts, faces, split = triangulate(quads, verts, near_amb, inside, grid, lib, clips, AROUND)
+    clock.append(time.perf_counter())
+    phases = ("signs", "crossings", "sheets", "qef", "projection", "faces")
     stats = {
+        "seconds": {k: round(b - a, 4) for k, a, b in zip(phases, clock, clock[1:])},
         "cells": list(grid.n),
         "active_edges": int(sum(c.edges.size for c in cross)),
         "fallback_crossings": int(sum(c.fallback for c in cross)),

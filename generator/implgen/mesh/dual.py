@@ -57,6 +57,14 @@ def qef_points(
     return np.clip(out, lower, lower + h)
 
 
+def piece_mask(vid: np.ndarray, piece: np.ndarray, nverts: int) -> np.ndarray:
+    """Per vertex, the bit mask of the pieces (bit j: piece j) of its crossings."""
+    mask = np.zeros(nverts, dtype=np.int64)
+    for j in np.unique(piece):
+        mask[np.bincount(vid[piece == j], minlength=nverts) > 0] |= np.int64(1) << np.int64(j)
+    return mask
+
+
 def _pieces_eval(lib: ShapeLib, clips: list[Clip], ids: list[int], p: np.ndarray):
     """Residuals (n, k) and gradients (n, k, 3) of the pieces `ids` (0: f, j: clips[j - 1]) at p."""
     res, jac = [], []
@@ -93,21 +101,29 @@ def project(
         ok = np.zeros(sel.size, dtype=bool)
         live = np.arange(sel.size)
         last = live_before = np.zeros(0)
+        prev = np.full(sel.size, np.inf)
         for _ in range(steps):
             if live.size == 0:
                 break
             r, jac = _pieces_eval(lib, clips, ids, p[live])
-            jjt = np.einsum("nki,nli->nkl", jac, jac)
-            jjt += (1e-14 * np.trace(jjt, axis1=1, axis2=2) + 1e-300)[:, None, None] * np.eye(len(ids))
             with np.errstate(all="ignore"):
-                y = np.linalg.solve(jjt, r[..., None])[..., 0]
-                step = -np.einsum("nki,nk->ni", jac, y)
+                if len(ids) == 1:  # one piece: the step along its gradient, no solve
+                    g = jac[:, 0, :]
+                    step = -(r[:, 0] / (g * g).sum(axis=1))[:, None] * g
+                else:
+                    jjt = np.einsum("nki,nli->nkl", jac, jac)
+                    jjt += (1e-14 * np.trace(jjt, axis1=1, axis2=2) + 1e-300)[:, None, None] * np.eye(len(ids))
+                    y = np.linalg.solve(jjt, r[..., None])[..., 0]
+                    step = -np.einsum("nki,nk->ni", jac, y)
             bad = ~np.isfinite(step).all(axis=1)
             step[bad] = 0.0
             p[live] += step
             size = np.linalg.norm(step, axis=1)
-            small = size <= tol
+            # converged: a step below tol, or at f's rounding (no longer halving, and below NOISE)
+            stalled = (size > 0.5 * prev[live]) & (size <= NOISE * scale)
+            small = (size <= tol) | stalled
             ok[live[small & ~bad]] = True
+            prev[live] = size
             last = size
             live_before = live
             live = live[~small & ~bad]

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from implgen.mesh.crossings import inside_flags
-from implgen.mesh.dual import project
+from implgen.mesh.dual import piece_mask, project
 from implgen.mesh.region import Clip, Grid
 from implgen.mesh.shapelib import ShapeLib
 
@@ -98,8 +98,7 @@ def triangulate(
     mids = np.zeros((nmid, 3))
     np.add.at(mids, mid_of, quads.point[qi])
     mids /= np.bincount(mid_of, minlength=nmid)[:, None]
-    mask = np.zeros(nmid, dtype=np.int64)
-    np.bitwise_or.at(mask, mid_of, np.int64(1) << quads.piece[qi].astype(np.int64))
+    mask = piece_mask(mid_of, quads.piece[qi], nmid)
     mids, _ = project(lib, clips, mids, mask, grid.h, grid.size)
     mid_id = np.full((len(q), 4), -1, dtype=np.int64)
     mid_id[qi, ks] = len(verts) + mid_of
