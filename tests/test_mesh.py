@@ -188,3 +188,18 @@ def test_singular_points_against_the_literature(path, box, count, f_tol):
     if path.endswith("barth6.yaml"):
         assert (np.linalg.norm(pts, axis=1) < 1.8).all()
         assert singular_in_solid(result).sum() == 50
+
+
+def test_mesh_passes_through_the_nodes():
+    """With the singular search on, the vertices of each node's cell sit on the node: Cayley's cubic in a ball
+    of 2 has a vertex at each of its 4 nodes, and stays a closed manifold."""
+    spec = load_spec(EX / "mesh/cayley.yaml")
+    result = mesh_spec(spec, {}, 24, parse_clip("sphere:2"), singular=True)
+    v, f = result.mesh.vertices, result.mesh.faces
+    for node in result.singular.points:
+        assert np.abs(v - node).max(axis=1).min() == 0.0
+    assert result.mesh.stats["snapped_to_singular"] >= 4
+    tm = trimesh.Trimesh(v, f, process=False)
+    assert tm.is_watertight and tm.is_winding_consistent and tm.volume > 0
+    m = manifold3d.Manifold(manifold3d.Mesh(vert_properties=v.astype(np.float32), tri_verts=f.astype(np.uint32)))
+    assert m.status() == manifold3d.Error.NoError

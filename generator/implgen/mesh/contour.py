@@ -27,6 +27,7 @@ class Mesh:
     faces: np.ndarray  # (F, 3) counter-clockwise seen from outside (f > 0)
     grid: Grid
     stats: dict = field(default_factory=dict)
+    cell: np.ndarray | None = None  # per vertex, the flat index of its cell's lower corner (-1: added by faces.py)
 
 
 def _corner_offsets(strides: np.ndarray) -> np.ndarray:
@@ -145,4 +146,6 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         "hidden_crossing_edges": int(sum(c.hidden for c in cross)),
         "split_sides": split,
     }
-    return Mesh(vertices=verts, faces=faces, grid=grid, stats=stats)
+    cell = np.full(len(verts), -1, dtype=np.int64)
+    cell[:nverts] = cflat[cell_of_vertex]
+    return Mesh(vertices=verts, faces=faces, grid=grid, stats=stats, cell=cell)

@@ -61,8 +61,29 @@ def mesh_spec(
     if singular:
         hi = grid.origin + grid.h * np.array(grid.n)
         sing = find_singular(lib, grid.origin, hi)
+        if sing.complete:  # isolated points (a curve's sample would only crumple the mesh along it)
+            snap_to_singular(mesh, sing.points, clips)
     t3 = time.perf_counter()
     return Result(mesh, lib, clips, sing, {"build": t1 - t0, "mesh": t2 - t1, "singular": t3 - t2})
+
+
+def snap_to_singular(mesh: Mesh, points: np.ndarray, clips: list[Clip]) -> int:
+    """Put the vertices of the cell that holds a singular point (inside every clip) on it: the mesh then passes
+    through each node, its cones meeting there. Returns how many vertices moved (mesh.stats["snapped"])."""
+    moved = 0
+    if len(points) and mesh.cell is not None:
+        cv = clip_values(clips, points)
+        inside = (cv <= 0).all(axis=0) if len(cv) else np.ones(len(points), dtype=bool)
+        g = mesh.grid
+        idx = np.floor((points[inside] - g.origin) / g.h).astype(np.int64)
+        ok = ((idx >= 0) & (idx < np.array(g.n))).all(axis=1)
+        flat = np.ravel_multi_index(tuple(idx[ok].T), g.shape)
+        where = {int(f): p for f, p in zip(flat, points[inside][ok])}
+        for v in np.nonzero(np.isin(mesh.cell, flat))[0]:
+            mesh.vertices[v] = where[int(mesh.cell[v])]
+            moved += 1
+    mesh.stats["snapped_to_singular"] = moved
+    return moved
 
 
 def singular_in_solid(result: Result) -> np.ndarray:
