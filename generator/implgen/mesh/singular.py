@@ -1,12 +1,12 @@
 """Singular points of f = 0 (f = 0 and grad f = 0: nodes, cusps) in a box, by subdivision and Newton.
 
 Subdivision: a cell is kept while each of f, f_x, f_y, f_z may vanish in it, and split in eight, level after
-level. A gradient component may vanish when the range of its values at the eight corners, widened on both sides
-by twice that range's width (once on the last two levels, where the cells are small enough for it to be nearly
-linear), holds 0: a crude Lipschitz bound, which also keeps a cusp's component that touches zero without
-changing sign. f may vanish when it changes sign at the corners or one of them is within 2 |grad f| x the
-diagonal of 0 (a node where f keeps one sign at every corner, its other sign in a narrow cone, is kept). Near an
-isolated singular point each component of the gradient is close to linear, and a plane through a point inside
+level. A gradient component may vanish when the range of its values at the eight corners and the centre,
+widened on both sides by twice that range's width (once on the last two levels, where the cells are small
+enough for it to be nearly linear), holds 0: a crude Lipschitz bound, which also keeps a cusp's component that
+touches zero without changing sign. f may vanish when it changes sign at the samples or one of them is within
+2 |grad f| x the diagonal of 0 (a node where f keeps one sign at every corner, its other sign in a narrow cone,
+is kept). Near an isolated singular point each component of the gradient is close to linear, and a plane through a point inside
 a cube leaves corners on both sides, so its cell is kept. This is a search, not a proof: a cell dropped is one
 where the samples rule out a zero, not one where interval arithmetic does.
 
@@ -38,9 +38,9 @@ class Singular:
 
 
 def _keep(vals: np.ndarray, widen: float, h: float) -> np.ndarray:
-    """vals (8, cells, 4), corner first: whether f and its gradient may all vanish in the cell. A gradient
+    """vals (9, cells, 4), sample first: whether f and its gradient may all vanish in the cell. A gradient
     component: its corner range, widened by `widen` times its width on each side, holds 0. f: it changes sign,
-    or some corner is within 2 |grad f| x the cell's diagonal of zero (f's own slope bounds how far it moves)."""
+    or some sample is within 2 |grad f| x the cell's diagonal of zero (f's own slope bounds how far it moves)."""
     lo, hi = np.minimum.reduce(vals), np.maximum.reduce(vals)
     w = widen * (hi - lo)
     grad_ok = ((lo[:, 1:] - w[:, 1:] <= 0) & (hi[:, 1:] + w[:, 1:] >= 0)).all(axis=1)
@@ -51,8 +51,10 @@ def _keep(vals: np.ndarray, widen: float, h: float) -> np.ndarray:
 
 
 def _corners(lib: ShapeLib, lo: np.ndarray, h: float) -> np.ndarray:
-    offs = np.array([[c & 1, c >> 1 & 1, c >> 2 & 1] for c in range(8)], dtype=np.float64) * h
-    p = lo[None, :, :] + offs[:, None, :]  # (8, cells, 3): corner first
+    """f and grad f at the 8 corners and the centre of each cell: (9, cells, 4). The centre catches a component
+    that touches zero without changing sign midway between corners where it is equal (a cusp's)."""
+    offs = [[c & 1, c >> 1 & 1, c >> 2 & 1] for c in range(8)] + [[0.5, 0.5, 0.5]]
+    p = lo[None, :, :] + (np.array(offs, dtype=np.float64) * h)[:, None, :]  # (9, cells, 3): sample first
     f, g = lib.value_gradient(p)
     return np.concatenate([f[..., None], g], axis=-1)
 
