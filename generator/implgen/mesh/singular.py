@@ -6,9 +6,9 @@ widened on both sides by twice that range's width (once on the last two levels, 
 enough for it to be nearly linear), holds 0: a crude Lipschitz bound, which also keeps a cusp's component that
 touches zero without changing sign. f may vanish when it changes sign at the samples or one of them is within
 2 |grad f| x the diagonal of 0 (a node where f keeps one sign at every corner, its other sign in a narrow cone,
-is kept). Near an isolated singular point each component of the gradient is close to linear, and a plane through a point inside
-a cube leaves corners on both sides, so its cell is kept. This is a search, not a proof: a cell dropped is one
-where the samples rule out a zero, not one where interval arithmetic does.
+is kept). Near an isolated singular point each component of the gradient is close to linear, and a plane
+through a point inside a cube leaves corners on both sides, so its cell is kept. This is a search, not a
+proof: a cell dropped is one where the samples rule out a zero, not one where interval arithmetic does.
 
 Newton: Gauss-Newton on the four equations (f / size, f_x, f_y, f_z) in three unknowns, from the centre of each
 kept cell, the Hessian by central differences of the generated gradient (the residual is exact, so the limit is
