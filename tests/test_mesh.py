@@ -203,3 +203,15 @@ def test_mesh_passes_through_the_nodes():
     assert tm.is_watertight and tm.is_winding_consistent and tm.volume > 0
     m = manifold3d.Manifold(manifold3d.Mesh(vert_properties=v.astype(np.float32), tri_verts=f.astype(np.uint32)))
     assert m.status() == manifold3d.Error.NoError
+
+
+def test_the_piriform_cusp():
+    """The piriform's cusp at the origin (f = x^4 - x^3 + y^2 + z^2: f_x = x^2 (4x - 3) touches zero without
+    changing sign) is found, the mesh passes through it, and the mesh is a closed sphere."""
+    spec = load_spec(EX / "shapes/piriform.yaml")
+    for cells in (32, 48):
+        result = mesh_spec(spec, {}, cells, [], singular=True)
+        pts = result.singular.points
+        assert result.singular.complete and len(pts) == 1 and np.abs(pts[0]).max() < 1e-7
+        tm = trimesh.Trimesh(result.mesh.vertices, result.mesh.faces, process=False)
+        assert tm.is_watertight and tm.euler_number == 2
