@@ -106,10 +106,10 @@ def axis_crossings(
     """The active edges along `axis` and their crossings. inside, g: per vertex (n0+1, n1+1, n2+1)."""
     shape = inside.shape
     strides = np.array([shape[1] * shape[2], shape[2], 1])
-    lower = np.take(inside, np.arange(shape[axis] - 1), axis=axis)
-    upper = np.take(inside, np.arange(1, shape[axis]), axis=axis)
-    idx = np.nonzero(lower != upper)
-    active = np.ravel_multi_index(idx, shape)
+    lo_sl = tuple(slice(0, -1) if a == axis else slice(None) for a in range(3))
+    hi_sl = tuple(slice(1, None) if a == axis else slice(None) for a in range(3))
+    idx = np.nonzero(inside[lo_sl] != inside[hi_sl])  # views: no copy of the flags
+    active = np.ravel_multi_index(idx, shape)  # ascending
     # the lines: vertices with index 0 along the axis, in flat vertex numbering
     base_idx = np.indices(tuple(1 if a == axis else s for a, s in enumerate(shape))).reshape(3, -1)
     base = np.ravel_multi_index(tuple(base_idx), shape)
@@ -117,7 +117,8 @@ def axis_crossings(
     line, t, piece, p, nrm = _candidates(lib, clips, grid, axis, starts)
     step = np.clip(np.floor(t / grid.h).astype(np.int64), 0, shape[axis] - 2)
     key = base[line] + step * strides[axis]
-    on = np.isin(key, active)
+    at = np.minimum(np.searchsorted(active, key), max(active.size - 1, 0))
+    on = (active[at] == key) if active.size else np.zeros(key.size, dtype=bool)
     hidden = int(np.unique(key[~on]).size)
     key, t, piece, p, nrm = key[on], t[on], piece[on], p[on], nrm[on]
     order = np.lexsort((t, key))
