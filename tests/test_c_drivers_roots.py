@@ -30,3 +30,8 @@ def test_far_torus_matches_near_torus_under_sanitizers(tmp_path):
 def test_runtime_sources_compile_clean(tmp_path, src):
     assert src.name in (*SOLVER_SOURCES, *SHAPE_SOURCES, *TRACER_SOURCES, "roots_bench.c")
     compile_c(tmp_path / "x.o", [src], sanitize=False, flags=["-c"])
+
+
+def test_shape_batch_equals_one_by_one_under_sanitizers(tmp_path):
+    sources = [CDIR / "test_shape_batch.c", CDIR / "shape_torus_fixture.c", *runtime_sources(SHAPE_SOURCES), *SOLVERS]
+    assert "all batch checks passed" in run_c(compile_c(tmp_path / "test_shape_batch", sources))

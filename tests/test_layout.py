@@ -28,6 +28,7 @@ FLOORS = {
     "view": 6,
     "export": 6,
     "share": 6,
+    "mesh": 6,
     "bench": 6,
     "demo": 6,
     "cli": 7,

@@ -85,6 +85,11 @@ COMMANDS: dict[str, Command] = {
             ("a bench's options and examples", "implgen bench render --help"),
         ),
     ),
+    "mesh": Command(
+        "mesh SPEC.yaml -o OUT.stl|.obj|.ply|.glb [options]",
+        "a watertight triangle mesh of the solid f < 0, crossings solved exactly",
+        "implgen.mesh.command:main",
+    ),
     "demo": Command(
         "demo [--shapes DIR] [-o DIR]",
         "what `make demo` runs: the example shapes, end to end",

@@ -1,0 +1,144 @@
+"""Grid lines → crossings: every line of the grid is a ray along an axis; the C runtime gives every root of f
+along it at once (ShapeLib.roots, one C call per family of lines), the clips' crossings are closed forms.
+
+A grid edge is active when the solid's inside flag differs at its two ends (f < 0 and every clip < 0, at the
+vertex). Its crossing is a root on that edge where the solid's boundary truly is: a root of f where every clip
+is <= 0, or a clip's crossing where f and the other clips are <= 0. An edge with several such points (three
+sheets through one edge) takes the middle one; an edge whose ends differ but where no root was found (a
+vertex within rounding of the surface) takes the end nearer the surface, and is counted.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from implgen.mesh.region import Clip, Grid
+from implgen.mesh.shapelib import ShapeLib
+
+
+@dataclass
+class Crossings:
+    """Active edges along one axis: `edges` (flat index of the edge's lower vertex), their crossing points,
+    unit normals (toward f > 0 of the piece that bounds the solid there; 0 where the gradient vanishes), and
+    which piece: 0 for f, k >= 1 for clips[k - 1]."""
+
+    edges: np.ndarray
+    points: np.ndarray
+    normals: np.ndarray
+    piece: np.ndarray
+    fallback: int
+    hidden: int  # edges whose two ends agree but that hold boundary points (a sheet poking through, a tangency)
+
+
+def clip_values(clips: list[Clip], p: np.ndarray) -> np.ndarray:
+    """(len(clips), ...) values of every clip at p."""
+    return np.stack([c.value(p) for c in clips]) if clips else np.zeros((0,) + p.shape[:-1])
+
+
+def inside_flags(lib: ShapeLib, clips: list[Clip], p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(inside, g) at points p: g = max(f, clips), inside = g < 0."""
+    g = lib.value(p)
+    cv = clip_values(clips, p)
+    if len(cv):
+        g = np.maximum(g, cv.max(axis=0))
+    return g < 0, g
+
+
+def grid_flags(lib: ShapeLib, clips: list[Clip], grid: Grid) -> tuple[np.ndarray, np.ndarray]:
+    """inside_flags at every vertex of the grid, without an array of its points."""
+    x, y, z = (grid.coords(a) for a in range(3))
+    g = lib.values_grid(x, y, z)
+    for c in clips:
+        np.maximum(g, c.on_grid(x, y, z), out=g)
+    return g < 0, g
+
+
+def unit(v: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = np.where((n > 0) & np.isfinite(n), v / n, 0.0)
+    return u
+
+
+def _candidates(lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, starts: np.ndarray):
+    """Every boundary point of the solid on the lines along `axis` starting at `starts` (L, 3): (line, t,
+    piece), t measured from the line's start."""
+    length = grid.n[axis] * grid.h
+    d = np.zeros(3)
+    d[axis] = 1.0
+    roots, counts = lib.roots(starts, d, 0.0, length)
+    lines, cols = np.nonzero(np.arange(roots.shape[1])[None, :] < counts[:, None])
+    ts = [roots[lines, cols]]
+    ls = [lines]
+    pieces = [np.zeros(lines.size, dtype=np.int32)]
+    for k, c in enumerate(clips):
+        x = c.crossings(axis, starts)
+        li, ci = np.nonzero(np.isfinite(x))
+        t = x[li, ci] - starts[li, axis]
+        ok = (t >= 0) & (t <= length)
+        ts.append(t[ok])
+        ls.append(li[ok])
+        pieces.append(np.full(int(ok.sum()), k + 1, dtype=np.int32))
+    line = np.concatenate(ls)
+    t = np.concatenate(ts)
+    piece = np.concatenate(pieces)
+    p = starts[line].copy()
+    p[:, axis] += t
+    # the piece bounds the solid there only where every other piece is <= 0
+    fvals, fgrad = lib.value_gradient(p)
+    cvals = clip_values(clips, p)
+    others = np.where(piece == 0, -np.inf, fvals)
+    for k in range(len(clips)):
+        others = np.maximum(others, np.where(piece == k + 1, -np.inf, cvals[k]))
+    keep = others <= 0
+    normals = fgrad.copy()
+    for k, c in enumerate(clips):
+        sel = piece == k + 1
+        normals[sel] = c.gradient(p[sel])
+    return line[keep], t[keep], piece[keep], p[keep], unit(normals[keep])
+
+
+def axis_crossings(
+    lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, inside: np.ndarray, g: np.ndarray
+) -> Crossings:
+    """The active edges along `axis` and their crossings. inside, g: per vertex (n0+1, n1+1, n2+1)."""
+    shape = inside.shape
+    strides = np.array([shape[1] * shape[2], shape[2], 1])
+    lo_sl = tuple(slice(0, -1) if a == axis else slice(None) for a in range(3))
+    hi_sl = tuple(slice(1, None) if a == axis else slice(None) for a in range(3))
+    idx = np.nonzero(inside[lo_sl] != inside[hi_sl])  # views: no copy of the flags
+    active = np.ravel_multi_index(idx, shape)  # ascending
+    # the lines: vertices with index 0 along the axis, in flat vertex numbering
+    base_idx = np.indices(tuple(1 if a == axis else s for a, s in enumerate(shape))).reshape(3, -1)
+    base = np.ravel_multi_index(tuple(base_idx), shape)
+    starts = grid.point(base)
+    line, t, piece, p, nrm = _candidates(lib, clips, grid, axis, starts)
+    step = np.clip(np.floor(t / grid.h).astype(np.int64), 0, shape[axis] - 2)
+    key = base[line] + step * strides[axis]
+    at = np.minimum(np.searchsorted(active, key), max(active.size - 1, 0))
+    on = (active[at] == key) if active.size else np.zeros(key.size, dtype=bool)
+    hidden = int(np.unique(key[~on]).size)
+    key, t, piece, p, nrm = key[on], t[on], piece[on], p[on], nrm[on]
+    order = np.lexsort((t, key))
+    key, piece, p, nrm = key[order], piece[order], p[order], nrm[order]
+    uniq, first, count = np.unique(key, return_index=True, return_counts=True)
+    pick = first + count // 2
+    points = np.empty((active.size, 3))
+    normals = np.zeros((active.size, 3))
+    pieces = np.zeros(active.size, dtype=np.int32)
+    pos = np.searchsorted(uniq, active)
+    found = (pos < uniq.size) & (uniq[np.minimum(pos, uniq.size - 1)] == active)
+    src = pick[pos[found]]
+    points[found], normals[found], pieces[found] = p[src], nrm[src], piece[src]
+    miss = np.nonzero(~found)[0]
+    if miss.size:  # an end within rounding of the surface: the end nearer it
+        lo_v = active[miss]
+        hi_v = lo_v + strides[axis]
+        gf = g.reshape(-1)
+        end = np.where(np.abs(gf[lo_v]) <= np.abs(gf[hi_v]), lo_v, hi_v)
+        points[miss] = grid.point(end)
+        _, grad = lib.value_gradient(points[miss])
+        normals[miss] = unit(grad)
+    return Crossings(edges=active, points=points, normals=normals, piece=pieces, fallback=int(miss.size), hidden=hidden)

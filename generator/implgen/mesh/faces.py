@@ -1,0 +1,120 @@
+"""Quads → triangles. Each active grid edge gives one quad, the sheets of its four cells in turn around it; two
+triangles on the shorter diagonal, facing f > 0.
+
+One case needs more: two cells that share an ambiguous face and whose two curves on that face both join the
+same pair of sheets (a thin tube through the face). The quad complex is still a manifold, but the two quad
+sides between those sheets join the same two vertices, so a triangle mesh would hold that edge four times. Each
+such side gets a vertex of its own, on the surface between the two crossings its curve joins, keyed by the face
+and the corner its curve cuts off; the quads around it are fanned from their own crossing point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from implgen.mesh.crossings import inside_flags
+from implgen.mesh.dual import piece_mask, project
+from implgen.mesh.region import Clip, Grid
+from implgen.mesh.shapelib import ShapeLib
+
+
+@dataclass
+class Quads:
+    """Quads of all three axes: sheet vertices (M, 4) counter-clockwise about +axis, the axis, the edge's
+    lower grid vertex (flat), whether the outside is toward -axis, and the edge's crossing (point, piece)."""
+
+    verts: np.ndarray
+    axis: np.ndarray
+    edge: np.ndarray
+    flip: np.ndarray
+    point: np.ndarray
+    piece: np.ndarray
+
+
+# the cells around an edge (contour.AROUND) differ, between turn k and k + 1, along the axis a + 1 + (k % 2);
+# the cell pair shares its offset along the remaining axis: AROUND[k]'s offset there
+SIDE_NORMAL = (1, 2, 1, 2)
+
+
+def _simple(q: np.ndarray, verts: np.ndarray, flip: np.ndarray) -> np.ndarray:
+    q = np.where(flip[:, None], q[:, ::-1], q)
+    d02 = np.linalg.norm(verts[q[:, 0]] - verts[q[:, 2]], axis=1)
+    d13 = np.linalg.norm(verts[q[:, 1]] - verts[q[:, 3]], axis=1)
+    alt = (d13 < d02)[:, None]
+    t1 = np.where(alt, q[:, [1, 2, 3]], q[:, [0, 1, 2]])
+    t2 = np.where(alt, q[:, [1, 3, 0]], q[:, [0, 2, 3]])
+    return np.concatenate([t1, t2])
+
+
+def triangulate(
+    quads: Quads,
+    verts: np.ndarray,
+    near_amb: np.ndarray,
+    inside: np.ndarray,
+    grid: Grid,
+    lib: ShapeLib,
+    clips: list[Clip],
+    around,
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """(vertices with any added, triangles, how many quad sides were split). near_amb: per vertex, whether its
+    cell has an ambiguous face (only a quad with all its sides' cells so can hold a doubled side)."""
+    q = quads.verts
+    dup = np.zeros((len(q), 4), dtype=bool)
+    sides = np.stack([np.sort(np.stack([q[:, k], q[:, (k + 1) % 4]], axis=1), axis=1) for k in range(4)], axis=1)
+    cand = np.nonzero(near_amb[q].any(axis=1))[0]
+    if cand.size:
+        key = sides[cand, :, 0] * len(verts) + sides[cand, :, 1]
+        _, inv, cnt = np.unique(key.reshape(-1), return_inverse=True, return_counts=True)
+        dup[cand] = (cnt[inv.reshape(-1)] > 2).reshape(-1, 4)
+    hit = dup.any(axis=1)
+    if not hit.any():
+        return verts, _simple(q, verts, quads.flip), 0
+    shape = inside.shape
+    qi, ks = np.nonzero(dup)
+    a = quads.axis[qi]
+    normal = (a + np.array(SIDE_NORMAL)[ks]) % 3
+    third = 3 - a - normal
+    e_idx = np.stack(np.unravel_index(quads.edge[qi], shape), axis=1)
+    # the face between the two cells of this side: its centre, computed from global indices
+    around = np.array(around)
+    off_b, off_c = around[ks, 0], around[ks, 1]
+    b_axis = (a + 1) % 3
+    d_third = np.where(third == b_axis, off_b, off_c)
+    centre = e_idx.astype(np.float64)
+    rows = np.arange(len(qi))
+    centre[rows, a] += 0.5
+    centre[rows, third] += 0.5 - d_third
+    c_in, _ = inside_flags(lib, clips, grid.origin + grid.h * centre)
+    # the corner the side's curve cuts off: the edge's end whose flag differs from the centre's
+    lo_in = inside.reshape(-1)[quads.edge[qi]]
+    strides = np.array([shape[1] * shape[2], shape[2], 1])
+    corner = np.where(lo_in != c_in, quads.edge[qi], quads.edge[qi] + strides[a])
+    key = np.stack([sides[qi, ks, 0], sides[qi, ks, 1], corner, normal], axis=1)
+    ukey, mid_of = np.unique(key, axis=0, return_inverse=True)
+    mid_of = mid_of.reshape(-1)
+    nmid = len(ukey)
+    mids = np.zeros((nmid, 3))
+    np.add.at(mids, mid_of, quads.point[qi])
+    mids /= np.bincount(mid_of, minlength=nmid)[:, None]
+    mask = piece_mask(mid_of, quads.piece[qi], nmid)
+    mids, _ = project(lib, clips, mids, mask, grid.h, grid.size)
+    mid_id = np.full((len(q), 4), -1, dtype=np.int64)
+    mid_id[qi, ks] = len(verts) + mid_of
+    fan = np.nonzero(hit)[0]
+    centre_id = len(verts) + nmid + np.arange(fan.size)
+    tris = []
+    for j, qn in enumerate(fan):  # few: only quads next to a split side
+        poly = []
+        for k in range(4):
+            poly.append(q[qn, k])
+            if mid_id[qn, k] >= 0:
+                poly.append(mid_id[qn, k])
+        for i in range(len(poly)):
+            t = [poly[i], poly[(i + 1) % len(poly)], centre_id[j]]
+            tris.append(t[::-1] if quads.flip[qn] else t)
+    out_verts = np.concatenate([verts, mids, quads.point[fan]])
+    keep = ~hit
+    faces = np.concatenate([_simple(q[keep], verts, quads.flip[keep]), np.array(tris, dtype=np.int64)])
+    return out_verts, faces, nmid

@@ -1,0 +1,94 @@
+"""One shape → a mesh and what is known of it: the library, the region, the contour, the singular points, the
+mesh's own checks (edges each shared by two faces, Euler characteristic, volume), timings."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from implgen.codegen.specmodel import Spec
+from implgen.mesh.contour import Mesh, contour
+from implgen.mesh.crossings import clip_values
+from implgen.mesh.region import Clip, make_grid
+from implgen.mesh.shapelib import ShapeLib
+from implgen.mesh.singular import Singular, find_singular
+
+
+@dataclass
+class Result:
+    mesh: Mesh
+    lib: ShapeLib
+    clips: list[Clip]
+    singular: Singular | None
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+def closed_and_euler(faces: np.ndarray, nverts: int) -> tuple[bool, int]:
+    """(every edge in exactly two faces, each way once; V - E + F over the vertices faces use)."""
+    e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    directed = np.unique(e, axis=0)
+    und, counts = np.unique(np.sort(e, axis=1), axis=0, return_counts=True)
+    closed = bool((counts == 2).all()) and len(directed) == len(e)
+    used = np.unique(faces).size if len(faces) else 0
+    return closed, int(used - len(und) + len(faces))
+
+
+def signed_volume(verts: np.ndarray, faces: np.ndarray) -> float:
+    a, b, c = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+def mesh_spec(
+    spec: Spec,
+    values: Mapping[str, float],
+    cells: int,
+    user_clips: list[Clip],
+    singular: bool = True,
+    what: str = "",
+) -> Result:
+    """Mesh the solid f < 0 (∩ the spec's box, ∩ the user's clip) of `spec` with these param values."""
+    t0 = time.perf_counter()
+    full = {**spec.params, **values}
+    lib = ShapeLib(spec, [full[k] for k in spec.params])
+    t1 = time.perf_counter()
+    grid, clips = make_grid(spec.box(dict(values)), user_clips, cells, what or spec.source)
+    mesh = contour(lib, clips, grid)
+    t2 = time.perf_counter()
+    sing = None
+    if singular:
+        hi = grid.origin + grid.h * np.array(grid.n)
+        sing = find_singular(lib, grid.origin, hi)
+        if sing.complete:  # isolated points (a curve's sample would only crumple the mesh along it)
+            snap_to_singular(mesh, sing.points, clips)
+    t3 = time.perf_counter()
+    return Result(mesh, lib, clips, sing, {"build": t1 - t0, "mesh": t2 - t1, "singular": t3 - t2})
+
+
+def snap_to_singular(mesh: Mesh, points: np.ndarray, clips: list[Clip]) -> int:
+    """Put the vertices of the cell that holds a singular point (inside every clip) on it: the mesh then passes
+    through each node, its cones meeting there. Returns how many vertices moved (mesh.stats["snapped"])."""
+    moved = 0
+    if len(points) and mesh.cell is not None:
+        cv = clip_values(clips, points)
+        inside = (cv <= 0).all(axis=0) if len(cv) else np.ones(len(points), dtype=bool)
+        g = mesh.grid
+        idx = np.floor((points[inside] - g.origin) / g.h).astype(np.int64)
+        ok = ((idx >= 0) & (idx < np.array(g.n))).all(axis=1)
+        flat = np.ravel_multi_index(tuple(idx[ok].T), g.shape)
+        where = {int(f): p for f, p in zip(flat, points[inside][ok])}
+        for v in np.nonzero(np.isin(mesh.cell, flat))[0]:
+            mesh.vertices[v] = where[int(mesh.cell[v])]
+            moved += 1
+    mesh.stats["snapped_to_singular"] = moved
+    return moved
+
+
+def singular_in_solid(result: Result) -> np.ndarray:
+    """Which singular points lie in the clipped region (every clip <= 0 there)."""
+    if result.singular is None or not len(result.singular.points):
+        return np.zeros(0, dtype=bool)
+    cv = clip_values(result.clips, result.singular.points)
+    return (cv <= 0).all(axis=0) if len(cv) else np.ones(len(result.singular.points), dtype=bool)

@@ -1,0 +1,87 @@
+"""One shape compiled with the runtime (compile/library.py, cached), and its batch entry points
+(runtime_c/shape_batch.c) bound with ctypes: every root of f along many rays at once, and f with its gradient
+at many points at once. Each call is one C loop; Python never loops per ray or per point."""
+
+from __future__ import annotations
+
+import ctypes
+from collections.abc import Sequence
+
+import numpy as np
+
+from implgen import abi
+from implgen.codegen.specmodel import Spec
+from implgen.compile import clib
+from implgen.compile.library import ShapeEntry, build_library
+
+MAX_DEGREE = abi.value("IG_MAX_DEGREE")
+AUTO = abi.value("IG_ROOTS_AUTO")
+
+_DP = ctypes.POINTER(ctypes.c_double)
+_IP = ctypes.POINTER(ctypes.c_int)
+_VP = ctypes.c_void_p
+
+
+def _ptr(a: np.ndarray):
+    return a.ctypes.data_as(_DP)
+
+
+class ShapeLib:
+    """The compiled shape `spec` with these param values (in the spec's order)."""
+
+    def __init__(self, spec: Spec, params: Sequence[float]):
+        path, _ = build_library([ShapeEntry(spec=spec, c_name=spec.name, folded=False)])
+        lib = clib.load(path)
+        lib.rt_scene_shape.restype = _VP
+        lib.rt_scene_shape.argtypes = [ctypes.c_int]
+        lib.ig_shape_roots_many.restype = None
+        lib.ig_shape_roots_many.argtypes = [_VP, _DP, ctypes.c_long, _DP, _DP, _DP, _DP, ctypes.c_int, _DP, _IP]
+        lib.ig_shape_eval_many.restype = None
+        lib.ig_shape_eval_many.argtypes = [_VP, _DP, ctypes.c_long, _DP, _DP, _DP]
+        lib.ig_shape_values_grid.restype = None
+        lib.ig_shape_values_grid.argtypes = [_VP, _DP, _DP, ctypes.c_long, _DP, ctypes.c_long, _DP, ctypes.c_long, _DP]
+        self._lib = lib
+        self._shape = lib.rt_scene_shape(0)
+        self._params = np.ascontiguousarray(np.asarray(list(params) or [0.0], dtype=np.float64))
+        self.degree = spec.degree
+
+    def roots(self, o: np.ndarray, d: np.ndarray, tmin: np.ndarray, tmax: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """All distinct roots in [tmin, tmax] of each ray o + t d: (roots (n, IG_MAX_DEGREE), NaN past each
+        count; counts (n,))."""
+        o = np.ascontiguousarray(o, dtype=np.float64).reshape(-1, 3)
+        n = o.shape[0]
+        d = np.ascontiguousarray(np.broadcast_to(np.asarray(d, dtype=np.float64), (n, 3)))
+        t0 = np.ascontiguousarray(np.broadcast_to(np.asarray(tmin, dtype=np.float64), (n,)))
+        t1 = np.ascontiguousarray(np.broadcast_to(np.asarray(tmax, dtype=np.float64), (n,)))
+        out = np.full((n, MAX_DEGREE), np.nan)
+        counts = np.zeros(n, dtype=np.intc)
+        self._lib.ig_shape_roots_many(
+            self._shape, _ptr(self._params), n, _ptr(o), _ptr(d), _ptr(t0), _ptr(t1), AUTO, _ptr(out),
+            counts.ctypes.data_as(_IP),
+        )  # fmt: skip
+        out[np.arange(MAX_DEGREE)[None, :] >= counts[:, None]] = np.nan
+        return out, counts
+
+    def value(self, p: np.ndarray) -> np.ndarray:
+        """f at each point (p: (..., 3)), shape p.shape[:-1]."""
+        p = np.ascontiguousarray(p, dtype=np.float64)
+        f = np.empty(p.shape[:-1])
+        self._lib.ig_shape_eval_many(self._shape, _ptr(self._params), f.size, _ptr(p), _ptr(f), None)
+        return f
+
+    def value_gradient(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(f, grad f) at each point (p: (..., 3))."""
+        p = np.ascontiguousarray(p, dtype=np.float64)
+        f = np.empty(p.shape[:-1])
+        g = np.empty(p.shape)
+        self._lib.ig_shape_eval_many(self._shape, _ptr(self._params), f.size, _ptr(p), _ptr(f), _ptr(g))
+        return f, g
+
+    def values_grid(self, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """f at every (x[i], y[j], z[k]), shape (len(x), len(y), len(z))."""
+        x, y, z = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, y, z))
+        f = np.empty((x.size, y.size, z.size))
+        self._lib.ig_shape_values_grid(
+            self._shape, _ptr(self._params), _ptr(x), x.size, _ptr(y), y.size, _ptr(z), z.size, _ptr(f)
+        )
+        return f

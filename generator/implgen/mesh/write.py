@@ -1,0 +1,54 @@
+"""A mesh to a file, written by trimesh (binary STL, OBJ, binary PLY with doubles, glTF binary), atomically; the
+per-vertex normals the formats that hold them get: the gradient of the piece that bounds the solid there
+(f, or a clip), normalised; the faces' average where that gradient vanishes (a node)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from implgen.mesh.crossings import clip_values, unit
+from implgen.mesh.region import Clip
+from implgen.mesh.shapelib import ShapeLib
+from implgen.outputs import atomic_write
+
+FORMATS = {".stl": "stl", ".obj": "obj", ".ply": "ply", ".glb": "glb"}
+
+
+def vertex_normals(lib: ShapeLib, clips: list[Clip], verts: np.ndarray) -> np.ndarray:
+    """Unit normals toward f > 0 (zero where the bounding piece's gradient vanishes)."""
+    f, g = lib.value_gradient(verts)
+    if clips:
+        cv = clip_values(clips, verts)
+        top = cv.argmax(axis=0)
+        use_clip = cv.max(axis=0) > f
+        for k, c in enumerate(clips):
+            sel = use_clip & (top == k)
+            g[sel] = c.gradient(verts[sel])
+    return unit(g)
+
+
+def to_trimesh(verts: np.ndarray, faces: np.ndarray, normals: np.ndarray | None = None):
+    import trimesh
+
+    mesh = trimesh.Trimesh(vertices=verts, faces=faces, process=False, validate=False)
+    if normals is not None:
+        fallback = np.asarray(mesh.vertex_normals)  # area-weighted face normals
+        bad = np.linalg.norm(normals, axis=1) == 0
+        mesh.vertex_normals = np.where(bad[:, None], fallback, normals)
+    return mesh
+
+
+def write_mesh(path: Path, verts: np.ndarray, faces: np.ndarray, normals: np.ndarray | None) -> None:
+    """Write in the format the suffix names (FORMATS); STL is binary."""
+    mesh = to_trimesh(verts, faces, normals)
+    kind = FORMATS[path.suffix.lower()]
+    if kind == "obj":  # 17 significant digits: the doubles exactly (trimesh's default keeps 8 decimals)
+        data = mesh.export(file_type=kind, include_normals=True, digits=17)
+    elif kind == "ply":
+        data = mesh.export(file_type=kind, vertex_normal=True)
+    else:  # binary STL (float32, as the format holds), glTF binary (float32)
+        data = mesh.export(file_type=kind)
+    blob = data.encode("utf-8") if isinstance(data, str) else bytes(data)
+    atomic_write(path, lambda fh: fh.write(blob))  # type: ignore[attr-defined]

@@ -1,0 +1,43 @@
+/* Batch forms of ig_shape_roots and of the shape's value and gradient. See shape_batch.h. */
+#include "shape_batch.h"
+
+#include <stddef.h>
+
+void ig_shape_roots_many(const ig_shape *shape, const double *params, long n, const double *o, const double *d,
+                         const double *tmin, const double *tmax, ig_root_method method, double *roots, int *counts)
+{
+    ig_shape_prep prep;
+    if (!shape || !o || !d || !tmin || !tmax || !roots || !counts)
+        return;
+    ig_shape_prepare(shape, params, &prep);
+    for (long i = 0; i < n; ++i) {
+        double *r = roots + (size_t)i * IG_MAX_DEGREE;
+        counts[i] = shape->coeffs ? ig_shape_solve(shape, params, &prep, o + 3 * (size_t)i, d + 3 * (size_t)i, tmin[i],
+                                                   tmax[i], method, 0, r, NULL)
+                                  : 0;
+    }
+}
+
+void ig_shape_eval_many(const ig_shape *shape, const double *params, long n, const double *p, double *f, double *g)
+{
+    if (!shape || !p || !f || !shape->value)
+        return;
+    for (long i = 0; i < n; ++i) {
+        f[i] = shape->value(p + 3 * (size_t)i, params);
+        if (g && shape->gradient)
+            shape->gradient(p + 3 * (size_t)i, params, g + 3 * (size_t)i);
+    }
+}
+
+void ig_shape_values_grid(const ig_shape *shape, const double *params, const double *x, long nx, const double *y,
+                          long ny, const double *z, long nz, double *f)
+{
+    if (!shape || !shape->value || !x || !y || !z || !f)
+        return;
+    for (long i = 0; i < nx; ++i)
+        for (long j = 0; j < ny; ++j)
+            for (long k = 0; k < nz; ++k) {
+                double p[3] = {x[i], y[j], z[k]};
+                f[((size_t)i * (size_t)ny + (size_t)j) * (size_t)nz + (size_t)k] = shape->value(p, params);
+            }
+}

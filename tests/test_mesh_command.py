@@ -1,0 +1,94 @@
+"""`implgen mesh` as the user runs it: all four formats written and read back by trimesh, binary STL by default,
+the JSON report and the one stderr line, a shape of a scene placed by its transform, and bad options refused
+with one line, exit status 2 and nothing written."""
+
+from __future__ import annotations
+
+import json
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from implgen_proc import implgen
+
+ROOT = Path(__file__).resolve().parent.parent
+TORUS = ROOT / "examples/shapes/torus_z.yaml"
+
+
+@pytest.mark.parametrize("suffix", [".stl", ".obj", ".ply", ".glb"])
+def test_every_format_reads_back(tmp_path, suffix):
+    out = tmp_path / f"torus{suffix}"
+    ran = implgen("mesh", TORUS, "-o", out, "--cells", "16", "--report", tmp_path / "r.json")
+    assert ran.code == 0, ran.err
+    rep = json.loads((tmp_path / "r.json").read_text())
+    loaded = trimesh.load(out, force="mesh")  # merges the STL's per-face corners back into shared vertices
+    assert len(loaded.faces) == rep["triangles"]
+    assert loaded.is_watertight and loaded.euler_number == 0
+    assert abs(loaded.volume - rep["volume"]) < 1e-5 * rep["volume"]
+    if suffix == ".stl":  # binary: an 80-byte header, a count, 50 bytes per triangle
+        data = out.read_bytes()
+        assert struct.unpack("<I", data[80:84])[0] == rep["triangles"]
+        assert len(data) == 84 + 50 * rep["triangles"]
+
+
+def test_report_and_stderr_line(tmp_path):
+    out, rep_path = tmp_path / "cayley.obj", tmp_path / "cayley.json"
+    ran = implgen("mesh", ROOT / "examples/mesh/cayley.yaml", "--clip", "sphere:2", "--cells", "24", "-o", out,
+                  "--report", rep_path)  # fmt: skip
+    assert ran.code == 0, ran.err
+    assert ran.err.count("\n") == 1 and "4 singular point(s)" in ran.err and "closed" in ran.err
+    rep = json.loads(rep_path.read_text())
+    assert rep["closed"] and rep["singular_in_clip"] == 4 and rep["singular_search_complete"]
+    pts = np.array(rep["singular_points"])
+    assert np.allclose(np.abs(pts), 1.0, atol=1e-9) and np.allclose(pts.prod(axis=1), 1.0, atol=1e-9)
+    mesh = trimesh.load(out, force="mesh")
+    assert mesh.is_watertight and (np.linalg.norm(mesh.vertices, axis=1) <= 2 + 1e-12).all()
+
+
+def test_param_changes_the_shape(tmp_path):
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    for rep, extra in ((a, []), (b, ["--param", "r=0.1"])):
+        assert implgen("mesh", TORUS, "-o", tmp_path / "t.ply", "--cells", "32", "--report", rep, *extra).code == 0
+    va, vb = json.loads(a.read_text())["volume"], json.loads(b.read_text())["volume"]
+    # 2 pi^2 R r^2: the thin torus holds (0.1 / 0.25)^2 of the volume
+    assert abs(vb / va - 0.16) < 0.02
+
+
+def test_scene_object_placed_by_its_transform(tmp_path):
+    out = tmp_path / "chmutov.stl"
+    ran = implgen("mesh", ROOT / "examples/scenes/high_degree.yaml", "--object", "chmutov8", "--cells", "16",
+                  "--no-singular", "-o", out)  # fmt: skip
+    assert ran.code == 0, ran.err
+    mesh = trimesh.load(out, force="mesh")
+    # scaled 0.8 and moved to (0, 1.05, -0.2): the centre follows, the size shrinks
+    assert np.allclose(mesh.bounds.mean(axis=0), [0, 1.05, -0.2], atol=0.05)
+    assert mesh.is_watertight and mesh.volume > 0
+
+
+@pytest.mark.parametrize(
+    "args, names",
+    [
+        (["-o", "{d}/x.dxf"], "-o"),
+        (["-o", "{d}/x.stl", "--cells", "2"], "--cells"),
+        (["-o", "{d}/x.stl", "--clip", "ball:3"], "--clip"),
+        (["-o", "{d}/x.stl", "--clip", "sphere:-1"], "--clip"),
+        (["-o", "{d}/x.stl", "--param", "q=1"], "--param"),
+        (["-o", "{d}/x.stl", "--param", "r=abc"], "--param"),
+        (["-o", "{d}/x.stl", "--report", "{d}/r.txt"], "--report"),
+        (["-o", "{d}/x.stl", "--object", "torus"], "--object"),
+        (["-o", "{d}/no/such/x.stl"], "-o"),
+    ],
+)
+def test_bad_options(tmp_path, args, names):
+    ran = implgen("mesh", TORUS, *[a.format(d=tmp_path) for a in args])
+    assert ran.code == 2 and ran.err.count("\n") == 1 and names in ran.err and "Traceback" not in ran.err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_unbounded_needs_a_clip(tmp_path):
+    ran = implgen("mesh", ROOT / "examples/shapes/cone.yaml", "-o", tmp_path / "c.stl")
+    assert ran.code == 2 and "--clip" in ran.err and ran.err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
