@@ -67,6 +67,8 @@ def test_params_or_an_open_box_keep_the_tree():
     power = chmutov(16, nested=False)
     open_box = parse_spec({"name": "c16", "equation": power.equation}, "<test>")
     assert chebform.chebyshev_form(open_box.f, open_box.bounds) is None
+    one_axis = parse_spec({"name": "c16", "equation": power.equation, "bounds": {"x": [-1, 1]}}, "<test>")
+    assert chebform.chebyshev_form(one_axis.f, one_axis.bounds) is None
     with_param = parse_spec(
         {
             "name": "c16",

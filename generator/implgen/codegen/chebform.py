@@ -60,7 +60,8 @@ def _row(a: int, centre: Fraction, half: Fraction) -> dict[int, Fraction]:
 
 
 def _exact_box(bounds) -> tuple[list[Fraction], list[Fraction]] | None:
-    if bounds is None:
+    """The box's ends as exact rationals; None unless every axis has two finite rational ends."""
+    if bounds is None or any(axis not in bounds for axis in "xyz"):
         return None
     lo, hi = [], []
     for axis in "xyz":
