@@ -97,7 +97,7 @@ def page_colour(driver, element_id: str) -> list[float]:
 
 
 def reference(driver, values: dict) -> np.ndarray:
-    """render() of the view the page shows: the starter's camera, the page's colours, the typed shape."""
+    """render() of the view the page shows: the page's camera, clip and colours, the typed shape."""
     doc = document_factory(None)()
     spec = protocol.parse_shape({"equation": EQUATION, "params": {"c": 11.8}}, doc.spec)
     doc.set_spec(spec)
@@ -105,7 +105,11 @@ def reference(driver, values: dict) -> np.ndarray:
     doc.options.color = tuple(page_colour(driver, "color"))
     doc.options.inside = tuple(page_colour(driver, "inside"))
     doc.options.background = tuple(page_colour(driver, "background"))
-    return to_uint8(render(doc.scene(640, 480, 4), threads=2)).astype(int)
+    doc.options.clip_size = float(driver.find_element("id", "clip-size").get_attribute("value"))
+    orbit = driver.execute_script("return window.implgenState().orbit")
+    doc.orbit = protocol.parse_orbit(orbit)
+    w, h = driver.execute_script("const c = document.getElementById('view'); return [c.width, c.height];")
+    return to_uint8(render(doc.scene(w, h, 4), threads=2)).astype(int)
 
 
 def test_the_page_in_a_real_browser(server, driver) -> None:

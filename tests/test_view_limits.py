@@ -104,6 +104,9 @@ class Page:
     def __init__(self, url: str):
         self.ws = open_ws(url)
         self.hello = json.loads(self.ws.recv(GUARD))
+        if self.hello.get("field") == "pages":  # too many pages: the line, then the close (ConnectionClosed)
+            assert self.hello["message"].startswith("too many pages open"), self.hello
+            self.ws.recv(GUARD)
         assert self.hello["type"] == "hello", self.hello
         self.seq = 0
 
@@ -126,11 +129,15 @@ class Page:
         return self.seq
 
     def next(self, guard: float = GUARD) -> dict | tuple:
-        """The next message: a dict for JSON, (seq, kind) for a picture."""
-        msg = self.ws.recv(guard)
-        if isinstance(msg, bytes):
-            return HEADER.unpack(msg[: HEADER.size])[:2]
-        return json.loads(msg)
+        """The next message: a dict for JSON, (seq, kind) for a picture; a build's status lines are skipped."""
+        deadline = time.monotonic() + guard
+        while True:
+            msg = self.ws.recv(max(0.01, deadline - time.monotonic()))
+            if isinstance(msg, bytes):
+                return HEADER.unpack(msg[: HEADER.size])[:2]
+            data = json.loads(msg)
+            if data["type"] != "status":
+                return data
 
     def reply(self, guard: float = GUARD) -> dict:
         """The next JSON message, skipping pictures."""

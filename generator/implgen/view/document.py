@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from implgen.codegen.spec import Spec, parse_spec
-from implgen.scene.model import Camera, Csg, Leaf, Light, Material, Node, Scene
+from implgen.scene.model import Camera, Clip, Csg, Leaf, Light, Material, Node, Scene
 
 CLIPS = ("none", "sphere", "box")
 LIGHTS = ("studio", "headlight", "top", "scene")
@@ -28,8 +28,8 @@ STARTER = {
 
 
 def _clip_spec(kind: str) -> Spec:
-    """The clip solid, its size `r` a run-time param: a ball of radius r, or the cube [-r, r]^3 (a ball that
-    holds the cube, cut by its bounds box: inside CSG a leaf is its solid cut by its bounds)."""
+    """The cut option's clip solid, its size `r` a run-time param: a ball of radius r, or the cube [-r, r]^3 (a
+    ball that holds the cube, cut by its bounds box: inside CSG a leaf is its solid cut by its bounds)."""
     eq = "x^2 + y^2 + z^2 - r^2" if kind == "sphere" else "x^2 + y^2 + z^2 - 4*r^2"
     box = {a: ["-r", "r"] for a in "xyz"}
     return parse_spec({"name": f"clip_{kind}", "equation": eq, "params": {"r": 1.0}, "bounds": box}, "clip")
@@ -74,6 +74,7 @@ class Orbit:
 class Options:
     clip: str = "sphere"
     clip_size: float = 3.0
+    cut: bool = False  # False: the surface inside the clip, cut open (as SURFER); True: the solid, its cut capped
     color: tuple[float, float, float] = (0.95, 0.75, 0.3)
     inside: tuple[float, float, float] = (0.35, 0.55, 0.95)
     lights: str = "studio"
@@ -146,6 +147,9 @@ class Document:
     def _shape_node(self) -> Node:
         leaf = Leaf(spec=self.spec, params=dict(self.values), matrix=np.eye(3, 4), material=None, where="shape")
         if self.options.clip == "none":
+            return leaf
+        if not self.options.cut:  # the surface inside the ball or the cube, cut open: both sides show
+            leaf.clip = Clip(kind=self.options.clip, size=self.options.clip_size)
             return leaf
         clip = Leaf(
             spec=CLIP_SPECS[self.options.clip],

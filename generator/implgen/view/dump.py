@@ -56,6 +56,10 @@ def _node(n: Node) -> dict:
         if not np.array_equal(n.matrix, np.eye(3, 4)):
             m = n.matrix
             out["transform"] = {"position": _vec(m[:, 3]), "axes": [_vec(m[:, i]) for i in range(3)]}
+        if n.clip is not None:
+            out["clip"] = {n.clip.kind: _num(n.clip.size)}
+            if any(n.clip.center):
+                out["clip"]["center"] = _vec(n.clip.center)
     else:
         out = {n.op: [_node(n.left), _node(n.right)]}
     if n.material is not None:

@@ -118,20 +118,40 @@ def _parse(mapping: dict[str, Any]) -> Spec:
     return hit
 
 
+def _used(spec: Spec) -> set[str]:
+    """The params the equation or the bounds use."""
+    symbols = set(spec.f.free_symbols)
+    for lo, hi in (spec.bounds or {}).values():
+        symbols |= lo.free_symbols | hi.free_symbols
+    return {p for p in spec.params if param_symbol(p) in symbols}
+
+
+def _parse_used(mapping: dict[str, Any]) -> Spec:
+    """_parse, and again without the params neither the equation nor the bounds use (no slider for them)."""
+    spec = _parse(mapping)
+    used = _used(spec)
+    if len(used) < len(spec.params):
+        mapping = {**mapping, "params": {k: v for k, v in mapping["params"].items() if k in used}}
+        if not mapping["params"]:
+            del mapping["params"]
+        spec = _parse(mapping)
+    return spec
+
+
 def parse_shape(data: dict, current: Spec) -> Spec:
-    """A new equation and param defaults, through the spec parser. The current shape's name is kept, and its
-    bounds while the equation stays the same (new defaults only): a box made for one surface would cut
-    another one anywhere."""
+    """A new equation and param defaults, through the spec parser; params the equation does not use are
+    dropped. The current shape's name is kept, and its bounds while the equation stays the same (new defaults
+    only): a box made for one surface would cut another one anywhere."""
     mapping: dict[str, Any] = {"name": current.name, "equation": data.get("equation")}
     if data.get("params"):
         mapping["params"] = _mapping("params", data["params"])
     if data.get("bounds") is not None:  # given: checked like a spec file's
-        return _parse({**mapping, "bounds": data["bounds"]})
-    spec = _parse(mapping)
+        return _parse_used({**mapping, "bounds": data["bounds"]})
+    spec = _parse_used(mapping)
     bounds = _bounds_text(current)
     if bounds is not None and spec.equation == current.equation:
         try:
-            return _parse({**mapping, "bounds": bounds})
+            return _parse_used({**mapping, "bounds": bounds})
         except UserError:
             pass  # a param the bounds need was removed: unbounded
     return spec
@@ -167,6 +187,10 @@ def parse_options(raw: Any) -> Options:
     o = Options()
     o.clip = _choice("clip", raw.get("clip", o.clip), CLIPS)
     o.clip_size = validate.number("options", "clip_size", raw.get("clip_size", o.clip_size), 1e-3, 1e6)
+    cut = raw.get("cut", o.cut)
+    if not isinstance(cut, bool):
+        raise UserError("options", "cut: expected true or false")
+    o.cut = cut
     o.color = validate.vector("options", "color", raw.get("color", list(o.color)), 0.0, 1.0)
     o.inside = validate.vector("options", "inside", raw.get("inside", list(o.inside)), 0.0, 1.0)
     o.lights = _choice("lights", raw.get("lights", o.lights), LIGHTS)
