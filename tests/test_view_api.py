@@ -157,6 +157,7 @@ def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
         ok = reply(ws)
         assert ok == {
             "type": "shape",
+            "name": "torus",  # no name sent: the current shape's
             "equation": "-r^2 + x^2 + y^2 + z^2",
             "params": {"r": 1.5},
             "values": {"r": 1.5},
@@ -207,13 +208,53 @@ def test_save_png_yaml_and_c(client) -> None:
         assert kind == KIND_SAVE and saved.shape == (64, 96, 3)
         ref = to_uint8(render(parse_scene(scene_of(hello, 96, 64, 2), "view.yaml"), threads=2))
         assert np.abs(saved.astype(int) - ref).max() <= 1
-        ws.send_text(json.dumps({"type": "save_yaml"}))
-        text = reply(ws)["text"]
-        spec = parse_spec(yaml.safe_load(text), "saved.yaml")
-        assert spec.equation == hello["equation"] and spec.params == {"a": 1, "b": 0.35} and spec.bounds
         ws.send_text(json.dumps({"type": "show_c"}))
         c = reply(ws)["text"]
         assert "torus_coeffs(" in c and "torus.h" in c
+
+
+@pytest.mark.parametrize("clip, cut", [("sphere", False), ("box", False), ("sphere", True), ("none", False)])
+def test_save_yaml_is_a_scene_that_renders_to_the_page_s_full_frame(client, tmp_path, clip: str, cut: bool) -> None:
+    """Save YAML writes a scene (camera, lights, clip, colours, the shape inline, named `surface` when typed)
+    that `implgen render` renders to the page's full frame, pixel for pixel; `implgen view` opens it on the same
+    view."""
+    with client.websocket_connect("/ws") as ws:
+        hello = reply(ws)
+        ws.send_text(
+            json.dumps(
+                {
+                    "type": "shape",
+                    "equation": "x^4 - 5*x^2 + y^4 - 5*y^2 + z^4 - 5*z^2 + c",
+                    "params": {"c": 11.8},
+                    "name": "surface",
+                    "fit": True,
+                }
+            )
+        )
+        shape = reply(ws)
+        assert shape["name"] == "surface" and shape["fit"] == 4.0
+        options = dict(hello["options"], clip=clip, cut=cut, clip_size=3.5, color=[0.2, 0.7, 0.4])
+        orbit = dict(hello["orbit"], yaw=40.0, pitch=20.0, distance=11.0)
+        ws.send_text(render_msg(hello, seq=1, w=96, h=72, values=shape["values"], options=options, orbit=orbit))
+        while True:
+            seq, kind, full = frame(picture(ws))
+            if kind == KIND_FULL:
+                break
+        ws.send_text(json.dumps({"type": "save_yaml", "width": 96, "height": 72}))
+        text = reply(ws)["text"]
+    saved = yaml.safe_load(text)
+    leaf = saved["objects"][0] if not cut else saved["objects"][0]["intersection"][0]
+    assert leaf["name"] == "surface" and leaf["params"] == {"c": 11.8}
+    assert (leaf.get("clip") == {clip: 3.5}) == (clip != "none" and not cut)
+    path = tmp_path / "saved.yaml"
+    path.write_text(text)
+    assert cli_main(["render", str(path), "-o", str(tmp_path / "out.png"), "-q"]) == 0
+    rendered = np.asarray(Image.open(tmp_path / "out.png").convert("RGB"))
+    assert np.array_equal(rendered, full)  # the same picture, pixel for pixel
+    assert full.std() > 10
+    doc = document_factory(path)()  # `implgen view saved.yaml`: the same view
+    again = to_uint8(render(doc.scene(96, 72, 4), threads=2))
+    assert np.abs(again.astype(int) - full).mean() < 0.5
 
 
 def test_scene_file_mode(tmp_path) -> None:
@@ -223,8 +264,9 @@ def test_scene_file_mode(tmp_path) -> None:
         assert hello["mode"] == "scene" and hello["options"]["lights"] == "scene"
         ws.send_text(render_msg(hello, seq=1, refine=False))
         assert frame(picture(ws))[2].std() > 10
-        ws.send_text(json.dumps({"type": "save_yaml"}))
+        ws.send_text(json.dumps({"type": "save_yaml", "width": 64, "height": 48}))
         saved = yaml.safe_load(reply(ws)["text"])
+        assert saved["image"]["width"] == 64
     sc = parse_scene(saved, tmp_path / "saved.yaml")  # a scene file implgen render takes
     assert len(sc.objects) == 2 and len(sc.lights) == 1
 

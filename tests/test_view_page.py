@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 import pytest
+import yaml
 
 from test_view_browser import canvas_pixels, frame_state, page_colour, wait, wait_full_after
 
@@ -287,3 +288,42 @@ def test_clip_shows_the_surface_cut_open_and_fits_each_new_equation(fresh_server
     wait(driver, lambda d: text(d, "degree") == "degree 4", "the tanglecube was not accepted")
     wait_full_after(driver, seq)
     assert driver.find_element("id", "clip-size").get_attribute("value") == "2.5"
+
+
+def test_save_yaml_is_a_scene_implgen_render_draws_as_the_page_does(fresh_server, driver, tmp_path) -> None:
+    """Save YAML writes the whole view as a scene (it used to be only name, equation and params, which
+    `implgen render` refused), rendered as the page's full frame; a typed shape is called `surface` in the YAML
+    and in the generated C (it used to be `torus`)."""
+    from PIL import Image
+
+    from implgen.cli import main as cli_main
+
+    seq = open_page(driver, fresh_server)
+    apply(driver, TANGLECUBE)
+    wait(driver, lambda d: text(d, "degree") == "degree 4", "the tanglecube was not accepted")
+    seq = wait_full_after(driver, seq)
+    time.sleep(0.5)
+    wait_full_after(driver, frame_state(driver)[0] - 1)
+    driver.execute_script(  # keep what the page hands to the download link
+        "window.saved = []; const make = URL.createObjectURL;"
+        "URL.createObjectURL = (b) => { window.saved.push(b); return make(b); };"
+    )
+    driver.find_element("id", "save-yaml").click()
+    saved = driver.execute_async_script(
+        "const done = arguments[arguments.length - 1];"
+        "const look = () => window.saved.length ? window.saved[0].text().then(done) : setTimeout(look, 50);"
+        "look();"
+    )
+    scene = yaml.safe_load(saved)
+    assert scene["objects"][0]["name"] == "surface" and scene["objects"][0]["clip"] == {"sphere": 4}
+    path = tmp_path / "surface.yaml"
+    path.write_text(saved)
+    assert cli_main(["render", str(path), "-o", str(tmp_path / "surface.png"), "-q"]) == 0
+    rendered = np.asarray(Image.open(tmp_path / "surface.png").convert("RGB")).astype(int)
+    shown = canvas_pixels(driver)
+    assert rendered.shape == shown.shape and np.abs(rendered - shown).mean() < 1.0
+
+    driver.find_element("id", "show-c").click()
+    wait(driver, lambda d: "surface_coeffs(" in text(d, "code"), "the generated C is not named after the shape")
+    assert "torus" not in text(driver, "code")
+    driver.find_element("id", "close-code").click()

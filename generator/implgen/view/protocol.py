@@ -7,7 +7,8 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
     {"type": "render", "seq": 7, "refine": true, "width": 640, "height": 480,
      "values": {"a": 1.2}, "orbit": {...}, "options": {...}}          the view to show (the newest wins)
     {"type": "save_png", "width": 1920, "height": 1080, "spp": 16}    the current view through render()
-    {"type": "save_yaml"} / {"type": "show_c"}                        the spec or scene / the generated C
+    {"type": "save_yaml", "width": 640, "height": 480}               the view as a scene file (its full frame)
+    {"type": "show_c"}                                                the generated C
 
 Bad values raise UserError naming the message field; the session sends the line back to the page. Every
 error reply, whatever failed, is built here (`error`, `error_for`). An equation's parse (seconds of SymPy at
@@ -139,10 +140,11 @@ def _parse_used(mapping: dict[str, Any]) -> Spec:
 
 
 def parse_shape(data: dict, current: Spec) -> Spec:
-    """A new equation and param defaults, through the spec parser; params the equation does not use are
-    dropped. The current shape's name is kept, and its bounds while the equation stays the same (new defaults
+    """A new equation, its name (the page sends `surface` for a typed one; the spec parser checks it) and param
+    defaults, through the spec parser; params the equation does not use are dropped. Without a name the current
+    shape's is kept, and its bounds while the equation stays the same (new defaults
     only): a box made for one surface would cut another one anywhere."""
-    mapping: dict[str, Any] = {"name": current.name, "equation": data.get("equation")}
+    mapping: dict[str, Any] = {"name": data.get("name", current.name), "equation": data.get("equation")}
     if data.get("params"):
         mapping["params"] = _mapping("params", data["params"])
     if data.get("bounds") is not None:  # given: checked like a spec file's
@@ -208,6 +210,13 @@ def parse_render(data: dict, spec: Spec) -> RenderRequest:
         orbit=parse_orbit(data.get("orbit", {})),
         options=parse_options(data.get("options", {})),
     )
+
+
+def parse_size(data: dict, what: str) -> tuple[int, int]:
+    """The page's full frame size (Save YAML writes it as the scene's image)."""
+    w = validate.whole(what, "width", data.get("width", 640), 16, MAX_FRAME[0])
+    h = validate.whole(what, "height", data.get("height", 480), 16, MAX_FRAME[1])
+    return w, h
 
 
 def parse_save(data: dict) -> tuple[int, int, int]:

@@ -141,6 +141,7 @@ class Session:
         o = d.options
         return {
             "type": "hello",
+            "name": d.spec.name,
             "equation": d.spec.equation,
             "params": d.spec.params,
             "values": d.values,
@@ -183,7 +184,8 @@ class Session:
                 self._saving = asyncio.get_running_loop().create_task(self._save_png(width, height, spp))
                 self._saving.add_done_callback(lambda _: release())
             elif kind == "save_yaml":
-                text = await self.work.call(self.work.parse, yaml_text, replace(self.doc))
+                width, height = protocol.parse_size(data, "save_yaml")
+                text = await self.work.call(self.work.parse, yaml_text, replace(self.doc), width, height)
                 await self.send({"type": "yaml", "mode": self._mode(), "text": text})
             elif kind == "show_c":
                 await self.send({"type": "c", "text": await self.work.call(self.work.parse, c_text, self.doc.spec)})
@@ -208,6 +210,7 @@ class Session:
         await self.send(
             {
                 "type": "shape",
+                "name": spec.name,
                 "equation": spec.equation,
                 "params": spec.params,
                 "values": self.doc.values,
@@ -381,11 +384,11 @@ class Session:
         await asyncio.gather(*tasks, return_exceptions=True)  # work.trace waits for the C threads to stop
 
 
-def yaml_text(doc: Document) -> str:
-    """The document as a spec, or for a scene file the whole scene (on the parse pool: SymPy prints it)."""
-    if doc.base is None:
-        return dump.to_yaml(dump.spec_mapping(doc.spec, doc.values))
-    return dump.to_yaml(dump.scene_mapping(doc.scene(spp=FULL_SPP)))
+def yaml_text(doc: Document, width: int, height: int) -> str:
+    """The view as a scene file `implgen render` takes: camera, lights, background, the shape inline with its
+    clip and colours (or a scene file's objects), the page's full frame as its image (on the parse pool: SymPy
+    prints the equations). Rendered, it is the page's full frame, pixel for pixel."""
+    return dump.to_yaml(dump.scene_mapping(doc.scene(width, height, FULL_SPP)))
 
 
 def c_text(spec) -> str:

@@ -117,9 +117,15 @@
   // The clip size is fitted to each new equation's real points until the user sets it.
   let userClip = false;
   const DEFAULT_CLIP = 3;
+  // A typed equation's shape is called "surface" unless the user names it; the same equation keeps its name.
+  let userName = false;
+  let acceptedEquation = null; // the equation text the server last accepted (as the box showed it)
   function applyShape() {
     clearTimeout(typing);
-    send({ type: "shape", equation: $("equation").value, params: parseParamsText($("params-text").value),
+    const text = $("equation").value;
+    const name = userName ? $("shape-name").value.trim()
+      : (text === acceptedEquation ? $("shape-name").value : "surface");
+    send({ type: "shape", equation: text, name, params: parseParamsText($("params-text").value),
       fit: !userClip });
   }
 
@@ -150,6 +156,8 @@
       }
     }
     $("params-text").value = Object.entries(msg.params).map(([k, v]) => `${k} = ${v}`).join(", ");
+    $("shape-name").value = msg.name;
+    acceptedEquation = $("equation").value;
     $("degree").textContent = `degree ${msg.degree}`;
     buildSliders();
   }
@@ -280,7 +288,7 @@
         showMessage(msg.message, true);
       }
     } else if (msg.type === "yaml") {
-      download(new Blob([msg.text], { type: "application/yaml" }), msg.mode === "scene" ? "scene.yaml" : "shape.yaml");
+      download(new Blob([msg.text], { type: "application/yaml" }), `${$("shape-name").value.replace(/[^A-Za-z0-9_]/g, "") || "scene"}.yaml`);
     } else if (msg.type === "c") {
       $("code").textContent = msg.text;
       $("code-dialog").showModal();
@@ -368,7 +376,9 @@
     send({ type: "save_png", width: parseInt($("save-width").value, 10), height: parseInt($("save-height").value, 10),
       spp: parseInt($("save-spp").value, 10) });
   });
-  $("save-yaml").addEventListener("click", () => send({ type: "save_yaml" }));
+  $("save-yaml").addEventListener("click", () => send({ type: "save_yaml", width: canvas.width, height: canvas.height }));
+  $("shape-name").addEventListener("input", () => { userName = true; });
+  $("shape-name").addEventListener("keydown", (e) => { if (e.key === "Enter") applyShape(); });
   $("show-c").addEventListener("click", () => send({ type: "show_c" }));
   $("close-code").addEventListener("click", () => $("code-dialog").close());
 
