@@ -93,7 +93,15 @@ def scene_of(hello: dict, w: int, h: int, spp: int, values=None) -> dict:
 
 
 def test_only_the_pages_files_are_served(client) -> None:
-    for path, kind in (("/", "text/html"), ("/app.js", "text/javascript"), ("/style.css", "text/css")):
+    served = (
+        ("/", "text/html"),
+        ("/app.js", "text/javascript"),
+        ("/share.js", "text/javascript"),
+        ("/style.css", "text/css"),
+        ("/favicon.ico", "image/x-icon"),
+        ("/favicon.svg", "image/svg+xml"),
+    )
+    for path, kind in served:
         r = client.get(path)
         assert r.status_code == 200 and r.headers["content-type"].startswith(kind)
         assert "default-src 'self'" in r.headers["content-security-policy"]

@@ -327,3 +327,68 @@ def test_save_yaml_is_a_scene_implgen_render_draws_as_the_page_does(fresh_server
     wait(driver, lambda d: "surface_coeffs(" in text(d, "code"), "the generated C is not named after the shape")
     assert "torus" not in text(driver, "code")
     driver.find_element("id", "close-code").click()
+
+
+def test_a_share_link_reopens_the_same_view_and_a_bad_one_is_read_safely(fresh_server, driver) -> None:
+    """The address carries the view: equation, name, params and slider values, camera, clip, colours. Opened
+    in another tab it shows the same picture. A link is untrusted text: fields that do not read are left out
+    and said so, nothing else happens."""
+    from selenium.webdriver.support.ui import Select
+
+    seq = open_page(driver, fresh_server)
+    apply(driver, TANGLECUBE.replace("11.8", "c"), "c = 11.8")
+    wait(driver, lambda d: text(d, "degree") == "degree 4", "the tanglecube was not accepted")
+    seq = wait_full_after(driver, seq)
+    Select(driver.find_element("id", "clip")).select_by_value("box")
+    seq = wait_full_after(driver, seq)
+    driver.execute_script(
+        "const s = document.querySelector('input[type=range][data-name=c]'); s.value = 11.2;"
+        "s.dispatchEvent(new Event('input')); s.dispatchEvent(new Event('change'));"
+        "const c = document.getElementById('view');"
+        "for (let i = 0; i < 3; i++) c.dispatchEvent(new WheelEvent('wheel', {deltaY: 100, bubbles: true}));"
+    )
+    seq = wait_full_after(driver, seq)
+    time.sleep(0.6)  # the wheel's rest
+    seq = max(seq, frame_state(driver)[0])
+    wait(driver, lambda d: frame_state(d)[1] == "full", "the view did not rest")
+    link = driver.current_url
+    here = canvas_pixels(driver)
+    state = driver.execute_script("return window.implgenState()")
+    assert "#v=1&" in link and "clip=box" in link and abs(state["values"]["c"] - 11.2) < 0.03
+
+    first = driver.current_window_handle
+    driver.switch_to.new_window("tab")
+    try:
+        open_page(driver, link)
+        wait(driver, lambda d: text(d, "degree") == "degree 4", "the link's equation was not applied")
+        wait(
+            driver,
+            lambda d: (
+                frame_state(d)[1] == "full"
+                and d.execute_script("return window.implgenState().values.c") == state["values"]["c"]
+            ),
+            "the link's view was not drawn",
+        )
+        time.sleep(0.5)
+        wait(driver, lambda d: frame_state(d)[1] == "full", "the link's view did not rest")
+        there = driver.execute_script("return window.implgenState()")
+        flat = lambda o: [o["yaw"], o["pitch"], o["distance"], *o["target"], o["fov"]]  # noqa: E731
+        assert flat(there["orbit"]) == pytest.approx(flat(state["orbit"]), rel=1e-11)
+        assert there["options"] == state["options"]
+        assert driver.find_element("id", "shape-name").get_attribute("value") == "surface"
+        assert np.abs(canvas_pixels(driver) - here).mean() < 1.0
+
+        # links pasted into the address of this page (a new part after "#": no reload)
+        equation = driver.find_element("id", "equation").get_attribute("value")
+        driver.get(fresh_server + "#v=1&eq=" + "x" * 20000)  # too long: nothing of it is used
+        wait(driver, lambda d: text(d, "message").startswith("share link:"), "no word on a bad link")
+        assert "too long" in text(driver, "message")
+        assert driver.find_element("id", "equation").get_attribute("value") == equation
+        seq = frame_state(driver)[0]
+        driver.get(fresh_server + "#v=1&cam=1,2,nope&color=zzzzzz&lights=<b>x</b>&clip=sphere:2")
+        wait(driver, lambda d: "cam, color, lights" in text(d, "message"), "the bad fields were not named")
+        wait_full_after(driver, seq)
+        assert driver.find_element("id", "clip-size").get_attribute("value") == "2"  # what did read is used
+    finally:
+        driver.close()
+        driver.switch_to.window(first)

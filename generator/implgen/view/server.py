@@ -42,6 +42,7 @@ STATIC = {
     "/favicon.svg": ("favicon.svg", "image/svg+xml"),
     "/favicon.ico": ("favicon.ico", "image/x-icon"),
     "/app.js": ("app.js", "text/javascript; charset=utf-8"),
+    "/share.js": ("share.js", "text/javascript; charset=utf-8"),
     "/style.css": ("style.css", "text/css; charset=utf-8"),
 }
 HEADERS = {

@@ -89,12 +89,44 @@
       queued = null;
       seq += 1;
       state.options = readOptions();
+      if (q.refine) keepLink();
       sentAt.set(seq, { t: performance.now(), clip: state.options.clip_size });
       send({
         type: "render", seq, refine: q.refine, width: canvas.width, height: canvas.height,
         values: state.values, orbit: state.orbit, options: state.options,
       });
     });
+  }
+
+  // The address carries the view (share.js): kept up to date whenever the view rests.
+  function keepLink() {
+    if (acceptedEquation === null) return;
+    const text = implgenLink.encode({
+      equation: acceptedEquation, name: $("shape-name").value, params: $("params-text").value,
+      values: state.values, orbit: state.orbit, options: state.options,
+    });
+    history.replaceState(null, "", `${location.pathname}${location.search}#${text}`);
+  }
+
+  // A share link's view, applied once the page has its first state from the server: its equation is sent as a
+  // new shape (its clip is the user's own: not fitted), its slider values wait for the shape's reply.
+  let linkValues = null;
+  function openLink() {
+    const { view, bad } = implgenLink.decode(location.hash);
+    if (bad.length) showMessage(`share link: left out what did not read: ${bad.join(", ")}`, true);
+    if (view.orbit) state.orbit = view.orbit;
+    if (view.options) {
+      setOptions(Object.assign(readOptions(), view.options));
+      if (view.options.clip !== undefined) userClip = true; // the link's clip (and camera) stay as they are
+      if (view.options.clip_size !== undefined) goodClipSize = view.options.clip_size;
+    }
+    if (view.equation === undefined) return false;
+    $("equation").value = view.equation;
+    if (view.params !== undefined) $("params-text").value = view.params;
+    if (view.name !== undefined) { $("shape-name").value = view.name; userName = true; }
+    linkValues = view.values || null;
+    applyShape();
+    return true;
   }
 
   // Coarse frames while something moves; refined once it has rested.
@@ -272,8 +304,18 @@
       if (msg.mode !== "scene") $("lights").querySelector("option[value=scene]").disabled = true;
       else for (const id of ["clip", "clip-size", "cut", "color", "inside"]) $(id).disabled = true; // the file's own
       showShape(msg);
-      requestRender(true);
+      if (!openLink()) requestRender(true); // with a link's equation: drawn once it is built
     } else if (msg.type === "shape") {
+      if (linkValues) { // the link's slider values, for the params the shape has
+        for (const [k, v] of Object.entries(linkValues)) {
+          if (k in msg.values) {
+            msg.values[k] = v;
+            const span = Math.max(1, Math.abs(msg.params[k]));
+            state.ranges[k] = [Math.min(v, msg.params[k] - span), Math.max(v, msg.params[k] + span)];
+          }
+        }
+        linkValues = null;
+      }
       showShape(msg);
       if ("fit" in msg) fitClip(msg.fit);
       requestRender(true);
@@ -375,6 +417,13 @@
     lastError = "";
     send({ type: "save_png", width: parseInt($("save-width").value, 10), height: parseInt($("save-height").value, 10),
       spp: parseInt($("save-spp").value, 10) });
+  });
+  // a link pasted into this page's address (only the part after "#" differs: no reload) opens its view too
+  window.addEventListener("hashchange", () => { if (ws && !openLink()) requestRender(true); });
+  $("copy-link").addEventListener("click", () => {
+    keepLink();
+    navigator.clipboard.writeText(location.href).then(() => showMessage("link copied: it reopens this view", false),
+      () => showMessage(`the link: ${location.href}`, false));
   });
   $("save-yaml").addEventListener("click", () => send({ type: "save_yaml", width: canvas.width, height: canvas.height }));
   $("shape-name").addEventListener("input", () => { userName = true; });
