@@ -171,6 +171,7 @@ def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
             "values": {"r": 1.5},
             "degree": 2,
             "fit": None,  # not asked for
+            "objects": [],  # a scene file's, to pick from
         }
         ws.send_text(
             json.dumps({"type": "shape", "equation": "x^2 + y^2 + z^2 - r^2", "params": {"r": 1.5}, "fit": True})
@@ -493,3 +494,47 @@ def test_a_foreign_origin_or_host_is_turned_away_before_any_work():
             with c.websocket_connect("/ws") as ws:
                 reply(ws)
     assert len(made) == 1  # only the accepted page got a document
+
+
+def test_a_scene_s_object_is_picked_in_the_picture_or_from_the_list(tmp_path) -> None:
+    """Two balls, left and right of the camera's axis, on a floor: a click on a ball's centre (where the camera
+    projects it, worked out here) picks that ball, a click above the floor's horizon picks nothing, the list picks
+    by index; the edits of each object are kept when another one is picked."""
+    scene = {
+        "image": {"width": 64, "height": 48},
+        "camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "fov": 40},
+        "lights": [{"position": [0, 5, 5], "color": [1, 1, 1]}],
+        "objects": [
+            {"equation": "y + 2", "name": "floor"},
+            {"equation": "(x + 2)^2 + y^2 + z^2 - 1", "name": "left"},
+            {"equation": "(x - 2)^2 + y^2 + z^2 - 1", "name": "right"},
+        ],
+    }
+    path = tmp_path / "balls.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    half = np.tan(np.radians(20))  # the pixel of (x, 0, 0) at distance 10, in a 640 x 480 picture
+
+    def pixel(x: float) -> float:
+        return (x / 10 / (half * 640 / 480) + 1) / 2 * 640 - 0.5
+
+    with TestClient(create_app(document_factory(path), threads=2)) as c, c.websocket_connect("/ws") as ws:
+        hello = reply(ws)
+        assert [o["name"] for o in hello["objects"]] == ["floor", "left", "right"] and hello["object"] == 0
+        ws.send_text(json.dumps({"type": "pick", "x": pixel(2.0), "y": 239.5, "width": 640, "height": 480}))
+        got = reply(ws)
+        assert (got["object"], got["name"], got["equation"]) == (2, "right", "y^2 + z^2 + (x - 2)^2 - 1")
+        ws.send_text(json.dumps({"type": "shape", "equation": "(x - 2)^2 + y^2 + z^2 - 0.25"}))
+        assert reply(ws)["name"] == "right"  # a scene's shape keeps its name
+        ws.send_text(json.dumps({"type": "pick", "x": pixel(-2.0), "y": 239.5, "width": 640, "height": 480}))
+        assert reply(ws)["object"] == 1
+        ws.send_text(json.dumps({"type": "pick", "x": 320, "y": 5, "width": 640, "height": 480}))
+        assert "nothing there" in reply(ws)["message"]
+        ws.send_text(json.dumps({"type": "object", "index": 2}))
+        back = reply(ws)
+        assert back["object"] == 2 and back["equation"] == "y^2 + z^2 + (x - 2)^2 - 1/4"  # its edit was kept
+        ws.send_text(json.dumps({"type": "object", "index": 3}))
+        assert "index" in reply(ws)["message"]
+    with TestClient(create_app(document_factory(None), threads=2)) as c, c.websocket_connect("/ws") as ws:
+        reply(ws)
+        ws.send_text(json.dumps({"type": "object", "index": 0}))
+        assert reply(ws)["message"] == "object: only a scene file has objects to pick"

@@ -142,8 +142,7 @@ def test_messages_clear_wrap_and_say_what_happened(fresh_server, driver) -> None
     size.clear()
     size.send_keys("abc\n")  # no number: the page says so itself, and sends the last good size
     wait(driver, lambda d: text(d, "message") == "clip size: expected a positive number", "no word on 'abc'")
-    seq = frame_state(driver)[0]
-    wait_full_after(driver, seq)  # a picture with the last good size: the server had nothing to refuse
+    wait(driver, lambda d: frame_state(d)[1] == "full", "no picture")  # the last good size: nothing to refuse
     assert text(driver, "message") == "clip size: expected a positive number"
     size.clear()
     size.send_keys("2\n")
@@ -392,3 +391,52 @@ def test_a_share_link_reopens_the_same_view_and_a_bad_one_is_read_safely(fresh_s
     finally:
         driver.close()
         driver.switch_to.window(first)
+
+
+@pytest.fixture(scope="module")
+def balls_server(tmp_path_factory):
+    """`implgen view` of a scene file: a floor and two balls, left and right of the camera's axis."""
+    scene = {
+        "image": {"width": 64, "height": 48},
+        "camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "fov": 40},
+        "lights": [{"position": [0, 5, 5], "color": [1, 1, 1]}],
+        "objects": [
+            {"equation": "y + 2", "name": "floor"},
+            {"equation": "(x + 2)^2 + y^2 + z^2 - 1", "name": "left"},
+            {"equation": "(x - 2)^2 + y^2 + z^2 - 1", "name": "right"},
+        ],
+    }
+    path = tmp_path_factory.mktemp("scene") / "balls.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    cmd = [sys.executable, "-m", "implgen.cli", "view", str(path), "--no-browser", "--port", "0"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True)
+    try:
+        line = proc.stdout.readline()
+        yield "http://" + line.split("http://", 1)[1].split()[0]
+    finally:
+        proc.terminate()
+        proc.wait(30)
+
+
+def test_a_scene_s_object_is_picked_by_a_click_or_from_the_list(balls_server, driver) -> None:
+    """With a scene file the equation box used to edit the first shape (the floor), whatever the user looked
+    at: a click on an object picks it, and so does the list."""
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.support.ui import Select
+
+    open_page(driver, balls_server)
+    assert not driver.find_element("id", "object-row").get_attribute("hidden")
+    chosen = Select(driver.find_element("id", "object"))
+    assert [o.text.split(" ")[0] for o in chosen.options] == ["floor", "left", "right"]
+    canvas = driver.find_element("id", "view")
+    box = driver.execute_script(
+        "const r = document.getElementById('view').getBoundingClientRect(); return [r.width, r.height]"
+    )
+    half = math.tan(math.radians(20)) * box[0] / box[1]  # where the camera shows x = 2 at distance 10
+    dx = 2 / 10 / half * box[0] / 2
+    ActionChains(driver).move_to_element_with_offset(canvas, round(dx), 0).click().perform()
+    wait(driver, lambda d: "(x - 2)^2" in d.find_element("id", "equation").get_attribute("value"), "no pick")
+    assert chosen.first_selected_option.text.startswith("right")
+    assert driver.find_element("id", "shape-name").get_attribute("value") == "right"
+    chosen.select_by_index(1)
+    wait(driver, lambda d: "(x + 2)^2" in d.find_element("id", "equation").get_attribute("value"), "no list pick")

@@ -85,6 +85,7 @@ class CScene:
             raise MemoryError("rt_scene_new failed")
         self._materials: dict[int, int] = {}
         self._built = built
+        self.leaf_nodes: dict[int, Leaf] = {}  # C node index -> the leaf it was made from (RtHit.leaf)
         try:
             self._fill(scene)
         except BaseException:
@@ -118,6 +119,7 @@ class CScene:
             if n.clip is not None:
                 c = n.clip
                 self._check(self.lib.rt_scene_set_clip(self.ptr, k, CLIPS[c.kind], darr(c.center), c.size), n.where)
+            self.leaf_nodes[k] = n
             return k
         mat = n.material or inherited
         left = self._node(n.left, mat)

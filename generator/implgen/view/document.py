@@ -92,6 +92,8 @@ class Document:
     options: Options = field(default_factory=Options)
     base: Scene | None = None
     leaf: Leaf | None = None
+    # a scene file's leaves edited so far, other than `leaf`: id(leaf) -> (its spec, its param values)
+    edits: dict[int, tuple[Spec, dict[str, float]]] = field(default_factory=dict)
 
     @staticmethod
     def for_spec(spec: Spec) -> Document:
@@ -114,6 +116,63 @@ class Document:
         doc.orbit = Orbit.looking(scene.camera)
         doc.options = Options(clip="none", lights="scene", background=scene.background)
         return doc
+
+    def state(self) -> dict:
+        """What the page starts from: the shape, its values, the camera, the options (and a scene's objects)."""
+        o, orbit = self.options, self.orbit
+        return {
+            "name": self.spec.name,
+            "equation": self.spec.equation,
+            "params": self.spec.params,
+            "values": self.values,
+            "degree": self.spec.degree,
+            "mode": "spec" if self.base is None else "scene",
+            "objects": self.objects(),
+            "object": self.object_index(),
+            "orbit": {
+                "yaw": orbit.yaw,
+                "pitch": orbit.pitch,
+                "distance": orbit.distance,
+                "target": list(orbit.target),
+                "fov": orbit.fov,
+            },
+            "options": {
+                "clip": o.clip,
+                "clip_size": o.clip_size,
+                "cut": o.cut,
+                "color": list(o.color),
+                "inside": list(o.inside),
+                "lights": o.lights,
+                "background": list(o.background),
+            },
+        }
+
+    def objects(self) -> list[dict]:
+        """A scene file's leaves, as the page lists them to pick one: the shape's name and where it is."""
+        if self.base is None:
+            return []
+        out = []
+        for i, leaf in enumerate(self.base.leaves()):
+            spec = self.spec if leaf is self.leaf else self.edits.get(id(leaf), (leaf.spec,))[0]
+            out.append({"index": i, "name": spec.name, "where": leaf.where})
+        return out
+
+    def object_index(self) -> int | None:
+        if self.base is None:
+            return None
+        return next(i for i, leaf in enumerate(self.base.leaves()) if leaf is self.leaf)
+
+    def select(self, index: int) -> None:
+        """Edit the scene file's leaf `index` (in leaves() order) from now on; the edits of the one edited so
+        far are kept."""
+        leaves = self.base.leaves() if self.base is not None else []
+        if not 0 <= index < len(leaves):
+            raise IndexError(index)
+        self.edits = dict(self.edits)  # a copy: a trial document (dataclasses.replace) shares the dict
+        self.edits[id(self.leaf)] = (self.spec, dict(self.values))
+        self.leaf = leaves[index]
+        self.spec, values = self.edits.pop(id(self.leaf), (self.leaf.spec, self.leaf.params))
+        self.values = dict(values)
 
     def set_spec(self, spec: Spec) -> None:
         """A new shape: a param keeps its slider value while its name and default stay, else takes the default."""
@@ -169,19 +228,21 @@ class Document:
             sc.objects = [node]
         else:
             sc = replace(self.base, width=width, height=height, spp=spp)
-            sc.objects = [_with_leaf(obj, self.leaf, self.spec, self.values) for obj in self.base.objects]
+            edits = {**self.edits, id(self.leaf): (self.spec, self.values)}
+            sc.objects = [_with_leaf(obj, edits) for obj in self.base.objects]
         sc.camera = self.orbit.camera()
         sc.lights = self.lights()
         sc.background = self.options.background
         return sc
 
 
-def _with_leaf(node: Node, target: Leaf | None, spec: Spec, values: dict[str, float]) -> Node:
-    """A copy of the tree with the edited leaf given the current spec and params."""
+def _with_leaf(node: Node, edits: dict[int, tuple[Spec, dict[str, float]]]) -> Node:
+    """A copy of the tree with each edited leaf given its spec and params."""
     if isinstance(node, Leaf):
-        if node is target:
+        if id(node) in edits:
+            spec, values = edits[id(node)]
             return replace(node, spec=spec, params=dict(values))
         return node
-    left = _with_leaf(node.left, target, spec, values)
-    right = _with_leaf(node.right, target, spec, values)
+    left = _with_leaf(node.left, edits)
+    right = _with_leaf(node.right, edits)
     return Csg(op=node.op, left=left, right=right, material=node.material, where=node.where)

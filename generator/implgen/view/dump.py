@@ -86,3 +86,19 @@ def scene_mapping(sc: Scene) -> dict:
 
 def to_yaml(mapping: dict) -> str:
     return yaml.safe_dump(mapping, sort_keys=False, default_flow_style=None, width=110)
+
+
+def yaml_text(doc, width: int, height: int, spp: int) -> str:
+    """The viewer's document (view/document.py) as a scene file `implgen render` takes: camera, lights,
+    background, the shape inline with its clip and colours (or a scene file's objects), the page's full frame as
+    its image (on the parse pool: SymPy prints the equations). Rendered, it is the page's full frame, pixel for
+    pixel."""
+    return to_yaml(scene_mapping(doc.scene(width, height, spp)))
+
+
+def c_text(spec: Spec) -> str:
+    """What `implgen SPEC.yaml --lang c` writes for the shape (on the parse pool)."""
+    from implgen.codegen.emit import generate
+
+    files = generate(spec, langs=("c",))
+    return "".join(f"/* ---- {name} ---- */\n{text}\n" for name, text in sorted(files.items()))

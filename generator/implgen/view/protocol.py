@@ -9,6 +9,8 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
     {"type": "save_png", "width": 1920, "height": 1080, "spp": 16}    the current view through render()
     {"type": "save_yaml", "width": 640, "height": 480}               the view as a scene file (its full frame)
     {"type": "show_c"}                                                the generated C
+    {"type": "pick", "x": 120, "y": 80, "width": 640, "height": 480}  a scene file: edit the object at a pixel
+    {"type": "object", "index": 2}                                    a scene file: edit this leaf
 
 Bad values raise UserError naming the message field; the session sends the line back to the page. Every
 error reply, whatever failed, is built here (`error`, `error_for`). An equation's parse (seconds of SymPy at
@@ -37,7 +39,7 @@ MAX_FRAME = (2048, 2048)  # the largest interactive frame
 MAX_SAVE = (8192, 8192)  # the largest saved picture
 MAX_SAVE_PIXELS = 8192 * 4608  # 8K at 16:9
 MAX_SAVE_SPP = 64
-TYPES = ("shape", "render", "save_png", "save_yaml", "show_c")
+TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object")
 PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
 
 _parsed: OrderedDict[str, Spec | UserError] = OrderedDict()
@@ -217,6 +219,14 @@ def parse_size(data: dict, what: str) -> tuple[int, int]:
     w = validate.whole(what, "width", data.get("width", 640), 16, MAX_FRAME[0])
     h = validate.whole(what, "height", data.get("height", 480), 16, MAX_FRAME[1])
     return w, h
+
+
+def parse_pick(data: dict) -> tuple[float, float, int, int]:
+    """A pixel of the page's full frame: (x, y, width, height)."""
+    w, h = parse_size(data, "pick")
+    x = validate.number("pick", "x", data.get("x"), 0.0, w - 1)
+    y = validate.number("pick", "y", data.get("y"), 0.0, h - 1)
+    return x, y, w, h
 
 
 def parse_save(data: dict) -> tuple[int, int, int]:

@@ -29,6 +29,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from implgen import validate
 from implgen.errors import UserError
 from implgen.imagefile import encode_jpeg, encode_png, to_uint8
 from implgen.scene.build import BuildResult, build_scene, runtime_ready
@@ -36,7 +37,7 @@ from implgen.scene.model import Scene
 from implgen.scene.render import usable_cores
 from implgen.scene.renderjob import RenderJob
 from implgen.scene.tracer import CScene
-from implgen.view import dump, fit, protocol
+from implgen.view import dump, fit, pick, protocol
 from implgen.view.document import Document
 from implgen.view.pace import CUT, Pace
 from implgen.view.work import Ticket, Work
@@ -137,33 +138,20 @@ class Session:
 
     def hello(self) -> dict:
         """The state the page starts from."""
-        d = self.doc
-        o = d.options
+        limits = {"frame": protocol.MAX_FRAME, "save": protocol.MAX_SAVE, "save_spp": protocol.MAX_SAVE_SPP}
+        return {"type": "hello", **self.doc.state(), "limits": limits}
+
+    def _shape_reply(self, **extra) -> dict:
+        """The page's new shape: its name, equation, params and their values (and what `extra` adds)."""
+        spec = self.doc.spec
         return {
-            "type": "hello",
-            "name": d.spec.name,
-            "equation": d.spec.equation,
-            "params": d.spec.params,
-            "values": d.values,
-            "degree": d.spec.degree,
-            "mode": "spec" if d.base is None else "scene",
-            "orbit": {
-                "yaw": d.orbit.yaw,
-                "pitch": d.orbit.pitch,
-                "distance": d.orbit.distance,
-                "target": list(d.orbit.target),
-                "fov": d.orbit.fov,
-            },
-            "options": {
-                "clip": o.clip,
-                "clip_size": o.clip_size,
-                "cut": o.cut,
-                "color": list(o.color),
-                "inside": list(o.inside),
-                "lights": o.lights,
-                "background": list(o.background),
-            },
-            "limits": {"frame": protocol.MAX_FRAME, "save": protocol.MAX_SAVE, "save_spp": protocol.MAX_SAVE_SPP},
+            "type": "shape",
+            "name": spec.name,
+            "equation": spec.equation,
+            "params": spec.params,
+            "values": self.doc.values,
+            "degree": spec.degree,
+            **extra,
         }
 
     async def handle(self, text: str | bytes) -> None:
@@ -185,12 +173,34 @@ class Session:
                 self._saving.add_done_callback(lambda _: release())
             elif kind == "save_yaml":
                 width, height = protocol.parse_size(data, "save_yaml")
-                text = await self.work.call(self.work.parse, yaml_text, replace(self.doc), width, height)
+                text = await self.work.call(self.work.parse, dump.yaml_text, replace(self.doc), width, height, FULL_SPP)
                 await self.send({"type": "yaml", "mode": self._mode(), "text": text})
+            elif kind in ("pick", "object"):
+                await self._pick(data)
             elif kind == "show_c":
-                await self.send({"type": "c", "text": await self.work.call(self.work.parse, c_text, self.doc.spec)})
+                await self.send(
+                    {"type": "c", "text": await self.work.call(self.work.parse, dump.c_text, self.doc.spec)}
+                )
         except UserError as err:
             await self.send(protocol.error_for(err))
+
+    async def _pick(self, data: dict) -> None:
+        """A scene file: the leaf to edit from now on, the one at a pixel of the picture or by its index."""
+        count = len(self.doc.objects())
+        if count == 0:
+            raise UserError(data["type"], "only a scene file has objects to pick")
+        if data["type"] == "pick":
+            x, y, width, height = protocol.parse_pick(data)
+            sc = self.doc.scene(width, height, 1)
+            index = await self.work.call(self.work.render, pick.pick_leaf, sc, await self._library(sc), x, y)
+            if index is None:
+                raise UserError("pick", "nothing there: the ray through that pixel meets no object")
+        else:
+            index = validate.whole("object", "index", data.get("index"), 0, count - 1)
+        self.doc.select(index)
+        self._cost = None
+        self.pace.new_shape()
+        await self.send(self._shape_reply(fit=None, object=index, objects=self.doc.objects()))
 
     def _mode(self) -> str:
         return "spec" if self.doc.base is None else "scene"
@@ -207,17 +217,7 @@ class Session:
         self.doc.spec, self.doc.values = trial.spec, trial.values
         self._cost = None  # measured anew by the new shape's first render
         self.pace.new_shape()
-        await self.send(
-            {
-                "type": "shape",
-                "name": spec.name,
-                "equation": spec.equation,
-                "params": spec.params,
-                "values": self.doc.values,
-                "degree": spec.degree,
-                "fit": fitted,
-            }
-        )
+        await self.send(self._shape_reply(fit=fitted, objects=self.doc.objects()))
 
     # ------------------------------------------------------------------ rendering
 
@@ -382,18 +382,3 @@ class Session:
         for t in tasks:
             t.cancel()
         await asyncio.gather(*tasks, return_exceptions=True)  # work.trace waits for the C threads to stop
-
-
-def yaml_text(doc: Document, width: int, height: int) -> str:
-    """The view as a scene file `implgen render` takes: camera, lights, background, the shape inline with its
-    clip and colours (or a scene file's objects), the page's full frame as its image (on the parse pool: SymPy
-    prints the equations). Rendered, it is the page's full frame, pixel for pixel."""
-    return dump.to_yaml(dump.scene_mapping(doc.scene(width, height, FULL_SPP)))
-
-
-def c_text(spec) -> str:
-    """What `implgen SPEC.yaml --lang c` writes for the shape (on the parse pool)."""
-    from implgen.codegen.emit import generate
-
-    files = generate(spec, langs=("c",))
-    return "".join(f"/* ---- {name} ---- */\n{text}\n" for name, text in sorted(files.items()))

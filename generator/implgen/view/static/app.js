@@ -151,12 +151,19 @@
   const DEFAULT_CLIP = 3;
   // A typed equation's shape is called "surface" unless the user names it; the same equation keeps its name.
   let userName = false;
+  let sceneMode = false; // a scene file: the equation box edits one of its shapes, picked in the picture or a list
+  function showObjects(list, index) {
+    const select = $("object");
+    select.replaceChildren(...list.map((o) => Object.assign(document.createElement("option"),
+      { value: o.index, textContent: `${o.name} (${o.where})` })));
+    select.value = index;
+  }
   let acceptedEquation = null; // the equation text the server last accepted (as the box showed it)
   function applyShape() {
     clearTimeout(typing);
     const text = $("equation").value;
     const name = userName ? $("shape-name").value.trim()
-      : (text === acceptedEquation ? $("shape-name").value : "surface");
+      : (text === acceptedEquation || sceneMode ? $("shape-name").value : "surface");
     send({ type: "shape", equation: text, name, params: parseParamsText($("params-text").value),
       fit: !userClip });
   }
@@ -301,6 +308,9 @@
       maxFrame = msg.limits.frame;
       fitCanvas();
       setOptions(msg.options);
+      sceneMode = msg.mode === "scene";
+      $("object-row").hidden = !sceneMode;
+      if (sceneMode) showObjects(msg.objects, msg.object);
       if (msg.mode !== "scene") $("lights").querySelector("option[value=scene]").disabled = true;
       else for (const id of ["clip", "clip-size", "cut", "color", "inside"]) $(id).disabled = true; // the file's own
       showShape(msg);
@@ -316,6 +326,12 @@
         }
         linkValues = null;
       }
+      if (msg.object !== undefined) { // another object of the scene picked: its equation in the box
+        $("equation").value = msg.equation;
+        userName = false;
+        $("equation").classList.remove("bad");
+      }
+      if (sceneMode && msg.objects) showObjects(msg.objects, msg.object ?? Number($("object").value));
       showShape(msg);
       if ("fit" in msg) fitClip(msg.fit);
       requestRender(true);
@@ -359,7 +375,7 @@
   // ---------------------------------------------------------------- the picture: orbit, pan, zoom
   let drag = null;
   canvas.addEventListener("pointerdown", (e) => {
-    drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey };
+    drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey, x0: e.clientX, y0: e.clientY, moved: false };
     canvas.setPointerCapture(e.pointerId);
     canvas.classList.add("dragging");
   });
@@ -367,6 +383,8 @@
     if (!drag) return;
     const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
     drag.x = e.clientX; drag.y = e.clientY;
+    if (!drag.moved && Math.hypot(e.clientX - drag.x0, e.clientY - drag.y0) < 4) return; // a click, so far
+    drag.moved = true;
     const o = state.orbit;
     if (drag.pan || e.shiftKey) {
       const y = o.yaw * Math.PI / 180, p = o.pitch * Math.PI / 180;
@@ -382,11 +400,18 @@
     }
     requestRender(false);
   });
-  const endDrag = () => {
+  const endDrag = (e) => {
     if (!drag) return;
+    const click = !drag.moved;
     drag = null;
     canvas.classList.remove("dragging");
-    requestRender(true);
+    if (!click) { requestRender(true); return; }
+    if (sceneMode && e.type === "pointerup") { // a click on a scene: edit the object there
+      const r = canvas.getBoundingClientRect();
+      const x = (e.clientX - r.left) * canvas.width / r.width, y = (e.clientY - r.top) * canvas.height / r.height;
+      send({ type: "pick", x: Math.max(0, Math.min(canvas.width - 1, x)),
+        y: Math.max(0, Math.min(canvas.height - 1, y)), width: canvas.width, height: canvas.height });
+    }
   };
   canvas.addEventListener("pointerup", endDrag);
   canvas.addEventListener("pointercancel", endDrag);
@@ -420,6 +445,7 @@
   });
   // a link pasted into this page's address (only the part after "#" differs: no reload) opens its view too
   window.addEventListener("hashchange", () => { if (ws && !openLink()) requestRender(true); });
+  $("object").addEventListener("change", () => send({ type: "object", index: Number($("object").value) }));
   $("copy-link").addEventListener("click", () => {
     keepLink();
     navigator.clipboard.writeText(location.href).then(() => showMessage("link copied: it reopens this view", false),
