@@ -101,7 +101,8 @@ class Page:
                 data = json.loads(msg)
                 if data["type"] == "error":
                     raise RuntimeError(data["message"])
-                return data
+                if data["type"] != "status":  # a build's progress line comes before the reply
+                    return data
 
     def edit(self, shape: dict) -> tuple[float, float]:
         """Send a new equation as the page does (the edit, then a refined render once it is accepted).

@@ -538,3 +538,30 @@ def test_a_scene_s_object_is_picked_in_the_picture_or_from_the_list(tmp_path) ->
         reply(ws)
         ws.send_text(json.dumps({"type": "object", "index": 0}))
         assert reply(ws)["message"] == "object: only a scene file has objects to pick"
+
+
+def test_pace_sizes_live_frames_for_about_30_ms() -> None:
+    """The live frame's size from the last frame's measure: TARGET seconds at the measured cost a pixel, at most
+    GROW times the last frame's pixels, between MIN_WIDTH pixels a row and half the full frame, the aspect kept;
+    a cut frame with no row done shrinks by FIRST_SHRINK^2, a new shape by FIRST_SHRINK."""
+    from implgen.view import pace
+
+    p = pace.Pace()
+    assert p.size(640, 480) == (160, 120)  # the first frame of a page
+    p.measured(160 * 120, 0.060)  # twice the target: half the pixels next
+    w, h = p.size(640, 480)
+    assert abs(w * h - 160 * 120 / 2) < 200 and abs(w / h - 4 / 3) < 0.02
+    p.measured(w * h, 0.001)  # very cheap: it may only double
+    assert abs(p.size(640, 480)[0] * p.size(640, 480)[1] - 2 * w * h) < 300
+    for _ in range(12):  # cheap frames: twice the pixels each time, up to half the full frame a side
+        w, h = p.size(640, 480)
+        p.measured(w * h, 1e-6)
+    assert p.size(640, 480) == (320, 240)
+    p.cut(320 * 240)
+    assert abs(p.pixels - 320 * 240 / 16) < 1
+    p.measured(100, 10.0)  # hopelessly slow: the smallest frame, which is never cut
+    w, h = p.size(640, 480)
+    assert (w, h) == (pace.MIN_WIDTH, 36) and p.smallest(640, 480, w)
+    p.pixels = 1000.0
+    p.new_shape()
+    assert p.pixels == 250.0

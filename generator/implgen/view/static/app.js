@@ -81,6 +81,8 @@
   }
 
   // A render request goes out at most once per animation frame; the newest view is what is sent.
+  // (The GPU preview, project issue 24 item 2, would draw the live picture itself here while the view moves,
+  // and leave the server's refined frame to replace it when the view rests.)
   function requestRender(refine) {
     if (queued) { queued.refine = queued.refine || refine; return; }
     queued = { refine };
