@@ -434,9 +434,10 @@ def main() -> int:
         f"(target ≤ 0.15), orbit {worst['fps']:.1f} frames/s (target ≥ 20), refinement {worst['refine']:.3f} s "
         "(target ≤ 0.4).",
         "",
-        "Coarse frames are 160×120 at 1 sample per pixel (JPEG), refined frames 640×480 at 4 (PNG); the studio "
-        "light preset (two lights, so two shadow rays per hit), clipped to a ball (a CSG intersection). The "
-        f"server starts at most {MAX_RENDERS_PER_SECOND} renders a second per page, which caps the orbit rate.",
+        "Coarse frames are at 1 sample per pixel (JPEG), sized by the server for about 30 ms each (view/pace.py: "
+        "at most 320×240 here), refined frames 640×480 at 4 (PNG); the studio light preset (two lights, so two "
+        "shadow rays per hit), the surface clipped to a ball (cut open). The server starts at most "
+        f"{MAX_RENDERS_PER_SECOND} renders a second per page, which caps the orbit rate.",
         "",
     ]
     lines += drag_lines(drag_new, drag_old, args.drag_rounds)

@@ -215,6 +215,7 @@ class Session:
             probe = fit.probe_scene(spec, trial.values)
             fitted = await self.work.call(self.work.render, fit.fit_clip, probe, await self._library(probe))
         self.doc.spec, self.doc.values = trial.spec, trial.values
+        self._shown = None  # an accepted shape is drawn coarse first, even the same one again
         self._cost = None  # measured anew by the new shape's first render
         self.pace.new_shape()
         await self.send(self._shape_reply(fit=fitted, objects=self.doc.objects()))

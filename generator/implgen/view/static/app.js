@@ -227,7 +227,8 @@
       max.setAttribute("aria-label", `${name} max`);
       const show = () => { value.textContent = Number(state.values[name]).toPrecision(4); };
       show();
-      slider.addEventListener("input", () => { state.values[name] = parseFloat(slider.value); show(); requestRender(false); });
+      // coarse while it moves, refined when it rests: even when it is let go where it started (no "change")
+      slider.addEventListener("input", () => { state.values[name] = parseFloat(slider.value); show(); moved(); });
       slider.addEventListener("change", () => requestRender(true));
       const setRange = () => {
         const a = parseFloat(min.value), b = parseFloat(max.value);
@@ -432,7 +433,7 @@
   $("apply").addEventListener("click", applyShape);
   $("clip-size").addEventListener("input", () => { userClip = true; });
   for (const id of ["clip", "clip-size", "cut", "color", "inside", "background", "lights"]) {
-    $(id).addEventListener("input", () => requestRender(false));
+    $(id).addEventListener("input", moved);
     $(id).addEventListener("change", () => requestRender(true));
   }
   $("reset-view").addEventListener("click", () => {
