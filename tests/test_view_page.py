@@ -232,6 +232,7 @@ def test_the_picture_fills_the_window_and_800x600_needs_no_sideways_scroll(fresh
         )
         no_scroll, cw, ch, sw, sh, dpr, button = got
         assert no_scroll and button and dpr == 2
+        assert not d.find_element("id", "object-row").is_displayed()  # a spec has no objects to pick
         assert (cw, ch) == (min(2048, 2 * sw), min(2048, 2 * sh)) and sw > 300 and sh > 200
         seq = frame_state(d)[0]
         d.set_window_size(1400, 800)
