@@ -115,7 +115,8 @@
   let linkValues = null;
   function openLink() {
     const { view, bad } = implgenLink.decode(location.hash);
-    if (bad.length) showMessage(`share link: left out what did not read: ${bad.join(", ")}`, true);
+    // a note, not an error: the picture that follows does not clear it
+    if (bad.length) showMessage(`share link: left out what did not read: ${bad.join(", ")}`, false);
     if (view.orbit) state.orbit = view.orbit;
     if (view.options) {
       setOptions(Object.assign(readOptions(), view.options));
