@@ -76,3 +76,36 @@ def test_bad_clips_are_one_line(obj, needle) -> None:
     with pytest.raises(UserError) as err:
         parse_scene(scene(obj), "clip.yaml")
     assert needle in str(err.value) and "\n" not in str(err.value)
+
+
+def test_the_c_side_refuses_a_clip_it_cannot_honour() -> None:
+    """rt_scene_set_clip: only a leaf, never a CSG operand (before or after), a finite positive size."""
+    import numpy as np
+
+    from implgen.compile import clib
+    from implgen.scene.model import Material
+    from implgen.scene.tracer import CLIPS, OPS, bind, darr
+
+    sc = parse_scene(scene({"equation": CONE, "name": "cone"}), "clip.yaml")
+    built = build.build_scene(sc)
+    lib = bind(clib.load(built.library))
+    s = lib.rt_scene_new()
+    try:
+        mat = lib.rt_scene_add_material(s, darr(Material().packed()))
+        eye = darr(np.eye(3, 4).reshape(-1))
+        shape = lib.rt_scene_shape(0)
+        a, b = (lib.rt_scene_add_leaf(s, shape, darr([]), 0, eye, mat) for _ in range(2))
+        origin = darr([0, 0, 0])
+        sphere = CLIPS["sphere"]
+        assert lib.rt_scene_set_clip(s, a, sphere, origin, 0.0) == -1  # not positive
+        assert lib.rt_scene_set_clip(s, a, sphere, origin, float("inf")) == -1
+        assert lib.rt_scene_set_clip(s, a, 7, origin, 1.0) == -1  # no such kind
+        assert lib.rt_scene_set_clip(s, a, sphere, origin, 1.0) == 0
+        assert lib.rt_scene_add_csg(s, OPS["union"], a, b, -1) == -1  # a clipped operand
+        assert b"clipped leaf" in lib.rt_scene_error(s)
+        u = lib.rt_scene_add_csg(s, OPS["union"], b, lib.rt_scene_add_leaf(s, shape, darr([]), 0, eye, mat), -1)
+        assert u >= 0
+        assert lib.rt_scene_set_clip(s, b, sphere, origin, 1.0) == -1  # already an operand
+        assert lib.rt_scene_set_clip(s, u, sphere, origin, 1.0) == -1  # not a leaf
+    finally:
+        lib.rt_scene_free(s)
