@@ -2,6 +2,7 @@
 
     .venv/bin/python bench/view_latency.py [--rounds N] [--orbit-frames N] [--neighbour-seconds S] [-o FILE]
     .venv/bin/python bench/view_latency.py --neighbours-only     # the last measure alone, printed, not written
+    nice .venv/bin/python bench/view_latency.py --drag-only [--compare /work/main]   # the drags alone (issue 24)
 
 Starts `implgen view --no-browser --port 0` in its own process with an empty build cache, connects as the page
 does, and for every example shape of degree <= 8, interleaved round by round, measures:
@@ -10,6 +11,12 @@ does, and for every example shape of degree <= 8, interleaved round by round, me
   - cached equation: the same edit sent again (generated code, objects and library all in the cache);
   - orbit: coarse frames per second while turning, each request sent when the previous frame has arrived;
   - refinement: from the coarse frame to the full 640 x 480, 4 samples per pixel frame of a resting view.
+Then drags (project issue 24: item 1): the page's mouse moves at 60 a second, whatever comes back, for
+DRAG_SECONDS, on the glassware scene, a zoomed-in Chmutov 12, x^20 + y^20 + z^20 - 1 and Barth's sextic: the
+coarse frames a second that arrive, the longest gap between two, and from the release (a refined request for
+the last view) to the refined frame. With --compare TREE, the same drags against a server run from another
+source tree (PYTHONPATH=TREE/generator: the code before the change), interleaved case by case and round by
+round, so both see the same load.
 Then, with heavy neighbours (project issue 22): one page orbits while three other pages keep sending
 `(x+y+z+a+b+1)^15` with a new constant each time (seconds of SymPy, then a build), and the orbiting page's
 frames per second and its longest wait for a frame are measured.
@@ -36,7 +43,7 @@ from implgen.bench.machine import describe as machine
 from implgen.bench.machine import write_results
 from implgen.codegen.spec import load_spec
 from implgen.view.dump import spec_mapping
-from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, MAX_RENDERS_PER_SECOND
+from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_ONE, MAX_RENDERS_PER_SECOND
 
 ROOT = Path(__file__).resolve().parents[1]
 SHAPES = ROOT / "examples" / "shapes"
@@ -79,7 +86,7 @@ class Page:
         while True:
             msg = self.ws.recv()
             if isinstance(msg, bytes):
-                s, k, _, _ = HEADER.unpack(msg[: HEADER.size])
+                s, k, _, _, _ = HEADER.unpack(msg[: HEADER.size])
                 if s == seq and k == kind:
                     return time.perf_counter()
             else:
@@ -94,7 +101,8 @@ class Page:
                 data = json.loads(msg)
                 if data["type"] == "error":
                     raise RuntimeError(data["message"])
-                return data
+                if data["type"] != "status":  # a build's progress line comes before the reply
+                    return data
 
     def edit(self, shape: dict) -> tuple[float, float]:
         """Send a new equation as the page does (the edit, then a refined render once it is accepted).
@@ -107,6 +115,154 @@ class Page:
         t1 = self.frame(seq, KIND_COARSE)
         t2 = self.frame(seq, KIND_FULL)
         return t1 - t0, t2 - t1
+
+
+DRAG_SECONDS = 3.0
+MOVE_GAP = 1 / 60  # seconds between the page's mouse moves while dragging
+CHMUTOV12 = (
+    "3 + 2048*(x^12 + y^12 + z^12) - 6144*(x^10 + y^10 + z^10) + 6912*(x^8 + y^8 + z^8) - 3584*(x^6 + y^6 + z^6)"
+    " + 840*(x^4 + y^4 + z^4) - 72*(x^2 + y^2 + z^2)"
+)  # T12(x) + T12(y) + T12(z), T12 the Chebyshev polynomial
+BOX = {a: ["-1.05", "1.05"] for a in "xyz"}
+# name, scene file (None: the starter page), the shape message (None: the file's), orbit changes, clip
+DRAGS = (
+    ("glassware scene", ROOT / "examples" / "scenes" / "glassware.yaml", None, {}, None),
+    ("chmutov12, zoomed in", None, {"equation": CHMUTOV12, "bounds": BOX}, {"distance": 1.4}, "none"),
+    ("x^20+y^20+z^20-1", None, {"equation": "x^20 + y^20 + z^20 - 1"}, {"distance": 5.0}, "sphere"),
+    (
+        "barth6",
+        None,
+        {
+            "equation": "4*(phi^2*x^2 - y^2)*(phi^2*y^2 - z^2)*(phi^2*z^2 - x^2) - (1 + 2*phi)*(x^2 + y^2 + z^2 - "
+            "w^2)^2*w^2",
+            "params": {"phi": 1.618033988749895, "w": 1.0},
+        },
+        {"distance": 9.6},
+        "sphere",
+    ),
+)
+
+
+def start_server(env: dict, file: Path | None) -> tuple[subprocess.Popen, str]:
+    cmd = [sys.executable, "-m", "implgen.cli", "view", "--no-browser", "--port", "0"]
+    server = subprocess.Popen(cmd + ([str(file)] if file else []), stdout=subprocess.PIPE, text=True, env=env)
+    line = server.stdout.readline()
+    return server, "ws://" + line.split("http://", 1)[1].split("/", 1)[0] + "/ws"
+
+
+def drag_page(url: str, shape: dict | None, orbit: dict, clip: str | None) -> Page:
+    page = Page(url)
+    if shape is not None:
+        page.send({"type": "shape", **shape})
+        page.values = dict(page.reply()["values"])
+    page.orbit.update(orbit)
+    page.orbit["target"] = [0.0, 0.0, 0.0] if shape is not None else page.orbit["target"]
+    if clip is not None:
+        page.options["clip"], page.options["clip_size"] = clip, 3.0
+    page.frame(page.render(True), KIND_FULL)  # built and drawn once before the drag
+    return page
+
+
+def drag(page: Page, seconds: float = DRAG_SECONDS) -> dict[str, float]:
+    """Mouse moves every MOVE_GAP for `seconds` (sent whatever comes back), then the release: coarse frames a
+    second, the longest gap without a frame, the median coarse frame's width, release to refined frame."""
+    stop = threading.Event()
+    last = [0]
+
+    def mover() -> None:
+        while not stop.is_set():
+            page.orbit["yaw"] = (page.orbit["yaw"] + 1.0) % 360.0
+            last[0] = page.render(False)
+            time.sleep(MOVE_GAP)
+
+    start = time.perf_counter()
+    arrivals, widths = [start], []
+    sender = threading.Thread(target=mover, daemon=True)
+    sender.start()
+    while time.perf_counter() - start < seconds:
+        try:
+            msg = page.ws.recv(timeout=max(0.01, seconds - (time.perf_counter() - start)))
+        except TimeoutError:
+            break
+        if isinstance(msg, bytes):
+            _, k, _, w, _ = HEADER.unpack(msg[: HEADER.size])
+            if k == KIND_COARSE:
+                arrivals.append(time.perf_counter())
+                widths.append(w)
+    stop.set()
+    sender.join()
+    end = time.perf_counter()
+    arrivals.append(end)
+    t0 = time.perf_counter()
+    seq = page.render(True)  # the release: the same view as the last move
+    sharp = full = None
+    while full is None:  # the full-size frame at 1 sample (when the server sends one), then at 4
+        msg = page.ws.recv()
+        if isinstance(msg, bytes):
+            s, k, _, _, _ = HEADER.unpack(msg[: HEADER.size])
+            if s == seq and k == KIND_ONE:
+                sharp = time.perf_counter() - t0
+            elif s == seq and k == KIND_FULL:
+                full = time.perf_counter() - t0
+    gaps = [b - a for a, b in zip(arrivals, arrivals[1:])]
+    return {
+        "fps": (len(arrivals) - 2) / (end - start),
+        "gap": max(gaps),
+        "width": statistics.median(widths) if widths else 0.0,
+        "sharp": sharp if sharp is not None else full,
+        "release": full,
+    }
+
+
+def drags(rounds: int, compare: Path | None) -> tuple[dict, dict | None]:
+    """Every drag case, interleaved round by round (and with the compared tree's server, case by case)."""
+    trees = {"new": None} | ({"old": compare} if compare else {})
+    out: dict[str, dict[str, dict[str, list[float]]]] = {t: {c[0]: {} for c in DRAGS} for t in trees}
+    with tempfile.TemporaryDirectory(prefix="implgen-bench-drag-") as cache:
+        servers, pages = [], {}
+        try:
+            for tree, path in trees.items():
+                env = dict(os.environ, IMPLGEN_CACHE=str(Path(cache) / tree))
+                if path is not None:
+                    env["PYTHONPATH"] = str(path / "generator")
+                for name, file, shape, orbit, clip in DRAGS:
+                    server, url = start_server(env, file)
+                    servers.append(server)
+                    pages[tree, name] = drag_page(url, shape, orbit, clip)
+            for r in range(rounds):
+                for name, *_ in DRAGS:
+                    for tree in trees:
+                        for k, v in drag(pages[tree, name]).items():
+                            out[tree][name].setdefault(k, []).append(v)
+                        print(f"drag round {r + 1}/{rounds} {name} {tree}", file=sys.stderr, flush=True)
+        finally:
+            for server in servers:
+                server.terminate()
+                server.wait(30)
+    med = {t: {n: {k: statistics.median(v) for k, v in d.items()} for n, d in o.items()} for t, o in out.items()}
+    return med["new"], med.get("old")
+
+
+def drag_lines(new: dict, old: dict | None, rounds: int) -> list[str]:
+    head = (
+        "| drag | coarse frames/s | longest gap (s) | coarse width (px) | release → full size, 1 spp (s) | "
+        "release → 4 spp (s) |"
+    )
+    lines = [
+        f"Drags (issue 24: item 1): mouse moves every {MOVE_GAP * 1e3:.0f} ms for {DRAG_SECONDS:g} s, sent whatever "
+        f"comes back, 640×480 canvas, then the release; medians of {rounds} rounds. Targets: ≥ 15 coarse "
+        "frames/s, refined ≤ 0.4 s after the release for degree ≤ 8. The server sends the full size at 1 sample "
+        "per pixel first when its 4-sample frame is expected to take longer than 0.4 s.",
+        "",
+        head if old is None else head + " before: frames/s | before: longest gap (s) |",
+        "|---|---|---|---|---|---|" + ("---|---|" if old else ""),
+    ]
+    for name, m in new.items():
+        row = f"| {name} | {m['fps']:.1f} | {m['gap']:.3f} | {m['width']:.0f} | {m['sharp']:.3f} | {m['release']:.3f} |"
+        if old is not None:
+            row += f" {old[name]['fps']:.1f} | {old[name]['gap']:.3f} |"
+        lines.append(row)
+    return lines + [""]
 
 
 NEIGHBOUR_EQUATION = "(x+y+z+a+b+1)^15"
@@ -180,6 +336,9 @@ def main() -> int:
     ap.add_argument("--orbit-frames", type=int, default=60, dest="orbit_frames")
     ap.add_argument("--neighbour-seconds", type=float, default=20.0, dest="neighbour_seconds")
     ap.add_argument("--neighbours-only", action="store_true", dest="neighbours_only")
+    ap.add_argument("--drag-only", action="store_true", dest="drag_only", help="the drags alone, printed")
+    ap.add_argument("--drag-rounds", type=int, default=5, dest="drag_rounds")
+    ap.add_argument("--compare", type=Path, help="a source tree whose server the drags are compared with")
     ap.add_argument("-o", "--output", type=Path, default=ROOT / "bench" / "results" / "view.md")
     args = ap.parse_args()
     if args.neighbours_only:
@@ -194,6 +353,13 @@ def main() -> int:
                 server.kill()
                 server.wait(30)
         return 0
+    if args.drag_only:
+        load = os.getloadavg()[0]
+        new, old = drags(args.drag_rounds, args.compare)
+        print("\n".join(drag_lines(new, old, args.drag_rounds)))
+        print(f"load average (1 min) {load:.2f} before, {os.getloadavg()[0]:.2f} after; {machine()}")
+        return 0
+    drag_new, drag_old = drags(args.drag_rounds, args.compare)
     specs = [s for s in (load_spec(p) for p in sorted(SHAPES.glob("*.yaml"))) if s.degree <= MAX_DEGREE]
     nonce = time.time_ns() % 10**9
     load_before = os.getloadavg()[0]
@@ -268,11 +434,13 @@ def main() -> int:
         f"(target ≤ 0.15), orbit {worst['fps']:.1f} frames/s (target ≥ 20), refinement {worst['refine']:.3f} s "
         "(target ≤ 0.4).",
         "",
-        "Coarse frames are 160×120 at 1 sample per pixel (JPEG), refined frames 640×480 at 4 (PNG); the studio "
-        "light preset (two lights, so two shadow rays per hit), clipped to a ball (a CSG intersection). The "
-        f"server starts at most {MAX_RENDERS_PER_SECOND} renders a second per page, which caps the orbit rate.",
+        "Coarse frames are at 1 sample per pixel (JPEG), sized by the server for about 30 ms each (view/pace.py: "
+        "at most 320×240 here), refined frames 640×480 at 4 (PNG); the studio light preset (two lights, so two "
+        "shadow rays per hit), the surface clipped to a ball (cut open). The server starts at most "
+        f"{MAX_RENDERS_PER_SECOND} renders a second per page, which caps the orbit rate.",
         "",
     ]
+    lines += drag_lines(drag_new, drag_old, args.drag_rounds)
     if busy is not None:
         lines += [
             f"With heavy neighbours: {NEIGHBOURS} other pages kept sending `{NEIGHBOUR_EQUATION} + n/k` (a new "

@@ -26,6 +26,9 @@
 /* Node kinds. */
 enum { RT_LEAF = 0, RT_UNION = 1, RT_INTERSECTION = 2, RT_DIFFERENCE = 3 };
 
+/* Clip kinds of a top-level leaf (rt_scene_set_clip): the surface is shown only inside a ball or a cube. */
+enum { RT_CLIP_NONE = 0, RT_CLIP_SPHERE = 1, RT_CLIP_BOX = 2 };
+
 /* Limits. implgen.scene.load checks scenes against RT_MAX_CSG_DEPTH, RT_MAX_DEPTH and RT_MAX_SPP too, reading
  * the numbers from this header (implgen.abi). */
 #define RT_MAX_CSG_DEPTH 96 /* depth of the binary CSG tree below a top-level object */
@@ -80,6 +83,12 @@ int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, 
                       const double *object_to_world /* 12 */, int material);
 int rt_scene_add_csg(rt_scene *s, int op, int left, int right, int material);
 int rt_scene_add_object(rt_scene *s, int node); /* a top-level object: a leaf or a CSG root */
+/* Show only the part of a leaf's surface inside the ball of radius `size` about `center` (RT_CLIP_SPHERE) or the
+ * cube of half-edge `size` (RT_CLIP_BOX), both in the leaf's object space; RT_CLIP_NONE: all of it. No cap: the
+ * surface is cut open, and its back shows through (a two-sided material colours it). For a leaf that is a
+ * top-level object; a clipped leaf cannot be a CSG operand (use a CSG intersection to cut a solid). Returns 0,
+ * or -1 with a message (not a leaf, used in CSG, size not finite and > 0, scene committed). */
+int rt_scene_set_clip(rt_scene *s, int node, int kind, const double center[3], double size);
 int rt_scene_add_light(rt_scene *s, const double position[3], const double color[3] /* colour x intensity */);
 void rt_scene_set_camera(rt_scene *s, const double eye[3], const double look_at[3], const double up[3],
                          double vfov_degrees);

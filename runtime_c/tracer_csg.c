@@ -263,6 +263,38 @@ static inline double object_unit_ray(const rt_node *n, const rt_ray *ray, double
     return L;
 }
 
+/* Narrows [*lo, *hi] (in t) to where the ray p + s u, s = t L, is inside the leaf's clip region: 0 when that is
+ * empty. The ball: |p + s u - c|^2 = r^2 with u a unit vector; the cube: its three slabs. */
+static inline int clip_range(const rt_node *n, const double *p, const double *u, double L, double *lo, double *hi)
+{
+    double q[3], s0 = -INFINITY, s1 = INFINITY;
+    int a;
+    for (a = 0; a < 3; ++a)
+        q[a] = p[a] - n->clip_c[a];
+    if (n->clip == RT_CLIP_SPHERE) {
+        double b = rt_dot(q, u), c = rt_dot(q, q) - n->clip_r * n->clip_r, disc = b * b - c, h;
+        if (!(disc > 0.0))
+            return 0;
+        h = sqrt(disc);
+        s0 = -b - h;
+        s1 = -b + h;
+    } else {
+        for (a = 0; a < 3; ++a) {
+            if (u[a] == 0.0) {
+                if (fabs(q[a]) > n->clip_r)
+                    return 0;
+                continue;
+            }
+            double e0 = (-n->clip_r - q[a]) / u[a], e1 = (n->clip_r - q[a]) / u[a];
+            s0 = fmax(s0, fmin(e0, e1));
+            s1 = fmin(s1, fmax(e0, e1));
+        }
+    }
+    *lo = fmax(*lo, s0 / L);
+    *hi = fmin(*hi, s1 / L);
+    return *hi > *lo;
+}
+
 /* The roots (in s = t L) among which the leaf's hit is the first in (tmin, tmax). The solver stops at the first
  * root in [lo, hi] (with any, at any point of the piece that holds it); only when that one cannot be used -- a
  * root exactly at tmin, or an unrefined point at an end -- are all of them needed. ex: NULL, or receives the
@@ -346,7 +378,7 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
         return csg_hit(s, k, ray, tmin, tmax, lo, hi, hit);
     /* A top-level leaf is a surface: its hit is the nearest root after tmin, solved along the unit object-space
      * direction (see rt_leaf_roots); an identity leaf takes the ray's own. */
-    if (n->prep.degree == 1 && !n->prep.bounded) {
+    if (n->prep.degree == 1 && !n->prep.bounded && n->clip == RT_CLIP_NONE) {
         int got = plane_hit(n, k, ray, tmin, tmax, lo, hi, hit);
         if (got >= 0)
             return got;
@@ -357,6 +389,8 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
         pu = u;
     }
     if (!(L > 0.0) || !isfinite(L))
+        return 0;
+    if (n->clip != RT_CLIP_NONE && !clip_range(n, po, pu, L, &lo, &hi))
         return 0;
     /* An opaque shadow ray only asks whether there is a hit: the root need not be refined, nor its expansion
      * kept (an opaque shadow hit is never finished). */

@@ -21,6 +21,10 @@ typedef struct rt_node {
     int obounded;       /* the spec gives bounds (some sides may still be infinite) */
     ig_shape_prep prep; /* shape.c's per-shape clip and shift data, worked out once (ig_shape_solve) */
     double half;        /* the largest half-extent of prep's finite box axes, 0 without one (rt_hit_error) */
+    int clip;           /* RT_CLIP_*: a top-level leaf's surface is shown only inside the clip region */
+    double clip_c[3];   /* the clip's centre (object space) */
+    double clip_r;      /* its radius, or its half-edge */
+    int operand;        /* a CSG node uses this node */
     /* any node */
     double wbox[6]; /* world-space box, slightly padded; valid when wbounded */
     int wbounded;

@@ -207,6 +207,8 @@ int rt_scene_add_csg(rt_scene *s, int op, int left, int right, int material)
         return fail(s, "CSG child index out of range");
     if (material >= s->nmaterials)
         return fail(s, "material index out of range");
+    if (s->nodes[left].clip != RT_CLIP_NONE || s->nodes[right].clip != RT_CLIP_NONE)
+        return fail(s, "a clipped leaf cannot be a CSG operand");
     dl = s->nodes[left].depth;
     dr = s->nodes[right].depth;
     if ((dl > dr ? dl : dr) + 1 > RT_MAX_CSG_DEPTH)
@@ -221,7 +223,38 @@ int rt_scene_add_csg(rt_scene *s, int op, int left, int right, int material)
     n->material = material;
     n->depth = (dl > dr ? dl : dr) + 1;
     n->mnorm = 1.0;
+    s->nodes[left].operand = s->nodes[right].operand = 1;
     return k;
+}
+
+int rt_scene_set_clip(rt_scene *s, int node, int kind, const double center[3], double size)
+{
+    rt_node *n;
+    int a;
+    if (s->committed)
+        return fail(s, "scene already committed");
+    if (node < 0 || node >= s->nnodes || s->nodes[node].kind != RT_LEAF)
+        return fail(s, "a clip is for a leaf");
+    n = &s->nodes[node];
+    if (n->operand)
+        return fail(s, "a clipped leaf cannot be a CSG operand");
+    if (kind != RT_CLIP_NONE && kind != RT_CLIP_SPHERE && kind != RT_CLIP_BOX)
+        return fail(s, "unknown clip kind");
+    if (kind != RT_CLIP_NONE) {
+        if (!(size > 0.0) || !isfinite(size) || !isfinite(center[0]) || !isfinite(center[1]) || !isfinite(center[2]))
+            return fail(s, "clip size must be finite and positive, its centre finite");
+        /* the object-space box of what can be seen: the shape's own box cut by the clip region's (both kinds
+         * fit in the cube of half-edge size), so an unbounded shape becomes a bounded object */
+        for (a = 0; a < 3; ++a) {
+            n->obox[a] = fmax(n->obox[a], center[a] - size);
+            n->obox[a + 3] = fmin(n->obox[a + 3], center[a] + size);
+        }
+        n->obounded = 1;
+    }
+    n->clip = kind;
+    memcpy(n->clip_c, center, sizeof n->clip_c);
+    n->clip_r = size;
+    return 0;
 }
 
 int rt_scene_add_object(rt_scene *s, int node)

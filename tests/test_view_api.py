@@ -28,7 +28,7 @@ from implgen.view.command import document_factory
 from implgen.view.document import Document
 from implgen.view.protocol import MAX_MESSAGE
 from implgen.view.server import create_app, origin_allowed
-from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_SAVE, Session
+from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_ONE, KIND_SAVE, Session
 
 SCENES = ROOT / "examples" / "scenes"
 
@@ -39,8 +39,26 @@ def client():
         yield c
 
 
+def picture(ws) -> bytes:
+    """The next picture, past the build's status lines ("compiling ...") that may come before it."""
+    while True:
+        msg = ws.receive()
+        if msg.get("bytes") is not None:
+            return msg["bytes"]
+        data = json.loads(msg["text"])
+        assert data["type"] == "status", data
+
+
+def reply(ws) -> dict:
+    """The next JSON message, past the build's status lines."""
+    while True:
+        data = ws.receive_json()
+        if data["type"] != "status":
+            return data
+
+
 def frame(msg: bytes) -> tuple[int, int, np.ndarray]:
-    seq, kind, w, h = HEADER.unpack(msg[: HEADER.size])
+    seq, kind, _, w, h = HEADER.unpack(msg[: HEADER.size])
     img = np.asarray(Image.open(io.BytesIO(msg[HEADER.size :])).convert("RGB"))
     assert img.shape == (h, w, 3)
     return seq, kind, img
@@ -75,7 +93,15 @@ def scene_of(hello: dict, w: int, h: int, spp: int, values=None) -> dict:
 
 
 def test_only_the_pages_files_are_served(client) -> None:
-    for path, kind in (("/", "text/html"), ("/app.js", "text/javascript"), ("/style.css", "text/css")):
+    served = (
+        ("/", "text/html"),
+        ("/app.js", "text/javascript"),
+        ("/share.js", "text/javascript"),
+        ("/style.css", "text/css"),
+        ("/favicon.ico", "image/x-icon"),
+        ("/favicon.svg", "image/svg+xml"),
+    )
+    for path, kind in served:
         r = client.get(path)
         assert r.status_code == 200 and r.headers["content-type"].startswith(kind)
         assert "default-src 'self'" in r.headers["content-security-policy"]
@@ -89,58 +115,68 @@ def test_only_the_pages_files_are_served(client) -> None:
 
 def test_coarse_then_full_frame_match_the_normal_render(client) -> None:
     with client.websocket_connect("/ws") as ws:
-        hello = ws.receive_json()
+        hello = reply(ws)
         assert hello["type"] == "hello" and hello["params"] == {"a": 1.0, "b": 0.35} and hello["degree"] == 4
         ws.send_text(render_msg(hello, seq=3, w=160, h=120))
-        seq, kind, coarse = frame(ws.receive_bytes())
-        assert (seq, kind, coarse.shape) == (3, KIND_COARSE, (30, 40, 3))
-        seq, kind, full = frame(ws.receive_bytes())
+        seq, kind, coarse = frame(picture(ws))
+        ch, cw = coarse.shape[:2]  # a page's first coarse frame: at most half the width and height
+        assert (seq, kind) == (3, KIND_COARSE) and 16 <= cw <= 80 and ch == round(cw * 0.75)
+        seq, kind, full = frame(picture(ws))
+        if kind == KIND_ONE:  # the full size at 1 sample first, when the 4 samples are expected to be slow
+            seq, kind, full = frame(picture(ws))
         assert (seq, kind, full.shape) == (3, KIND_FULL, (120, 160, 3))
     # the same view through parse_scene + render(): the full frame is lossless PNG of the same samples
     ref = to_uint8(render(parse_scene(scene_of(hello, 160, 120, 4), "view.yaml"), threads=2))
     assert np.abs(full.astype(int) - ref).max() <= 1
     assert full.std() > 10  # not a blank picture: the torus is there
-    ref_coarse = to_uint8(render(parse_scene(scene_of(hello, 40, 30, 1), "view.yaml"), threads=2))
+    ref_coarse = to_uint8(render(parse_scene(scene_of(hello, cw, ch, 1), "view.yaml"), threads=2))
     assert np.abs(coarse.astype(int) - ref_coarse).mean() < 4  # JPEG
 
 
 def test_a_slider_rerenders_without_building(client, monkeypatch) -> None:
     with client.websocket_connect("/ws") as ws:
-        hello = ws.receive_json()
+        hello = reply(ws)
         ws.send_text(render_msg(hello, seq=1, refine=False))
-        _, _, before = frame(ws.receive_bytes())
+        _, _, before = frame(picture(ws))
         calls = []
         real = session_mod.build_scene
         monkeypatch.setattr(session_mod, "build_scene", lambda *a, **k: calls.append(1) or real(*a, **k))
         ws.send_text(render_msg(hello, seq=2, refine=False, values={"a": 1.0, "b": 0.6}))
-        seq, _, after = frame(ws.receive_bytes())
+        seq, _, after = frame(picture(ws))
         assert seq == 2 and calls == []
         assert np.abs(after.astype(int) - before).mean() > 2  # a fatter tube
 
 
 def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
     with client.websocket_connect("/ws") as ws:
-        hello = ws.receive_json()
+        hello = reply(ws)
         ws.send_text(json.dumps({"type": "shape", "equation": "x^2 + y^2 +* z^2 - 1"}))
-        err = ws.receive_json()
+        err = reply(ws)
         assert err["type"] == "error" and err["field"] == "equation" and "syntax error" in err["message"]
         assert "\n" not in err["message"]
         for bad in ("__import__('os').system('true')", "x^25 + y", "x + w", "x" * 30_000):
             ws.send_text(json.dumps({"type": "shape", "equation": bad}))
-            err = ws.receive_json()
+            err = reply(ws)
             assert err["field"] in ("equation", "message"), err
         ws.send_text(render_msg(hello, seq=5, refine=False))
-        seq, _, img = frame(ws.receive_bytes())
+        seq, _, img = frame(picture(ws))
         assert seq == 5 and img.std() > 10
         ws.send_text(json.dumps({"type": "shape", "equation": "x^2 + y^2 + z^2 - r^2", "params": {"r": "1.5"}}))
-        ok = ws.receive_json()
+        ok = reply(ws)
         assert ok == {
             "type": "shape",
+            "name": "torus",  # no name sent: the current shape's
             "equation": "-r^2 + x^2 + y^2 + z^2",
             "params": {"r": 1.5},
             "values": {"r": 1.5},
             "degree": 2,
+            "fit": None,  # not asked for
+            "objects": [],  # a scene file's, to pick from
         }
+        ws.send_text(
+            json.dumps({"type": "shape", "equation": "x^2 + y^2 + z^2 - r^2", "params": {"r": 1.5}, "fit": True})
+        )
+        assert reply(ws)["fit"] == 1.8  # the ball of radius 1.5, and a margin
 
 
 @pytest.mark.parametrize(
@@ -160,45 +196,86 @@ def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
 )
 def test_bad_messages_are_answered_in_one_line(client, msg: str, needle: str) -> None:
     with client.websocket_connect("/ws") as ws:
-        hello = ws.receive_json()
+        hello = reply(ws)
         ws.send_text(msg)
-        err = ws.receive_json()
+        err = reply(ws)
         assert err["type"] == "error" and needle in err["message"] and "\n" not in err["message"]
         ws.send_bytes(b"\x00" * 10)
-        assert ws.receive_json()["type"] == "error"
+        assert reply(ws)["type"] == "error"
         ws.send_text(render_msg(hello, seq=9, refine=False))  # still serving
-        assert frame(ws.receive_bytes())[0] == 9
+        assert frame(picture(ws))[0] == 9
     assert len("[" * 100_000) > MAX_MESSAGE
 
 
 def test_save_png_yaml_and_c(client) -> None:
     with client.websocket_connect("/ws") as ws:
-        hello = ws.receive_json()
+        hello = reply(ws)
         ws.send_text(render_msg(hello, seq=1, refine=False))
-        frame(ws.receive_bytes())
+        frame(picture(ws))
         ws.send_text(json.dumps({"type": "save_png", "width": 96, "height": 64, "spp": 2}))
-        seq, kind, saved = frame(ws.receive_bytes())
+        seq, kind, saved = frame(picture(ws))
         assert kind == KIND_SAVE and saved.shape == (64, 96, 3)
         ref = to_uint8(render(parse_scene(scene_of(hello, 96, 64, 2), "view.yaml"), threads=2))
         assert np.abs(saved.astype(int) - ref).max() <= 1
-        ws.send_text(json.dumps({"type": "save_yaml"}))
-        text = ws.receive_json()["text"]
-        spec = parse_spec(yaml.safe_load(text), "saved.yaml")
-        assert spec.equation == hello["equation"] and spec.params == {"a": 1, "b": 0.35} and spec.bounds
         ws.send_text(json.dumps({"type": "show_c"}))
-        c = ws.receive_json()["text"]
+        c = reply(ws)["text"]
         assert "torus_coeffs(" in c and "torus.h" in c
+
+
+@pytest.mark.parametrize("clip, cut", [("sphere", False), ("box", False), ("sphere", True), ("none", False)])
+def test_save_yaml_is_a_scene_that_renders_to_the_page_s_full_frame(client, tmp_path, clip: str, cut: bool) -> None:
+    """Save YAML writes a scene (camera, lights, clip, colours, the shape inline, named `surface` when typed)
+    that `implgen render` renders to the page's full frame, pixel for pixel; `implgen view` opens it on the same
+    view."""
+    with client.websocket_connect("/ws") as ws:
+        hello = reply(ws)
+        ws.send_text(
+            json.dumps(
+                {
+                    "type": "shape",
+                    "equation": "x^4 - 5*x^2 + y^4 - 5*y^2 + z^4 - 5*z^2 + c",
+                    "params": {"c": 11.8},
+                    "name": "surface",
+                    "fit": True,
+                }
+            )
+        )
+        shape = reply(ws)
+        assert shape["name"] == "surface" and shape["fit"] == 4.0
+        options = dict(hello["options"], clip=clip, cut=cut, clip_size=3.5, color=[0.2, 0.7, 0.4])
+        orbit = dict(hello["orbit"], yaw=40.0, pitch=20.0, distance=11.0)
+        ws.send_text(render_msg(hello, seq=1, w=96, h=72, values=shape["values"], options=options, orbit=orbit))
+        while True:
+            seq, kind, full = frame(picture(ws))
+            if kind == KIND_FULL:
+                break
+        ws.send_text(json.dumps({"type": "save_yaml", "width": 96, "height": 72}))
+        text = reply(ws)["text"]
+    saved = yaml.safe_load(text)
+    leaf = saved["objects"][0] if not cut else saved["objects"][0]["intersection"][0]
+    assert leaf["name"] == "surface" and leaf["params"] == {"c": 11.8}
+    assert (leaf.get("clip") == {clip: 3.5}) == (clip != "none" and not cut)
+    path = tmp_path / "saved.yaml"
+    path.write_text(text)
+    assert cli_main(["render", str(path), "-o", str(tmp_path / "out.png"), "-q"]) == 0
+    rendered = np.asarray(Image.open(tmp_path / "out.png").convert("RGB"))
+    assert np.array_equal(rendered, full)  # the same picture, pixel for pixel
+    assert full.std() > 10
+    doc = document_factory(path)()  # `implgen view saved.yaml`: the same view
+    again = to_uint8(render(doc.scene(96, 72, 4), threads=2))
+    assert np.abs(again.astype(int) - full).mean() < 0.5
 
 
 def test_scene_file_mode(tmp_path) -> None:
     make = document_factory(SCENES / "torus_shadow.yaml")
     with TestClient(create_app(make, threads=2)) as c, c.websocket_connect("/ws") as ws:
-        hello = ws.receive_json()
+        hello = reply(ws)
         assert hello["mode"] == "scene" and hello["options"]["lights"] == "scene"
         ws.send_text(render_msg(hello, seq=1, refine=False))
-        assert frame(ws.receive_bytes())[2].std() > 10
-        ws.send_text(json.dumps({"type": "save_yaml"}))
-        saved = yaml.safe_load(ws.receive_json()["text"])
+        assert frame(picture(ws))[2].std() > 10
+        ws.send_text(json.dumps({"type": "save_yaml", "width": 64, "height": 48}))
+        saved = yaml.safe_load(reply(ws)["text"])
+        assert saved["image"]["width"] == 64
     sc = parse_scene(saved, tmp_path / "saved.yaml")  # a scene file implgen render takes
     assert len(sc.objects) == 2 and len(sc.lights) == 1
 
@@ -214,26 +291,26 @@ def test_failures_are_one_error_reply_and_the_page_keeps_going(client, monkeypat
         raise UserError("save_png", "too big for today")
 
     with client.websocket_connect("/ws") as ws:
-        hello = ws.receive_json()
+        hello = reply(ws)
         monkeypatch.setattr(session_mod, "RenderJob", bug)
         ws.send_text(render_msg(hello, seq=1, refine=False))
-        assert ws.receive_json() == {
+        assert reply(ws) == {
             "type": "error",
             "field": "message",
             "message": "internal error: ZeroDivisionError",
         }
         monkeypatch.undo()
-        for raise_, reply in ((bug, "internal error: ZeroDivisionError"), (bad, "save_png: too big for today")):
+        for raise_, line in ((bug, "internal error: ZeroDivisionError"), (bad, "save_png: too big for today")):
             monkeypatch.setattr(session_mod, "_file_png", raise_)  # the save, on its pool thread
             ws.send_text(json.dumps({"type": "save_png", "width": 32, "height": 32, "spp": 1}))
-            assert ws.receive_json() == {"type": "error", "field": "message", "message": reply}
+            assert reply(ws) == {"type": "error", "field": "message", "message": line}
         ws.send_text(json.dumps({"type": "shape", "equation": "x^2 +"}))
-        err = ws.receive_json()
+        err = reply(ws)
         assert err["field"] == "equation" and "syntax error in 'x^2 +'" in err["message"], err
         ws.send_bytes(b"{}")
-        assert ws.receive_json() == {"type": "error", "field": "message", "message": "message: expected text (JSON)"}
+        assert reply(ws) == {"type": "error", "field": "message", "message": "message: expected text (JSON)"}
         ws.send_text(render_msg(hello, seq=2, refine=False))
-        assert frame(ws.receive_bytes())[:2] == (2, KIND_COARSE)
+        assert frame(picture(ws))[:2] == (2, KIND_COARSE)
     failed = [r for r in caplog.records if r.name == "implgen.view"]
     assert [r.getMessage() for r in failed] == ["viewer render failed", "viewer save failed"]
     assert all(r.exc_info and r.exc_info[0] is ZeroDivisionError for r in failed)
@@ -242,21 +319,61 @@ def test_failures_are_one_error_reply_and_the_page_keeps_going(client, monkeypat
 # ------------------------------------------------------------------------------------- clip: exact hits
 
 
-@pytest.mark.parametrize("clip, size, t", [("none", 3.0, 3.65), ("sphere", 1.2, 3.8), ("box", 1.0, 4.0)])
-def test_clip_is_an_intersection_with_a_ball_or_a_cube(clip: str, size: float, t: float) -> None:
-    """Torus about y (a = 1, b = 0.35): the ray down the z-axis from z = 5 meets the tube at z = 1.35, the
-    clip ball of radius 1.2 at z = 1.2, the clip cube [-1, 1]^3 at z = 1."""
+@pytest.mark.parametrize(
+    "clip, size, cut, t, entering",
+    [
+        ("none", 3.0, False, 3.65, 1),
+        ("sphere", 1.2, False, 4.35, 0),
+        ("box", 1.0, False, 4.35, 0),
+        ("sphere", 1.2, True, 3.8, 1),
+        ("box", 1.0, True, 4.0, 1),
+    ],
+)
+def test_clip_shows_the_surface_inside_or_cuts_the_solid(clip: str, size: float, cut: bool, t, entering) -> None:
+    """Torus about y (a = 1, b = 0.35): the ray down the z-axis from z = 5 meets the tube at z = 1.35 and leaves
+    it at z = 0.65. By default (as SURFER) a clip shows the surface inside the ball of radius 1.2 or the cube
+    [-1, 1]^3 only, cut open: the first hit is the tube's inner wall at z = 0.65, seen from inside the solid
+    (its back, the inside colour). With `cut`, the solid is intersected with the ball or the cube: the cut face,
+    at z = 1.2 or z = 1, is hit entering."""
     doc = document_factory(None)()
-    doc.options.clip, doc.options.clip_size = clip, size
+    doc.options.clip, doc.options.clip_size, doc.options.cut = clip, size, cut
     sc = doc.scene(8, 8, 1)
     hit = CScene(sc, build.build_scene(sc)).intersect([0, 0, 5], [0, 0, -1])
     assert hit.t == pytest.approx(t, abs=1e-9)
+    assert hit.entering == entering
 
 
 # ------------------------------------------------------------------------------------- newest wins
 
 
-def test_a_newer_request_cancels_the_running_render() -> None:
+def test_a_coarse_frame_in_flight_is_finished_and_the_newest_request_drawn_next() -> None:
+    """A drag: requests come faster than frames. Each coarse frame is finished and sent (never thrown away by
+    the next move), the requests between are skipped, and the last one is drawn."""
+    sent: list = []
+
+    async def scenario() -> None:
+        s = Session(Document.for_spec(parse_spec(_starter(), "starter")), _collect(sent), threads=2)
+        hello = s.hello()
+        for seq in range(1, 41):  # 40 moves 5 ms apart: far faster than a frame
+            await s.handle(render_msg(hello, seq=seq, refine=False, w=1280, h=960))
+            await asyncio.sleep(0.005)
+        while not sent or HEADER.unpack(sent[-1][: HEADER.size])[0] != 40:
+            await asyncio.sleep(0.01)
+        await s.close()
+
+    asyncio.run(scenario())
+    seqs = [HEADER.unpack(m[: HEADER.size])[0] for m in sent]
+    assert seqs[0] == 1 and seqs[-1] == 40 and seqs == sorted(seqs) and len(seqs) < 40
+
+
+def _collect(sent: list):
+    async def send(msg) -> None:
+        sent.append(msg)
+
+    return send
+
+
+def test_a_newer_request_cancels_the_running_refinement() -> None:
     sent: list = []
 
     async def scenario() -> None:
@@ -368,12 +485,83 @@ def test_a_foreign_origin_or_host_is_turned_away_before_any_work():
     with TestClient(create_app(make, threads=2)) as c:
         with pytest.raises(WebSocketDisconnect) as err:
             with c.websocket_connect("/ws", headers={"origin": "http://evil.example"}) as ws:
-                ws.receive_json()
+                reply(ws)
         assert err.value.code == 1008
         with c.websocket_connect("/ws", headers={"origin": "http://testserver"}) as ws:
-            assert ws.receive_json()["type"] == "hello"
+            assert reply(ws)["type"] == "hello"
     with TestClient(create_app(make, threads=2, allowed_hosts=("127.0.0.1", "localhost", "::1"))) as c:
         with pytest.raises(WebSocketDisconnect):  # the test client's Host is `testserver`, as a rebound name
             with c.websocket_connect("/ws") as ws:
-                ws.receive_json()
+                reply(ws)
     assert len(made) == 1  # only the accepted page got a document
+
+
+def test_a_scene_s_object_is_picked_in_the_picture_or_from_the_list(tmp_path) -> None:
+    """Two balls, left and right of the camera's axis, on a floor: a click on a ball's centre (where the camera
+    projects it, worked out here) picks that ball, a click above the floor's horizon picks nothing, the list picks
+    by index; the edits of each object are kept when another one is picked."""
+    scene = {
+        "image": {"width": 64, "height": 48},
+        "camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "fov": 40},
+        "lights": [{"position": [0, 5, 5], "color": [1, 1, 1]}],
+        "objects": [
+            {"equation": "y + 2", "name": "floor"},
+            {"equation": "(x + 2)^2 + y^2 + z^2 - 1", "name": "left"},
+            {"equation": "(x - 2)^2 + y^2 + z^2 - 1", "name": "right"},
+        ],
+    }
+    path = tmp_path / "balls.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    half = np.tan(np.radians(20))  # the pixel of (x, 0, 0) at distance 10, in a 640 x 480 picture
+
+    def pixel(x: float) -> float:
+        return (x / 10 / (half * 640 / 480) + 1) / 2 * 640 - 0.5
+
+    with TestClient(create_app(document_factory(path), threads=2)) as c, c.websocket_connect("/ws") as ws:
+        hello = reply(ws)
+        assert [o["name"] for o in hello["objects"]] == ["floor", "left", "right"] and hello["object"] == 0
+        ws.send_text(json.dumps({"type": "pick", "x": pixel(2.0), "y": 239.5, "width": 640, "height": 480}))
+        got = reply(ws)
+        assert (got["object"], got["name"], got["equation"]) == (2, "right", "y^2 + z^2 + (x - 2)^2 - 1")
+        ws.send_text(json.dumps({"type": "shape", "equation": "(x - 2)^2 + y^2 + z^2 - 0.25"}))
+        assert reply(ws)["name"] == "right"  # a scene's shape keeps its name
+        ws.send_text(json.dumps({"type": "pick", "x": pixel(-2.0), "y": 239.5, "width": 640, "height": 480}))
+        assert reply(ws)["object"] == 1
+        ws.send_text(json.dumps({"type": "pick", "x": 320, "y": 5, "width": 640, "height": 480}))
+        assert "nothing there" in reply(ws)["message"]
+        ws.send_text(json.dumps({"type": "object", "index": 2}))
+        back = reply(ws)
+        assert back["object"] == 2 and back["equation"] == "y^2 + z^2 + (x - 2)^2 - 1/4"  # its edit was kept
+        ws.send_text(json.dumps({"type": "object", "index": 3}))
+        assert "index" in reply(ws)["message"]
+    with TestClient(create_app(document_factory(None), threads=2)) as c, c.websocket_connect("/ws") as ws:
+        reply(ws)
+        ws.send_text(json.dumps({"type": "object", "index": 0}))
+        assert reply(ws)["message"] == "object: only a scene file has objects to pick"
+
+
+def test_pace_sizes_live_frames_for_about_30_ms() -> None:
+    """The live frame's size from the last frame's measure: TARGET seconds at the measured cost a pixel, at most
+    GROW times the last frame's pixels, between MIN_WIDTH pixels a row and half the full frame, the aspect kept;
+    a cut frame with no row done shrinks by FIRST_SHRINK^2, a new shape by FIRST_SHRINK."""
+    from implgen.view import pace
+
+    p = pace.Pace()
+    assert p.size(640, 480) == (160, 120)  # the first frame of a page
+    p.measured(160 * 120, 0.060)  # twice the target: half the pixels next
+    w, h = p.size(640, 480)
+    assert abs(w * h - 160 * 120 / 2) < 200 and abs(w / h - 4 / 3) < 0.02
+    p.measured(w * h, 0.001)  # very cheap: it may only double
+    assert abs(p.size(640, 480)[0] * p.size(640, 480)[1] - 2 * w * h) < 300
+    for _ in range(12):  # cheap frames: twice the pixels each time, up to half the full frame a side
+        w, h = p.size(640, 480)
+        p.measured(w * h, 1e-6)
+    assert p.size(640, 480) == (320, 240)
+    p.cut(320 * 240)
+    assert abs(p.pixels - 320 * 240 / 16) < 1
+    p.measured(100, 10.0)  # hopelessly slow: the smallest frame, which is never cut
+    w, h = p.size(640, 480)
+    assert (w, h) == (pace.MIN_WIDTH, 36) and p.smallest(640, 480, w)
+    p.pixels = 1000.0
+    p.new_shape()
+    assert p.pixels == 250.0

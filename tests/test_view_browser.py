@@ -29,6 +29,7 @@ from implgen.view.command import bind, document_factory, serve
 pytestmark = pytest.mark.needs_program("chromium", "chromedriver")
 EQUATION = "x^4 - 5*x^2 + y^4 - 5*y^2 + z^4 - 5*z^2 + c"  # a tanglecube; c = 11.8 is the classic one
 PARAMS = "c = 11.8"
+BARTH6 = "4*(phi^2*x^2 - y^2)*(phi^2*y^2 - z^2)*(phi^2*z^2 - x^2) - (1 + 2*phi)*(x^2 + y^2 + z^2 - w^2)^2*w^2"
 WAIT = 120  # seconds: generous, the machine may be busy; nothing here is a timing
 
 
@@ -97,7 +98,7 @@ def page_colour(driver, element_id: str) -> list[float]:
 
 
 def reference(driver, values: dict) -> np.ndarray:
-    """render() of the view the page shows: the starter's camera, the page's colours, the typed shape."""
+    """render() of the view the page shows: the page's camera, clip and colours, the typed shape."""
     doc = document_factory(None)()
     spec = protocol.parse_shape({"equation": EQUATION, "params": {"c": 11.8}}, doc.spec)
     doc.set_spec(spec)
@@ -105,7 +106,11 @@ def reference(driver, values: dict) -> np.ndarray:
     doc.options.color = tuple(page_colour(driver, "color"))
     doc.options.inside = tuple(page_colour(driver, "inside"))
     doc.options.background = tuple(page_colour(driver, "background"))
-    return to_uint8(render(doc.scene(640, 480, 4), threads=2)).astype(int)
+    doc.options.clip_size = float(driver.find_element("id", "clip-size").get_attribute("value"))
+    orbit = driver.execute_script("return window.implgenState().orbit")
+    doc.orbit = protocol.parse_orbit(orbit)
+    w, h = driver.execute_script("const c = document.getElementById('view'); return [c.width, c.height];")
+    return to_uint8(render(doc.scene(w, h, 4), threads=2)).astype(int)
 
 
 def test_the_page_in_a_real_browser(server, driver) -> None:
@@ -167,24 +172,17 @@ def test_the_page_in_a_real_browser(server, driver) -> None:
     assert turned > moved and np.abs(canvas_pixels(driver) - after).mean() > 2
 
     shot = os.environ.get("IMPLGEN_SCREENSHOT")
-    if shot:  # the classic tanglecube, a little further away, for the README
-        from selenium.webdriver.common.actions.wheel_input import ScrollOrigin
-
-        driver.set_window_size(1100, 700)
-        from selenium.webdriver.support.ui import Select
-
-        Select(driver.find_element("id", "clip")).select_by_value("none")  # the whole surface
+    if shot:  # Barth's sextic in its clip ball, cut open as SURFER shows it, for the README
+        driver.set_window_size(1280, 720)
+        params.clear()
+        params.send_keys("phi = 1.618033988749895, w = 1")
         eq.clear()
-        eq.send_keys(EQUATION)
+        eq.send_keys(BARTH6)
         eq.send_keys(Keys.ENTER)
-        wait(driver, lambda d: not d.find_element("id", "equation-error").text, "the message stayed")
-        shown = wait_full_after(driver, turned)
-        slider = driver.find_element("css selector", "input[type=range][data-name=c]")  # rebuilt with the shape
-        ActionChains(driver).click_and_hold(slider).release().perform()  # the middle of the range: c = 11.8
-        shown = wait_full_after(driver, shown)
-        ActionChains(driver).scroll_from_origin(ScrollOrigin.from_element(canvas), 0, 600).perform()
-        wait_full_after(driver, shown)
-        time.sleep(1.0)
+        wait(driver, lambda d: d.find_element("id", "degree").text == "degree 6", "Barth's sextic was not accepted")
+        wait_full_after(driver, turned)
+        time.sleep(1.5)  # the window's new size, refined
+        wait(driver, lambda d: frame_state(d)[1] == "full", "the picture did not rest")
         driver.save_screenshot(shot)
     assert parse_spec({"name": "t", "equation": EQUATION, "params": {"c": 11.8}}).degree == 4
 

@@ -155,6 +155,15 @@ def _object_job(source: Path, include_dirs: Sequence[Path], extra_flags: Sequenc
     return Job(target, key, Path(source).name, lambda tmp: [cc, *flags, "-c", str(source), "-o", tmp, *includes])
 
 
+def objects_present(jobs: Sequence[tuple[Path, Sequence[Path]]], extra_flags: Sequence[str] = ()) -> tuple[int, int]:
+    """(how many of these sources' objects the build cache holds, how many sources): a build's progress, as a
+    page can show it while the runtime is compiled for the first time. Looks at the files only (a build in
+    progress renames each sealed object into place)."""
+    cc, folder = compiler(), cachedir.cache_dir("obj")
+    objects = [_object_job(src, inc, [*extra_flags], cc, folder) for src, inc in jobs]
+    return sum(job.target.is_file() for job in objects), len(objects)
+
+
 def _build_all(jobs: Sequence[Job]) -> None:
     missing = [job for job in jobs if not cachedir.check_entry(job.target, job.key)]
     if missing:

@@ -97,6 +97,20 @@ def _glue(entries: Sequence[ShapeEntry]) -> Path:
     return glue
 
 
+LIBRARY_FLAGS = ("-pthread",)
+
+
+def _runtime_jobs() -> list[tuple[Path, list[Path]]]:
+    rt = runtime_dir()
+    return [(src, [rt]) for src in runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES, TRACER_SOURCES)]
+
+
+def runtime_progress() -> tuple[int, int]:
+    """(the runtime's objects in the build cache, the runtime's sources): all there once it has been compiled,
+    which happens once per cache (the viewer says so while it lasts)."""
+    return clib.objects_present(_runtime_jobs(), LIBRARY_FLAGS)
+
+
 def build_library(entries: Sequence[ShapeEntry]) -> tuple[Path, int]:
     """The tracer library holding these shapes: (its path, how many shapes were generated on this call)."""
     dirs, generated = [], 0
@@ -108,7 +122,7 @@ def build_library(entries: Sequence[ShapeEntry]) -> tuple[Path, int]:
     rt = runtime_dir()
     # Each runtime source sees only the runtime's headers, so its object is shared by every library; each shape
     # sees its own folder too, and only the glue sees all of them.
-    jobs = [(src, [rt]) for src in runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES, TRACER_SOURCES)]
+    jobs = _runtime_jobs()
     jobs += [(d / f"{e.c_name}.c", [rt, d]) for d, e in zip(dirs, entries)]
     jobs.append((glue, [rt, *dirs]))
-    return clib.build_jobs(jobs, extra_flags=["-pthread"], libs=["-lm", "-pthread"], tag="scene"), generated
+    return clib.build_jobs(jobs, extra_flags=LIBRARY_FLAGS, libs=["-lm", "-pthread"], tag="scene"), generated

@@ -159,6 +159,8 @@ def scene_pov(scene, width: int, height: int, coverage: bool = False) -> str:
     for node in scene.objects:
         if not isinstance(node, Leaf):
             raise ValueError("scene_pov exports leaf objects only (no CSG)")
+        if node.clip is not None:
+            raise ValueError("scene_pov does not export a leaf's clip (the surface would show whole)")
         if coverage:
             if node.spec.degree == 1:
                 continue

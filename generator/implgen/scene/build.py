@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from implgen.compile.library import ShapeEntry, build_library
+from implgen.compile.library import ShapeEntry, build_library, runtime_progress
 from implgen.scene.model import Leaf, Scene
 
 
@@ -67,3 +67,9 @@ def build_scene(scene: Scene, fold: bool = False) -> BuildResult:
     entries, leaf_index = plan_shapes(scene, fold)
     library, generated = build_library(entries)
     return BuildResult(library=library, entries=entries, leaf_index=leaf_index, generated=generated)
+
+
+def runtime_ready() -> tuple[int, int]:
+    """(the tracer runtime's objects already compiled in the build cache, its sources): a first build compiles
+    the rest (compile/library.runtime_progress)."""
+    return runtime_progress()

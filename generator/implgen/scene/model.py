@@ -46,6 +46,19 @@ class Material:
         return values + [0.0] * (abi.value("RT_MATERIAL_DOUBLES") - len(values))
 
 
+CLIP_KINDS = ("sphere", "box")
+
+
+@dataclass(frozen=True)
+class Clip:
+    """A top-level surface shown only inside a ball (`sphere`, radius `size`) or a cube (`box`, half-edge `size`)
+    about `center`, in the leaf's object space; cut open, no cap (rt_scene_set_clip)."""
+
+    kind: str
+    size: float
+    center: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
 @dataclass
 class Leaf:
     spec: Spec  # its symbolic part deferred when the spec's content was parsed before (codegen/speccache.py)
@@ -53,6 +66,7 @@ class Leaf:
     matrix: np.ndarray  # 3x4 object -> world
     material: Material | None
     where: str  # key path in the scene, for messages
+    clip: Clip | None = None  # a top-level leaf only
 
 
 @dataclass

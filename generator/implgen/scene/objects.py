@@ -16,7 +16,7 @@ from implgen.errors import UserError
 from implgen.scene import keys
 from implgen.scene import transform as tf
 from implgen.scene.materials import material_ref
-from implgen.scene.model import Csg, Leaf, Material, Node
+from implgen.scene.model import CLIP_KINDS, Clip, Csg, Leaf, Material, Node
 from implgen.scene.model import depth as node_depth
 from implgen.scene.reader import Reader, given
 
@@ -24,7 +24,8 @@ MAX_CSG_NESTING = 32  # CSG operations nested inside each other, as written in t
 MAX_CSG_CHILDREN = 1024  # objects in one CSG list (a list becomes a balanced binary tree)
 MAX_OBJECTS = 10_000  # shapes placed in one scene, CSG operands included (each is one BVH leaf)
 CSG_OPS = ("union", "intersection", "difference")
-LEAF_KEYS = ("shape", "equation", "name", "params", "bounds", "transform", "material")
+LEAF_KEYS = ("shape", "equation", "name", "params", "bounds", "transform", "material", "clip")
+CLIP_KEYS = (*CLIP_KINDS, "center")
 
 
 def _resolve_shape_path(ctx: Reader, key: str, value: Any) -> Path:
@@ -99,7 +100,19 @@ def _leaf(ctx: Reader, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
         spec.check_values(params, ctx.source, f"{key}.params")
     m = tf.parse_transform(ctx.source, f"{key}.transform", ctx.resolve(f"{key}.transform", raw.get("transform")))
     mat = material_ref(ctx, f"{key}.material", raw["material"], named) if "material" in raw else None
-    return Leaf(spec=spec, params=params, matrix=m, material=mat, where=key)
+    clip = _clip(ctx, f"{key}.clip", raw["clip"]) if "clip" in raw else None
+    return Leaf(spec=spec, params=params, matrix=m, material=mat, where=key, clip=clip)
+
+
+def _clip(ctx: Reader, key: str, raw: Any) -> Clip:
+    """`clip: {sphere: R}` or `{box: H}`, optional `center: [x, y, z]` (object space; default the origin)."""
+    raw = ctx.mapping(key, raw, CLIP_KEYS)
+    kinds = [k for k in CLIP_KINDS if k in raw]
+    if len(kinds) != 1:
+        raise ctx.fail(key, f"give exactly one of {', '.join(CLIP_KINDS)} (its radius or half-edge)")
+    size = ctx.num(f"{key}.{kinds[0]}", raw[kinds[0]], 1e-9, 1e9)
+    center = ctx.vec(f"{key}.center", raw["center"], -1e9, 1e9) if "center" in raw else (0.0, 0.0, 0.0)
+    return Clip(kind=kinds[0], size=size, center=center)
 
 
 def _node(ctx: Reader, key: str, raw: Any, named: dict[str, Material], depth: int) -> Node:
@@ -107,7 +120,10 @@ def _node(ctx: Reader, key: str, raw: Any, named: dict[str, Material], depth: in
         raise ctx.fail(key, "expected a mapping (a shape, an inline equation or a CSG operation)")
     ops = [op for op in CSG_OPS if op in raw]
     if not ops:
-        return _leaf(ctx, key, raw, named)
+        leaf = _leaf(ctx, key, raw, named)
+        if depth > 0 and leaf.clip is not None:
+            raise ctx.fail(f"{key}.clip", "only for a top-level shape (a CSG intersection cuts a solid)")
+        return leaf
     if len(ops) > 1:
         raise ctx.fail(key, f"one CSG operation per node (found {', '.join(ops)})")
     op = ops[0]

@@ -22,6 +22,7 @@ OPS = {
     "intersection": abi.value("RT_INTERSECTION"),
     "difference": abi.value("RT_DIFFERENCE"),
 }
+CLIPS = {"sphere": abi.value("RT_CLIP_SPHERE"), "box": abi.value("RT_CLIP_BOX")}
 
 _d = ctypes.c_double
 _pd = ctypes.POINTER(ctypes.c_double)
@@ -40,6 +41,7 @@ def bind(lib: ctypes.CDLL) -> ctypes.CDLL:
         "rt_scene_add_leaf": (ctypes.c_int, [vp, vp, _pd, ctypes.c_int, _pd, ctypes.c_int]),
         "rt_scene_add_csg": (ctypes.c_int, [vp, ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_int]),
         "rt_scene_add_object": (ctypes.c_int, [vp, ctypes.c_int]),
+        "rt_scene_set_clip": (ctypes.c_int, [vp, ctypes.c_int, ctypes.c_int, _pd, _d]),
         "rt_scene_add_light": (ctypes.c_int, [vp, _pd, _pd]),
         "rt_scene_set_camera": (None, [vp, _pd, _pd, _pd, _d]),
         "rt_scene_set_background": (None, [vp, _pd]),
@@ -83,6 +85,7 @@ class CScene:
             raise MemoryError("rt_scene_new failed")
         self._materials: dict[int, int] = {}
         self._built = built
+        self.leaf_nodes: dict[int, Leaf] = {}  # C node index -> the leaf it was made from (RtHit.leaf)
         try:
             self._fill(scene)
         except BaseException:
@@ -109,10 +112,15 @@ class CScene:
             shape = self.lib.rt_scene_shape(entry_i)
             params = leaf_params(entry, n)
             mat = self._material(n.material or inherited)
-            return self._check(
+            k = self._check(
                 self.lib.rt_scene_add_leaf(self.ptr, shape, darr(params), len(params), darr(n.matrix.reshape(-1)), mat),
                 n.where,
             )
+            if n.clip is not None:
+                c = n.clip
+                self._check(self.lib.rt_scene_set_clip(self.ptr, k, CLIPS[c.kind], darr(c.center), c.size), n.where)
+            self.leaf_nodes[k] = n
+            return k
         mat = n.material or inherited
         left = self._node(n.left, mat)
         right = self._node(n.right, mat)

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from implgen.codegen.spec import Spec, parse_spec
-from implgen.scene.model import Camera, Csg, Leaf, Light, Material, Node, Scene
+from implgen.scene.model import Camera, Clip, Csg, Leaf, Light, Material, Node, Scene
 
 CLIPS = ("none", "sphere", "box")
 LIGHTS = ("studio", "headlight", "top", "scene")
@@ -28,8 +28,8 @@ STARTER = {
 
 
 def _clip_spec(kind: str) -> Spec:
-    """The clip solid, its size `r` a run-time param: a ball of radius r, or the cube [-r, r]^3 (a ball that
-    holds the cube, cut by its bounds box: inside CSG a leaf is its solid cut by its bounds)."""
+    """The cut option's clip solid, its size `r` a run-time param: a ball of radius r, or the cube [-r, r]^3 (a
+    ball that holds the cube, cut by its bounds box: inside CSG a leaf is its solid cut by its bounds)."""
     eq = "x^2 + y^2 + z^2 - r^2" if kind == "sphere" else "x^2 + y^2 + z^2 - 4*r^2"
     box = {a: ["-r", "r"] for a in "xyz"}
     return parse_spec({"name": f"clip_{kind}", "equation": eq, "params": {"r": 1.0}, "bounds": box}, "clip")
@@ -74,6 +74,7 @@ class Orbit:
 class Options:
     clip: str = "sphere"
     clip_size: float = 3.0
+    cut: bool = False  # False: the surface inside the clip, cut open (as SURFER); True: the solid, its cut capped
     color: tuple[float, float, float] = (0.95, 0.75, 0.3)
     inside: tuple[float, float, float] = (0.35, 0.55, 0.95)
     lights: str = "studio"
@@ -91,6 +92,8 @@ class Document:
     options: Options = field(default_factory=Options)
     base: Scene | None = None
     leaf: Leaf | None = None
+    # a scene file's leaves edited so far, other than `leaf`: id(leaf) -> (its spec, its param values)
+    edits: dict[int, tuple[Spec, dict[str, float]]] = field(default_factory=dict)
 
     @staticmethod
     def for_spec(spec: Spec) -> Document:
@@ -113,6 +116,63 @@ class Document:
         doc.orbit = Orbit.looking(scene.camera)
         doc.options = Options(clip="none", lights="scene", background=scene.background)
         return doc
+
+    def state(self) -> dict:
+        """What the page starts from: the shape, its values, the camera, the options (and a scene's objects)."""
+        o, orbit = self.options, self.orbit
+        return {
+            "name": self.spec.name,
+            "equation": self.spec.equation,
+            "params": self.spec.params,
+            "values": self.values,
+            "degree": self.spec.degree,
+            "mode": "spec" if self.base is None else "scene",
+            "objects": self.objects(),
+            "object": self.object_index(),
+            "orbit": {
+                "yaw": orbit.yaw,
+                "pitch": orbit.pitch,
+                "distance": orbit.distance,
+                "target": list(orbit.target),
+                "fov": orbit.fov,
+            },
+            "options": {
+                "clip": o.clip,
+                "clip_size": o.clip_size,
+                "cut": o.cut,
+                "color": list(o.color),
+                "inside": list(o.inside),
+                "lights": o.lights,
+                "background": list(o.background),
+            },
+        }
+
+    def objects(self) -> list[dict]:
+        """A scene file's leaves, as the page lists them to pick one: the shape's name and where it is."""
+        if self.base is None:
+            return []
+        out = []
+        for i, leaf in enumerate(self.base.leaves()):
+            spec = self.spec if leaf is self.leaf else self.edits.get(id(leaf), (leaf.spec,))[0]
+            out.append({"index": i, "name": spec.name, "where": leaf.where})
+        return out
+
+    def object_index(self) -> int | None:
+        if self.base is None:
+            return None
+        return next(i for i, leaf in enumerate(self.base.leaves()) if leaf is self.leaf)
+
+    def select(self, index: int) -> None:
+        """Edit the scene file's leaf `index` (in leaves() order) from now on; the edits of the one edited so
+        far are kept."""
+        leaves = self.base.leaves() if self.base is not None else []
+        if not 0 <= index < len(leaves):
+            raise IndexError(index)
+        self.edits = dict(self.edits)  # a copy: a trial document (dataclasses.replace) shares the dict
+        self.edits[id(self.leaf)] = (self.spec, dict(self.values))
+        self.leaf = leaves[index]
+        self.spec, values = self.edits.pop(id(self.leaf), (self.leaf.spec, self.leaf.params))
+        self.values = dict(values)
 
     def set_spec(self, spec: Spec) -> None:
         """A new shape: a param keeps its slider value while its name and default stay, else takes the default."""
@@ -147,6 +207,9 @@ class Document:
         leaf = Leaf(spec=self.spec, params=dict(self.values), matrix=np.eye(3, 4), material=None, where="shape")
         if self.options.clip == "none":
             return leaf
+        if not self.options.cut:  # the surface inside the ball or the cube, cut open: both sides show
+            leaf.clip = Clip(kind=self.options.clip, size=self.options.clip_size)
+            return leaf
         clip = Leaf(
             spec=CLIP_SPECS[self.options.clip],
             params={"r": self.options.clip_size},
@@ -165,19 +228,21 @@ class Document:
             sc.objects = [node]
         else:
             sc = replace(self.base, width=width, height=height, spp=spp)
-            sc.objects = [_with_leaf(obj, self.leaf, self.spec, self.values) for obj in self.base.objects]
+            edits = {**self.edits, id(self.leaf): (self.spec, self.values)}
+            sc.objects = [_with_leaf(obj, edits) for obj in self.base.objects]
         sc.camera = self.orbit.camera()
         sc.lights = self.lights()
         sc.background = self.options.background
         return sc
 
 
-def _with_leaf(node: Node, target: Leaf | None, spec: Spec, values: dict[str, float]) -> Node:
-    """A copy of the tree with the edited leaf given the current spec and params."""
+def _with_leaf(node: Node, edits: dict[int, tuple[Spec, dict[str, float]]]) -> Node:
+    """A copy of the tree with each edited leaf given its spec and params."""
     if isinstance(node, Leaf):
-        if node is target:
+        if id(node) in edits:
+            spec, values = edits[id(node)]
             return replace(node, spec=spec, params=dict(values))
         return node
-    left = _with_leaf(node.left, target, spec, values)
-    right = _with_leaf(node.right, target, spec, values)
+    left = _with_leaf(node.left, edits)
+    right = _with_leaf(node.right, edits)
     return Csg(op=node.op, left=left, right=right, material=node.material, where=node.where)

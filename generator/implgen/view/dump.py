@@ -56,6 +56,10 @@ def _node(n: Node) -> dict:
         if not np.array_equal(n.matrix, np.eye(3, 4)):
             m = n.matrix
             out["transform"] = {"position": _vec(m[:, 3]), "axes": [_vec(m[:, i]) for i in range(3)]}
+        if n.clip is not None:
+            out["clip"] = {n.clip.kind: _num(n.clip.size)}
+            if any(n.clip.center):
+                out["clip"]["center"] = _vec(n.clip.center)
     else:
         out = {n.op: [_node(n.left), _node(n.right)]}
     if n.material is not None:
@@ -82,3 +86,19 @@ def scene_mapping(sc: Scene) -> dict:
 
 def to_yaml(mapping: dict) -> str:
     return yaml.safe_dump(mapping, sort_keys=False, default_flow_style=None, width=110)
+
+
+def yaml_text(doc, width: int, height: int, spp: int) -> str:
+    """The viewer's document (view/document.py) as a scene file `implgen render` takes: camera, lights,
+    background, the shape inline with its clip and colours (or a scene file's objects), the page's full frame as
+    its image (on the parse pool: SymPy prints the equations). Rendered, it is the page's full frame, pixel for
+    pixel."""
+    return to_yaml(scene_mapping(doc.scene(width, height, spp)))
+
+
+def c_text(spec: Spec) -> str:
+    """What `implgen SPEC.yaml --lang c` writes for the shape (on the parse pool)."""
+    from implgen.codegen.emit import generate
+
+    files = generate(spec, langs=("c",))
+    return "".join(f"/* ---- {name} ---- */\n{text}\n" for name, text in sorted(files.items()))

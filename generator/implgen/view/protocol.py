@@ -7,7 +7,10 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
     {"type": "render", "seq": 7, "refine": true, "width": 640, "height": 480,
      "values": {"a": 1.2}, "orbit": {...}, "options": {...}}          the view to show (the newest wins)
     {"type": "save_png", "width": 1920, "height": 1080, "spp": 16}    the current view through render()
-    {"type": "save_yaml"} / {"type": "show_c"}                        the spec or scene / the generated C
+    {"type": "save_yaml", "width": 640, "height": 480}               the view as a scene file (its full frame)
+    {"type": "show_c"}                                                the generated C
+    {"type": "pick", "x": 120, "y": 80, "width": 640, "height": 480}  a scene file: edit the object at a pixel
+    {"type": "object", "index": 2}                                    a scene file: edit this leaf
 
 Bad values raise UserError naming the message field; the session sends the line back to the page. Every
 error reply, whatever failed, is built here (`error`, `error_for`). An equation's parse (seconds of SymPy at
@@ -36,7 +39,7 @@ MAX_FRAME = (2048, 2048)  # the largest interactive frame
 MAX_SAVE = (8192, 8192)  # the largest saved picture
 MAX_SAVE_PIXELS = 8192 * 4608  # 8K at 16:9
 MAX_SAVE_SPP = 64
-TYPES = ("shape", "render", "save_png", "save_yaml", "show_c")
+TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object")
 PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
 
 _parsed: OrderedDict[str, Spec | UserError] = OrderedDict()
@@ -118,20 +121,41 @@ def _parse(mapping: dict[str, Any]) -> Spec:
     return hit
 
 
+def _used(spec: Spec) -> set[str]:
+    """The params the equation or the bounds use."""
+    symbols = set(spec.f.free_symbols)
+    for lo, hi in (spec.bounds or {}).values():
+        symbols |= lo.free_symbols | hi.free_symbols
+    return {p for p in spec.params if param_symbol(p) in symbols}
+
+
+def _parse_used(mapping: dict[str, Any]) -> Spec:
+    """_parse, and again without the params neither the equation nor the bounds use (no slider for them)."""
+    spec = _parse(mapping)
+    used = _used(spec)
+    if len(used) < len(spec.params):
+        mapping = {**mapping, "params": {k: v for k, v in mapping["params"].items() if k in used}}
+        if not mapping["params"]:
+            del mapping["params"]
+        spec = _parse(mapping)
+    return spec
+
+
 def parse_shape(data: dict, current: Spec) -> Spec:
-    """A new equation and param defaults, through the spec parser. The current shape's name is kept, and its
-    bounds while the equation stays the same (new defaults only): a box made for one surface would cut
-    another one anywhere."""
-    mapping: dict[str, Any] = {"name": current.name, "equation": data.get("equation")}
+    """A new equation, its name (the page sends `surface` for a typed one; the spec parser checks it) and param
+    defaults, through the spec parser; params the equation does not use are dropped. Without a name the current
+    shape's is kept, and its bounds while the equation stays the same (new defaults
+    only): a box made for one surface would cut another one anywhere."""
+    mapping: dict[str, Any] = {"name": data.get("name", current.name), "equation": data.get("equation")}
     if data.get("params"):
         mapping["params"] = _mapping("params", data["params"])
     if data.get("bounds") is not None:  # given: checked like a spec file's
-        return _parse({**mapping, "bounds": data["bounds"]})
-    spec = _parse(mapping)
+        return _parse_used({**mapping, "bounds": data["bounds"]})
+    spec = _parse_used(mapping)
     bounds = _bounds_text(current)
     if bounds is not None and spec.equation == current.equation:
         try:
-            return _parse({**mapping, "bounds": bounds})
+            return _parse_used({**mapping, "bounds": bounds})
         except UserError:
             pass  # a param the bounds need was removed: unbounded
     return spec
@@ -167,6 +191,10 @@ def parse_options(raw: Any) -> Options:
     o = Options()
     o.clip = _choice("clip", raw.get("clip", o.clip), CLIPS)
     o.clip_size = validate.number("options", "clip_size", raw.get("clip_size", o.clip_size), 1e-3, 1e6)
+    cut = raw.get("cut", o.cut)
+    if not isinstance(cut, bool):
+        raise UserError("options", "cut: expected true or false")
+    o.cut = cut
     o.color = validate.vector("options", "color", raw.get("color", list(o.color)), 0.0, 1.0)
     o.inside = validate.vector("options", "inside", raw.get("inside", list(o.inside)), 0.0, 1.0)
     o.lights = _choice("lights", raw.get("lights", o.lights), LIGHTS)
@@ -184,6 +212,21 @@ def parse_render(data: dict, spec: Spec) -> RenderRequest:
         orbit=parse_orbit(data.get("orbit", {})),
         options=parse_options(data.get("options", {})),
     )
+
+
+def parse_size(data: dict, what: str) -> tuple[int, int]:
+    """The page's full frame size (Save YAML writes it as the scene's image)."""
+    w = validate.whole(what, "width", data.get("width", 640), 16, MAX_FRAME[0])
+    h = validate.whole(what, "height", data.get("height", 480), 16, MAX_FRAME[1])
+    return w, h
+
+
+def parse_pick(data: dict) -> tuple[float, float, int, int]:
+    """A pixel of the page's full frame: (x, y, width, height)."""
+    w, h = parse_size(data, "pick")
+    x = validate.number("pick", "x", data.get("x"), 0.0, w - 1)
+    y = validate.number("pick", "y", data.get("y"), 0.0, h - 1)
+    return x, y, w, h
 
 
 def parse_save(data: dict) -> tuple[int, int, int]:

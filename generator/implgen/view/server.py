@@ -1,4 +1,5 @@
-"""The viewer's web server: Starlette routes for the page's own three files and one WebSocket per page.
+"""The viewer's web server: Starlette routes for the page's own files (the page, its script, its style, its
+icon) and one WebSocket per page.
 
 Nothing else is served: the static files are a fixed table read from the package, not a folder mapped onto
 URLs. Messages are bounded (uvicorn's ws_max_size and protocol.MAX_MESSAGE); each page gets its own Session,
@@ -38,7 +39,10 @@ log = logging.getLogger("implgen.view")
 
 STATIC = {
     "/": ("index.html", "text/html; charset=utf-8"),
+    "/favicon.svg": ("favicon.svg", "image/svg+xml"),
+    "/favicon.ico": ("favicon.ico", "image/x-icon"),
     "/app.js": ("app.js", "text/javascript; charset=utf-8"),
+    "/share.js": ("share.js", "text/javascript; charset=utf-8"),
     "/style.css": ("style.css", "text/css; charset=utf-8"),
 }
 HEADERS = {
@@ -116,6 +120,8 @@ def create_app(
             return
         await ws.accept()
         if pages["open"] >= work.limits.max_pages:
+            message = f"too many pages open (at most {work.limits.max_pages}): close one, then reload this one"
+            await ws.send_json(protocol.error("pages", message))
             await ws.close(code=1013, reason="too many pages open")
             return
 

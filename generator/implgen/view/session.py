@@ -1,11 +1,15 @@
 """One page's session: its document, its compiled library, and the render loop where the newest request wins.
 
 Messages arrive on the event loop; a `render` request replaces whatever request is waiting and cancels the
-render that is running (rt_render_cancel: the C threads stop after their current row), so stale frames are
-never queued. Nothing slow runs on the event loop: parses and builds go to the `parse` pool, live frames to the
-`render` pool, saves to the `save` pool (work.py), each C render under a Ticket with its time budget. Each
-request is first drawn coarse (a quarter of the size, 1 sample per pixel, sent as JPEG) and, when it asks to be
-refined and nothing newer has come, at full size with 4 samples (sent as PNG).
+refined render that is running (rt_render_cancel: the C threads stop after their current row), so stale
+frames are never queued. A coarse frame in flight is finished and sent (or cut by its time budget, pace.py):
+throwing it away at each mouse move would leave a drag with no frames at all when a frame takes longer than
+the gap between moves. Nothing slow runs on the event loop: parses and builds go to the `parse` pool, live
+frames to the `render` pool, saves to the `save` pool (work.py), each C render under a Ticket with its time
+budget. Each request is first drawn coarse (1 sample per pixel, sent as JPEG, its size chosen by pace.py so
+that it takes about 30 ms) and, when it asks to be refined and nothing newer has come, at full size with 4
+samples (sent as PNG; first at 1 sample when the 4 would take more than REFINE_TARGET). A refined request for
+the view the last coarse frame showed goes straight to the full frame.
 
 A slider moves a param value: the scene description is rebuilt around the already loaded library (microseconds;
 params are run-time values of the generated code). A new equation is parsed once (protocol.py keeps the recent
@@ -25,22 +29,26 @@ from dataclasses import replace
 
 import numpy as np
 
+from implgen import validate
 from implgen.errors import UserError
 from implgen.imagefile import encode_jpeg, encode_png, to_uint8
-from implgen.scene.build import BuildResult, build_scene
+from implgen.scene.build import BuildResult, build_scene, runtime_ready
 from implgen.scene.model import Scene
 from implgen.scene.render import usable_cores
 from implgen.scene.renderjob import RenderJob
 from implgen.scene.tracer import CScene
-from implgen.view import dump, protocol
+from implgen.view import dump, fit, pick, protocol
 from implgen.view.document import Document
+from implgen.view.pace import CUT, Pace
 from implgen.view.work import Ticket, Work
 
-COARSE_DIVISOR = 4
 FULL_SPP = 4
 MAX_RENDERS_PER_SECOND = 60  # per page: requests beyond this wait (and are overtaken by newer ones)
-KIND_COARSE, KIND_FULL, KIND_SAVE = 0, 1, 2
-HEADER = struct.Struct(">IBxxxHH")  # seq, kind, width, height; the image bytes follow
+KIND_COARSE, KIND_FULL, KIND_SAVE, KIND_ONE = 0, 1, 2, 3  # KIND_ONE: full size at 1 sample, before KIND_FULL
+BUILD_QUIET, BUILD_POLL = 0.2, 0.4  # seconds: a build says nothing before the first, then repeats its progress
+REFINE_TARGET = 0.4  # seconds: a refined frame expected to take longer is first sent at 1 sample (KIND_ONE)
+HEADER = struct.Struct(">IBBxxHH")  # seq, kind, flags, width, height; the image bytes follow
+FLAG_EMPTY = 1  # no pixel of the frame shows anything but the background: no real points in view
 LIVE_JPEG_QUALITY = 88  # the coarse frame: small and soon replaced
 LIVE_PNG_LEVEL = 1  # the full frame: speed over size (zlib level 1)
 BAND = 256  # rows converted to 8 bits at a time: no float temporaries the size of a whole saved picture
@@ -70,9 +78,10 @@ def _eight_bits(img: np.ndarray) -> np.ndarray:
     return out
 
 
-def _trace(ticket: Ticket, loop, sc: Scene, lib: BuildResult, spp: int, threads: int, encode) -> bytes | None:
-    """On a pool thread: one C render of `sc` under its ticket, encoded; None when cancelled (by the page, or by
-    the budget: ticket.expired says which). The same context and samples as render() (renderjob.py)."""
+def _trace(ticket: Ticket, loop, sc: Scene, lib: BuildResult, spp: int, threads: int, encode):
+    """On a pool thread: one C render of `sc` under its ticket, encoded, and whether it shows nothing but the
+    background; None when cancelled (by the page, or by the budget: ticket.expired says which). The same
+    context and samples as render() (renderjob.py)."""
     if ticket.cancelled:
         return None
     cs = CScene(sc, lib.for_scene(sc, fold=False))
@@ -87,7 +96,10 @@ def _trace(ticket: Ticket, loop, sc: Scene, lib: BuildResult, spp: int, threads:
             job.image = img = None  # the float picture is not kept while the bytes are encoded
     finally:
         cs.close()
-    return None if rgb8 is None else encode(rgb8)
+    if rgb8 is None:
+        return None
+    background = to_uint8(np.asarray(sc.background, np.float32).reshape(1, 1, 3))
+    return encode(rgb8), bool((rgb8 == background).all())
 
 
 _default_work: Work | None = None
@@ -110,6 +122,11 @@ class Session:
         self._pending: protocol.RenderRequest | None = None
         self._wake = asyncio.Event()
         self._live: Ticket | None = None  # the live render in progress
+        self._live_full = False  # it is a refined frame (a newer request cancels it; a coarse one is finished)
+        self._shown: tuple | None = None  # the view the last coarse frame showed
+        self.pace = Pace()  # the coarse frames' size
+        self._seconds = 0.0  # the last render's wall time, encoding included
+        self._told = False  # the page was told a build is going on
         self._save: Ticket | None = None  # the save's render in progress
         self._cost: float | None = None  # core seconds a sample of the last render of this shape
         self._last_start = 0.0
@@ -121,31 +138,20 @@ class Session:
 
     def hello(self) -> dict:
         """The state the page starts from."""
-        d = self.doc
-        o = d.options
+        limits = {"frame": protocol.MAX_FRAME, "save": protocol.MAX_SAVE, "save_spp": protocol.MAX_SAVE_SPP}
+        return {"type": "hello", **self.doc.state(), "limits": limits}
+
+    def _shape_reply(self, **extra) -> dict:
+        """The page's new shape: its name, equation, params and their values (and what `extra` adds)."""
+        spec = self.doc.spec
         return {
-            "type": "hello",
-            "equation": d.spec.equation,
-            "params": d.spec.params,
-            "values": d.values,
-            "degree": d.spec.degree,
-            "mode": "spec" if d.base is None else "scene",
-            "orbit": {
-                "yaw": d.orbit.yaw,
-                "pitch": d.orbit.pitch,
-                "distance": d.orbit.distance,
-                "target": list(d.orbit.target),
-                "fov": d.orbit.fov,
-            },
-            "options": {
-                "clip": o.clip,
-                "clip_size": o.clip_size,
-                "color": list(o.color),
-                "inside": list(o.inside),
-                "lights": o.lights,
-                "background": list(o.background),
-            },
-            "limits": {"frame": protocol.MAX_FRAME, "save": protocol.MAX_SAVE, "save_spp": protocol.MAX_SAVE_SPP},
+            "type": "shape",
+            "name": spec.name,
+            "equation": spec.equation,
+            "params": spec.params,
+            "values": self.doc.values,
+            "degree": spec.degree,
+            **extra,
         }
 
     async def handle(self, text: str | bytes) -> None:
@@ -166,12 +172,35 @@ class Session:
                 self._saving = asyncio.get_running_loop().create_task(self._save_png(width, height, spp))
                 self._saving.add_done_callback(lambda _: release())
             elif kind == "save_yaml":
-                text = await self.work.call(self.work.parse, yaml_text, replace(self.doc))
+                width, height = protocol.parse_size(data, "save_yaml")
+                text = await self.work.call(self.work.parse, dump.yaml_text, replace(self.doc), width, height, FULL_SPP)
                 await self.send({"type": "yaml", "mode": self._mode(), "text": text})
+            elif kind in ("pick", "object"):
+                await self._pick(data)
             elif kind == "show_c":
-                await self.send({"type": "c", "text": await self.work.call(self.work.parse, c_text, self.doc.spec)})
+                await self.send(
+                    {"type": "c", "text": await self.work.call(self.work.parse, dump.c_text, self.doc.spec)}
+                )
         except UserError as err:
             await self.send(protocol.error_for(err))
+
+    async def _pick(self, data: dict) -> None:
+        """A scene file: the leaf to edit from now on, the one at a pixel of the picture or by its index."""
+        count = len(self.doc.objects())
+        if count == 0:
+            raise UserError(data["type"], "only a scene file has objects to pick")
+        if data["type"] == "pick":
+            x, y, width, height = protocol.parse_pick(data)
+            sc = self.doc.scene(width, height, 1)
+            index = await self.work.call(self.work.render, pick.pick_leaf, sc, await self._library(sc), x, y)
+            if index is None:
+                raise UserError("pick", "nothing there: the ray through that pixel meets no object")
+        else:
+            index = validate.whole("object", "index", data.get("index"), 0, count - 1)
+        self.doc.select(index)
+        self._cost = None
+        self.pace.new_shape()
+        await self.send(self._shape_reply(fit=None, object=index, objects=self.doc.objects()))
 
     def _mode(self) -> str:
         return "spec" if self.doc.base is None else "scene"
@@ -181,17 +210,15 @@ class Session:
         trial = replace(self.doc)  # the page keeps showing the current shape until the new one is built
         trial.set_spec(spec)
         await self._library(trial.scene())
+        fitted = None
+        if data.get("fit") is True:  # the page's clip size is not the user's own: fit it to the new surface
+            probe = fit.probe_scene(spec, trial.values)
+            fitted = await self.work.call(self.work.render, fit.fit_clip, probe, await self._library(probe))
         self.doc.spec, self.doc.values = trial.spec, trial.values
+        self._shown = None  # an accepted shape is drawn coarse first, even the same one again
         self._cost = None  # measured anew by the new shape's first render
-        await self.send(
-            {
-                "type": "shape",
-                "equation": spec.equation,
-                "params": spec.params,
-                "values": self.doc.values,
-                "degree": spec.degree,
-            }
-        )
+        self.pace.new_shape()
+        await self.send(self._shape_reply(fit=fitted, objects=self.doc.objects()))
 
     # ------------------------------------------------------------------ rendering
 
@@ -202,14 +229,36 @@ class Session:
         specs = sc.specs()
         built = self.work.library(specs)
         if built is None:
-            built = await self.work.call(self.work.parse, build_scene, sc)
+            telling = asyncio.get_running_loop().create_task(self._tell_build())
+            try:
+                built = await self.work.call(self.work.parse, build_scene, sc)
+            finally:
+                telling.cancel()
+                if self._told:
+                    self._told = False
+                    await self.send({"type": "status", "text": ""})
             self.work.keep_library(specs, built)
         return built
 
+    async def _tell_build(self) -> None:
+        """While a build lasts more than a moment: what it does, for the page's status ("compiling the runtime
+        (first run only): 3 of 9 files", once per build cache; then the shape)."""
+        await asyncio.sleep(BUILD_QUIET)
+        while True:
+            done, total = await asyncio.to_thread(runtime_ready)
+            if done < total:
+                text = f"compiling the runtime (first run only): {done} of {total} files"
+            else:
+                text = "compiling the shape"
+            self._told = True
+            await self.send({"type": "status", "text": text})
+            await asyncio.sleep(BUILD_POLL)
+
     def request(self, req: protocol.RenderRequest) -> None:
-        """The newest request wins: it replaces the waiting one and cancels the running render."""
+        """The newest request wins: it replaces the waiting one and cancels the running refined render (a
+        coarse one is finished: it is the drag's next frame)."""
         self._pending = req
-        if self._live is not None:
+        if self._live is not None and self._live_full:
             self._live.cancel()
         self._wake.set()
         if self._task is None or self._task.done():
@@ -236,38 +285,65 @@ class Session:
                 await self._failed(err, "viewer render failed")
 
     async def _frames(self, req: protocol.RenderRequest) -> None:
-        cw, ch = max(1, req.width // COARSE_DIVISOR), max(1, req.height // COARSE_DIVISOR)
-        data = await self._render(cw, ch, 1, _live_jpeg)
-        if data is None:
-            return
-        await self._send_frame(req.seq, KIND_COARSE, cw, ch, data)
-        if req.refine and self._pending is None:
-            data = await self._render(req.width, req.height, FULL_SPP, _live_png)
+        view = (req.width, req.height, req.values, req.orbit, req.options, id(self.doc.spec))
+        while not (req.refine and view == self._shown):
+            cw, ch = self.pace.size(req.width, req.height)
+            smallest = self.pace.smallest(req.width, req.height, cw)
+            data, ticket = await self._render(cw, ch, 1, _live_jpeg, full=False, cut=not smallest)
             if data is not None:
-                await self._send_frame(req.seq, KIND_FULL, req.width, req.height, data)
+                self.pace.measured(cw * ch, self._seconds)
+                self._shown = view
+                await self._send_frame(req.seq, KIND_COARSE, cw, ch, *data)
+                break
+            if ticket is None or not ticket.expired:
+                return  # cancelled: the page closed
+            done_seconds, rows = ticket.expired  # cut: the rows done say what a pixel costs
+            if rows:
+                self.pace.measured(rows * cw, done_seconds)
+            else:
+                self.pace.cut(cw * ch)
+            if self._pending is not None:
+                return  # the next request is drawn at the new size
+            # else this view again, smaller: it is all the page will see until the next move
+        if req.refine and self._pending is None:
+            per_pixel = self.pace.seconds_per_pixel
+            if per_pixel is None or per_pixel * req.width * req.height * FULL_SPP > REFINE_TARGET:
+                data, _ = await self._render(req.width, req.height, 1, _live_png, full=True)
+                if data is None or self._pending is not None:
+                    return
+                await self._send_frame(req.seq, KIND_ONE, req.width, req.height, *data)
+            data, _ = await self._render(req.width, req.height, FULL_SPP, _live_png, full=True)
+            if data is not None:
+                await self._send_frame(req.seq, KIND_FULL, req.width, req.height, *data)
 
-    async def _send_frame(self, seq: int, kind: int, width: int, height: int, data: bytes) -> None:
-        await self.send(HEADER.pack(seq, kind, width, height) + data)
+    async def _send_frame(self, seq: int, kind: int, width: int, height: int, data: bytes, empty: bool) -> None:
+        await self.send(HEADER.pack(seq, kind, FLAG_EMPTY if empty else 0, width, height) + data)
         self.frames += 1
 
-    async def _render(self, width: int, height: int, spp: int, encode: Callable) -> bytes | None:
-        """The document's current view, encoded; None when a newer request cancelled it. Over its time budget:
-        a UserError saying what the surface costs."""
+    async def _render(
+        self, width: int, height: int, spp: int, encode: Callable, full: bool, cut: bool = False
+    ) -> tuple[tuple[bytes, bool] | None, Ticket | None]:
+        """The document's current view, encoded, and its ticket; no bytes when a newer request cancelled it (a
+        refined frame) or when it was `cut` after pace.CUT seconds (a coarse frame: ticket.expired says so).
+        Over the render budget: a UserError saying what the surface costs."""
         sc = self.doc.scene(width, height, spp)
         lib = await self._library(sc)
-        if self._pending is not None:  # overtaken while the scene was being built
-            return None
-        ticket = Ticket(self.work.limits.render_budget, "render", "render", width, spp, self.threads)
+        if full and self._pending is not None:  # overtaken while the scene was being built
+            return None, None
+        budget = min(CUT, self.work.limits.render_budget) if cut else self.work.limits.render_budget
+        ticket = Ticket(budget, "render", "render", width, spp, self.threads)
         ticket.check_rows(self._cost)
-        self._live = ticket
+        self._live, self._live_full = ticket, full
+        t0 = time.perf_counter()
         try:
             data = await self.work.trace(self.work.render, ticket, _trace, sc, lib, spp, self.threads, encode)
         finally:
+            self._seconds = time.perf_counter() - t0  # the render and its encoding, as the page waits for them
             self._live = None
             self._cost = ticket.cost or self._cost
-        if data is None and ticket.expired:
+        if data is None and ticket.expired and not cut:
             raise ticket.over_budget()
-        return data
+        return data, ticket
 
     async def _save_png(self, width: int, height: int, spp: int) -> None:
         """The current view at any size: the same C render context and samples as render(), and the PNG encoder
@@ -289,7 +365,7 @@ class Session:
             return
         finally:
             self._save = None
-        await self.send(HEADER.pack(0, KIND_SAVE, width, height) + data)
+        await self.send(HEADER.pack(0, KIND_SAVE, 0, width, height) + data[0])
 
     async def _failed(self, err: Exception, what: str) -> None:
         """Tell the page what failed; a bug (not bad input) also goes to the log with its traceback."""
@@ -307,18 +383,3 @@ class Session:
         for t in tasks:
             t.cancel()
         await asyncio.gather(*tasks, return_exceptions=True)  # work.trace waits for the C threads to stop
-
-
-def yaml_text(doc: Document) -> str:
-    """The document as a spec, or for a scene file the whole scene (on the parse pool: SymPy prints it)."""
-    if doc.base is None:
-        return dump.to_yaml(dump.spec_mapping(doc.spec, doc.values))
-    return dump.to_yaml(dump.scene_mapping(doc.scene(spp=FULL_SPP)))
-
-
-def c_text(spec) -> str:
-    """What `implgen SPEC.yaml --lang c` writes for the shape (on the parse pool)."""
-    from implgen.codegen.emit import generate
-
-    files = generate(spec, langs=("c",))
-    return "".join(f"/* ---- {name} ---- */\n{text}\n" for name, text in sorted(files.items()))

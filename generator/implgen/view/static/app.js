@@ -6,8 +6,11 @@
   const $ = (id) => document.getElementById(id);
   const canvas = $("view");
   const ctx2d = canvas.getContext("2d");
-  const HEADER = 12; // seq (u32), kind (u8), 3 spare bytes, width (u16), height (u16)
-  const KIND_COARSE = 0, KIND_FULL = 1, KIND_SAVE = 2;
+  const HEADER = 12; // seq (u32), kind (u8), flags (u8), 2 spare bytes, width (u16), height (u16)
+  const KIND_COARSE = 0, KIND_FULL = 1, KIND_SAVE = 2, KIND_ONE = 3;
+  const RANK = { [KIND_COARSE]: 0, [KIND_ONE]: 1, [KIND_FULL]: 2 }; // a newer frame of the same request wins
+  const KIND_NAME = { [KIND_COARSE]: "coarse", [KIND_ONE]: "full, 1 sample", [KIND_FULL]: "full" };
+  const FLAG_EMPTY = 1; // the frame shows nothing but the background
 
   const state = {
     params: {}, // name -> default (as the server parsed it)
@@ -19,6 +22,10 @@
   };
   let ws = null;
   let lastError = ""; // the server's last error line, kept when the socket closes after it
+  let messageIsError = false; // the message line holds an error: the next picture clears it
+  let errorSeq = 0; // ... a picture of a request sent after the error came, not an older one still on its way
+  const overlay = { connect: "connecting...", build: "", empty: false }; // what the picture's overlay says
+  let lastBitmap = null; // the picture drawn last, drawn again when the canvas changes size
   let seq = 0;
   let drawnSeq = -1;
   let drawnKind = -1;
@@ -33,16 +40,39 @@
     .toString(16).padStart(2, "0")).join("");
   const fromHex = (hex) => [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16) / 255);
 
+  // ---------------------------------------------------------------- what the page says
+  function showMessage(text, isError) {
+    $("message").textContent = text;
+    messageIsError = isError && text !== "";
+    if (isError) { lastError = text; errorSeq = seq; }
+  }
+
+  function showOverlay() {
+    // the most pressing first: a build in progress, the connection, an empty picture
+    $("overlay").textContent = overlay.build || overlay.connect || (overlay.empty ? "no real points in view" : "");
+  }
+
+  function showEmpty(empty) {
+    overlay.empty = empty;
+    showOverlay();
+  }
+
   // ---------------------------------------------------------------- messages out
   function send(msg) {
     if (ws && ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify(msg));
   }
 
+  let goodClipSize = null; // the clip size of the last picture drawn: used while the field holds no number
   function readOptions() {
-    const size = parseFloat($("clip-size").value);
+    const field = $("clip-size");
+    const size = Number(field.value);
+    const ok = field.value.trim() !== "" && Number.isFinite(size) && size > 0;
+    field.classList.toggle("bad", !ok);
+    if (!ok) showMessage("clip size: expected a positive number", true);
     return {
       clip: $("clip").value,
-      clip_size: Number.isFinite(size) ? size : state.options.clip_size,
+      clip_size: ok ? size : (goodClipSize ?? state.options.clip_size),
+      cut: $("cut").checked,
       color: fromHex($("color").value),
       inside: fromHex($("inside").value),
       lights: $("lights").value,
@@ -51,6 +81,8 @@
   }
 
   // A render request goes out at most once per animation frame; the newest view is what is sent.
+  // (The GPU preview, project issue 24 item 2, would draw the live picture itself here while the view moves,
+  // and leave the server's refined frame to replace it when the view rests.)
   function requestRender(refine) {
     if (queued) { queued.refine = queued.refine || refine; return; }
     queued = { refine };
@@ -58,13 +90,46 @@
       const q = queued;
       queued = null;
       seq += 1;
-      sentAt.set(seq, performance.now());
       state.options = readOptions();
+      if (q.refine) keepLink();
+      sentAt.set(seq, { t: performance.now(), clip: state.options.clip_size });
       send({
         type: "render", seq, refine: q.refine, width: canvas.width, height: canvas.height,
         values: state.values, orbit: state.orbit, options: state.options,
       });
     });
+  }
+
+  // The address carries the view (share.js): kept up to date whenever the view rests.
+  function keepLink() {
+    if (acceptedEquation === null) return;
+    const text = implgenLink.encode({
+      equation: acceptedEquation, name: $("shape-name").value, params: $("params-text").value,
+      values: state.values, orbit: state.orbit, options: state.options,
+    });
+    history.replaceState(null, "", `${location.pathname}${location.search}#${text}`);
+  }
+
+  // A share link's view, applied once the page has its first state from the server: its equation is sent as a
+  // new shape (its clip is the user's own: not fitted), its slider values wait for the shape's reply.
+  let linkValues = null;
+  function openLink() {
+    const { view, bad } = implgenLink.decode(location.hash);
+    // a note, not an error: the picture that follows does not clear it
+    if (bad.length) showMessage(`share link: left out what did not read: ${bad.join(", ")}`, false);
+    if (view.orbit) state.orbit = view.orbit;
+    if (view.options) {
+      setOptions(Object.assign(readOptions(), view.options));
+      if (view.options.clip !== undefined) userClip = true; // the link's clip (and camera) stay as they are
+      if (view.options.clip_size !== undefined) goodClipSize = view.options.clip_size;
+    }
+    if (view.equation === undefined) return false;
+    $("equation").value = view.equation;
+    if (view.params !== undefined) $("params-text").value = view.params;
+    if (view.name !== undefined) { $("shape-name").value = view.name; userName = true; }
+    linkValues = view.values || null;
+    applyShape();
+    return true;
   }
 
   // Coarse frames while something moves; refined once it has rested.
@@ -84,9 +149,40 @@
     return out;
   }
 
+  // The clip size is fitted to each new equation's real points until the user sets it.
+  let userClip = false;
+  const DEFAULT_CLIP = 3;
+  // A typed equation's shape is called "surface" unless the user names it; the same equation keeps its name.
+  let userName = false;
+  let sceneMode = false; // a scene file: the equation box edits one of its shapes, picked in the picture or a list
+  function showObjects(list, index) {
+    const select = $("object");
+    select.replaceChildren(...list.map((o) => Object.assign(document.createElement("option"),
+      { value: o.index, textContent: `${o.name} (${o.where})` })));
+    select.value = index;
+  }
+  let acceptedEquation = null; // the equation text the server last accepted (as the box showed it)
   function applyShape() {
     clearTimeout(typing);
-    send({ type: "shape", equation: $("equation").value, params: parseParamsText($("params-text").value) });
+    const text = $("equation").value;
+    const name = userName ? $("shape-name").value.trim()
+      : (text === acceptedEquation || sceneMode ? $("shape-name").value : "surface");
+    send({ type: "shape", equation: text, name, params: parseParamsText($("params-text").value),
+      fit: !userClip });
+  }
+
+  function fitClip(size) {
+    if (userClip) return;
+    const r = size ?? DEFAULT_CLIP; // none: the surface runs on (or has no real point): the default ball
+    const before = Number($("clip-size").value);
+    $("clip-size").value = r;
+    $("clip-size").classList.remove("bad");
+    goodClipSize = r;
+    if (!(before > 0) || Math.abs(r - before) > 0.2 * before) { // a new size: frame the ball
+      const o = state.orbit;
+      o.target = [0, 0, 0];
+      o.distance = r / Math.sin(o.fov * Math.PI / 360) * 1.1;
+    }
   }
 
   // ---------------------------------------------------------------- messages in
@@ -102,6 +198,8 @@
       }
     }
     $("params-text").value = Object.entries(msg.params).map(([k, v]) => `${k} = ${v}`).join(", ");
+    $("shape-name").value = msg.name;
+    acceptedEquation = $("equation").value;
     $("degree").textContent = `degree ${msg.degree}`;
     buildSliders();
   }
@@ -130,7 +228,8 @@
       max.setAttribute("aria-label", `${name} max`);
       const show = () => { value.textContent = Number(state.values[name]).toPrecision(4); };
       show();
-      slider.addEventListener("input", () => { state.values[name] = parseFloat(slider.value); show(); requestRender(false); });
+      // coarse while it moves, refined when it rests: even when it is let go where it started (no "change")
+      slider.addEventListener("input", () => { state.values[name] = parseFloat(slider.value); show(); moved(); });
       slider.addEventListener("change", () => requestRender(true));
       const setRange = () => {
         const a = parseFloat(min.value), b = parseFloat(max.value);
@@ -152,6 +251,7 @@
     state.options = o;
     $("clip").value = o.clip;
     $("clip-size").value = o.clip_size;
+    $("cut").checked = o.cut;
     $("color").value = toHex(o.color);
     $("inside").value = toHex(o.inside);
     $("background").value = toHex(o.background);
@@ -160,27 +260,35 @@
 
   async function drawFrame(buf) {
     const view = new DataView(buf);
-    const fseq = view.getUint32(0), kind = view.getUint8(4);
+    const fseq = view.getUint32(0), kind = view.getUint8(4), flags = view.getUint8(5);
     const w = view.getUint16(8), h = view.getUint16(10);
     const bytes = new Uint8Array(buf, HEADER);
     lastError = "";
     if (kind === KIND_SAVE) {
       download(new Blob([bytes], { type: "image/png" }), "implgen-view.png");
-      $("message").textContent = `saved ${w} x ${h} PNG`;
+      showMessage(`saved ${w} x ${h} PNG`, false);
       return;
     }
-    if (fseq < drawnSeq || (fseq === drawnSeq && kind <= drawnKind)) return; // stale
-    const type = kind === KIND_FULL ? "image/png" : "image/jpeg";
+    const rank = RANK[kind];
+    if (rank === undefined) return;
+    const stale = () => fseq < drawnSeq || (fseq === drawnSeq && rank <= drawnKind);
+    if (stale()) return;
+    const type = kind === KIND_COARSE ? "image/jpeg" : "image/png";
     const bitmap = await createImageBitmap(new Blob([bytes], { type }));
-    if (fseq < drawnSeq || (fseq === drawnSeq && kind <= drawnKind)) return;
+    if (stale()) return;
     ctx2d.imageSmoothingEnabled = true;
     ctx2d.drawImage(bitmap, 0, 0, canvas.width, canvas.height);
-    drawnSeq = fseq; drawnKind = kind; frames += 1;
-    canvas.dataset.seq = fseq; canvas.dataset.kind = kind === KIND_FULL ? "full" : "coarse";
+    lastBitmap = bitmap;
+    drawnSeq = fseq; drawnKind = rank; frames += 1;
+    canvas.dataset.seq = fseq; canvas.dataset.kind = kind === KIND_FULL ? "full" : kind === KIND_ONE ? "one" : "coarse";
     canvas.dataset.frames = frames;
-    const t0 = sentAt.get(fseq);
-    const ms = t0 === undefined ? "" : ` ${Math.round(performance.now() - t0)} ms`;
-    $("status").textContent = `${kind === KIND_FULL ? "full" : "coarse"} ${w} x ${h}${ms}`;
+    const sent = sentAt.get(fseq);
+    const ms = sent === undefined ? "" : ` ${Math.round(performance.now() - sent.t)} ms`;
+    if (sent !== undefined && !$("clip-size").classList.contains("bad")) goodClipSize = sent.clip;
+    // a picture drawn: the last error is over (not a field's own complaint while it still holds no number)
+    if (messageIsError && fseq > errorSeq && !$("clip-size").classList.contains("bad")) showMessage("", false);
+    $("status").textContent = `${KIND_NAME[kind]} ${w} x ${h}${ms}`;
+    showEmpty((flags & FLAG_EMPTY) !== 0);
     for (const k of sentAt.keys()) if (k < fseq) sentAt.delete(k);
   }
 
@@ -196,26 +304,53 @@
     if (ev.data instanceof ArrayBuffer) { drawFrame(ev.data); return; }
     const msg = JSON.parse(ev.data);
     if (msg.type === "hello") {
+      overlay.connect = "";
+      showOverlay();
       $("equation").value = msg.equation;
       state.orbit = msg.orbit;
       state.home = JSON.parse(JSON.stringify(msg.orbit));
+      maxFrame = msg.limits.frame;
+      fitCanvas();
       setOptions(msg.options);
+      sceneMode = msg.mode === "scene";
+      $("object-row").hidden = !sceneMode;
+      if (sceneMode) showObjects(msg.objects, msg.object);
       if (msg.mode !== "scene") $("lights").querySelector("option[value=scene]").disabled = true;
-      else for (const id of ["clip", "clip-size", "color", "inside"]) $(id).disabled = true; // the file's own
+      else for (const id of ["clip", "clip-size", "cut", "color", "inside"]) $(id).disabled = true; // the file's own
       showShape(msg);
-      requestRender(true);
+      if (!openLink()) requestRender(true); // with a link's equation: drawn once it is built
     } else if (msg.type === "shape") {
+      if (linkValues) { // the link's slider values, for the params the shape has
+        for (const [k, v] of Object.entries(linkValues)) {
+          if (k in msg.values) {
+            msg.values[k] = v;
+            const span = Math.max(1, Math.abs(msg.params[k]));
+            state.ranges[k] = [Math.min(v, msg.params[k] - span), Math.max(v, msg.params[k] + span)];
+          }
+        }
+        linkValues = null;
+      }
+      if (msg.object !== undefined) { // another object of the scene picked: its equation in the box
+        $("equation").value = msg.equation;
+        userName = false;
+        $("equation").classList.remove("bad");
+      }
+      if (sceneMode && msg.objects) showObjects(msg.objects, msg.object ?? Number($("object").value));
       showShape(msg);
+      if ("fit" in msg) fitClip(msg.fit);
       requestRender(true);
+    } else if (msg.type === "status") {
+      overlay.build = msg.text;
+      showOverlay();
     } else if (msg.type === "error") {
       if (msg.field === "equation") {
         $("equation").classList.add("bad");
         $("equation-error").textContent = msg.message;
       } else {
-        $("message").textContent = lastError = msg.message;
+        showMessage(msg.message, true);
       }
     } else if (msg.type === "yaml") {
-      download(new Blob([msg.text], { type: "application/yaml" }), msg.mode === "scene" ? "scene.yaml" : "shape.yaml");
+      download(new Blob([msg.text], { type: "application/yaml" }), `${$("shape-name").value.replace(/[^A-Za-z0-9_]/g, "") || "scene"}.yaml`);
     } else if (msg.type === "c") {
       $("code").textContent = msg.text;
       $("code-dialog").showModal();
@@ -232,15 +367,19 @@
     ws.addEventListener("message", onMessage);
     ws.addEventListener("close", (e) => {
       const why = e.reason ? `: ${e.reason}` : " (reload to reconnect)";
-      // the error the server closed after stays in view (a scene file that no longer reads)
-      $("message").textContent = `${lastError ? lastError + " - " : ""}disconnected from the server${why}`;
+      // the error the server closed after stays in view (a scene file that no longer reads, too many pages)
+      const text = e.code === 1013 && lastError ? lastError
+        : `${lastError ? lastError + " - " : ""}disconnected from the server${why}`;
+      showMessage(text, false);
+      overlay.connect = e.code === 1013 ? "too many pages open" : "disconnected";
+      showOverlay();
     });
   }
 
   // ---------------------------------------------------------------- the picture: orbit, pan, zoom
   let drag = null;
   canvas.addEventListener("pointerdown", (e) => {
-    drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey };
+    drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey, x0: e.clientX, y0: e.clientY, moved: false };
     canvas.setPointerCapture(e.pointerId);
     canvas.classList.add("dragging");
   });
@@ -248,6 +387,8 @@
     if (!drag) return;
     const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
     drag.x = e.clientX; drag.y = e.clientY;
+    if (!drag.moved && Math.hypot(e.clientX - drag.x0, e.clientY - drag.y0) < 4) return; // a click, so far
+    drag.moved = true;
     const o = state.orbit;
     if (drag.pan || e.shiftKey) {
       const y = o.yaw * Math.PI / 180, p = o.pitch * Math.PI / 180;
@@ -263,11 +404,18 @@
     }
     requestRender(false);
   });
-  const endDrag = () => {
+  const endDrag = (e) => {
     if (!drag) return;
+    const click = !drag.moved;
     drag = null;
     canvas.classList.remove("dragging");
-    requestRender(true);
+    if (!click) { requestRender(true); return; }
+    if (sceneMode && e.type === "pointerup") { // a click on a scene: edit the object there
+      const r = canvas.getBoundingClientRect();
+      const x = (e.clientX - r.left) * canvas.width / r.width, y = (e.clientY - r.top) * canvas.height / r.height;
+      send({ type: "pick", x: Math.max(0, Math.min(canvas.width - 1, x)),
+        y: Math.max(0, Math.min(canvas.height - 1, y)), width: canvas.width, height: canvas.height });
+    }
   };
   canvas.addEventListener("pointerup", endDrag);
   canvas.addEventListener("pointercancel", endDrag);
@@ -284,8 +432,9 @@
   $("equation").addEventListener("input", () => { clearTimeout(typing); typing = setTimeout(applyShape, 600); });
   $("params-text").addEventListener("keydown", (e) => { if (e.key === "Enter") applyShape(); });
   $("apply").addEventListener("click", applyShape);
-  for (const id of ["clip", "clip-size", "color", "inside", "background", "lights"]) {
-    $(id).addEventListener("input", () => requestRender(false));
+  $("clip-size").addEventListener("input", () => { userClip = true; });
+  for (const id of ["clip", "clip-size", "cut", "color", "inside", "background", "lights"]) {
+    $(id).addEventListener("input", moved);
     $(id).addEventListener("change", () => requestRender(true));
   }
   $("reset-view").addEventListener("click", () => {
@@ -293,14 +442,61 @@
     requestRender(true);
   });
   $("save-png").addEventListener("click", () => {
-    $("message").textContent = "rendering...";
+    showMessage("rendering...", false);
     lastError = "";
     send({ type: "save_png", width: parseInt($("save-width").value, 10), height: parseInt($("save-height").value, 10),
       spp: parseInt($("save-spp").value, 10) });
   });
-  $("save-yaml").addEventListener("click", () => send({ type: "save_yaml" }));
+  // a link pasted into this page's address (only the part after "#" differs: no reload) opens its view too
+  window.addEventListener("hashchange", () => { if (ws && !openLink()) requestRender(true); });
+  $("object").addEventListener("change", () => send({ type: "object", index: Number($("object").value) }));
+  $("copy-link").addEventListener("click", () => {
+    keepLink();
+    navigator.clipboard.writeText(location.href).then(() => showMessage("link copied: it reopens this view", false),
+      () => showMessage(`the link: ${location.href}`, false));
+  });
+  $("save-yaml").addEventListener("click", () => send({ type: "save_yaml", width: canvas.width, height: canvas.height }));
+  $("shape-name").addEventListener("input", () => { userName = true; });
+  $("shape-name").addEventListener("keydown", (e) => { if (e.key === "Enter") applyShape(); });
   $("show-c").addEventListener("click", () => send({ type: "show_c" }));
   $("close-code").addEventListener("click", () => $("code-dialog").close());
+
+  // ---------------------------------------------------------------- the picture's size: the window's
+  // The canvas holds as many pixels as the screen shows (CSS size x devicePixelRatio: sharp on high-DPI
+  // screens), at most the server's largest frame; a new size is drawn refined once the resizing rests.
+  let maxFrame = [2048, 2048];
+  function fitCanvas() {
+    const stage = $("stage");
+    const dpr = window.devicePixelRatio || 1;
+    let w = Math.round(stage.clientWidth * dpr), h = Math.round(stage.clientHeight * dpr);
+    const k = Math.min(1, maxFrame[0] / w, maxFrame[1] / h);
+    w = Math.max(16, Math.floor(w * k)); h = Math.max(16, Math.floor(h * k));
+    if (w === canvas.width && h === canvas.height) return false;
+    canvas.width = w; canvas.height = h;
+    if (lastBitmap) ctx2d.drawImage(lastBitmap, 0, 0, w, h);
+    return true;
+  }
+  let resizeTimer = 0;
+  new ResizeObserver(() => {
+    if (!fitCanvas() || !ws || ws.readyState !== WebSocket.OPEN || drawnSeq < 0) return;
+    requestRender(false);
+    clearTimeout(resizeTimer);
+    resizeTimer = setTimeout(() => requestRender(true), 180);
+  }).observe($("stage"));
+  fitCanvas();
+
+  const fullScreen = () => {
+    if (document.fullscreenElement) document.exitFullscreen();
+    else $("stage").requestFullscreen().catch(() => {});
+  };
+  $("fullscreen").addEventListener("click", fullScreen);
+  document.addEventListener("keydown", (e) => {
+    if (e.key === "f" && e.target === document.body) fullScreen();
+  });
+
+  // the page's state, for tests and for the share link: a copy, never the live object
+  window.implgenState = () => JSON.parse(JSON.stringify({ orbit: state.orbit, options: readOptions(),
+    values: state.values }));
 
   connect();
 })();

@@ -1,0 +1,101 @@
+// implgen view: the share link. The page's whole view lives in its address after "#", in readable fields:
+//   #v=1&eq=x^2+...&name=surface&params=a = 1&values=a:1.2&cam=yaw,pitch,distance,tx,ty,tz,fov
+//     &clip=sphere:3[:cut]&color=f2bf4d&inside=5a8cf2&bg=1f1f24&lights=studio
+// A link is text from anywhere: decode() reads it as untrusted input, bounded in length, each field checked
+// by its own pattern and range and dropped when it does not pass (the server checks everything again); it
+// never evaluates anything. Plain JS, no build step.
+"use strict";
+
+window.implgenLink = (() => {
+  const MAX_LINK = 16384; // characters after "#"
+  const MAX_EQUATION = 8192;
+  const MAX_PARAMS = 64;
+  const NAME = /^[A-Za-z_][A-Za-z0-9_]{0,62}$/;
+  const HEX = /^[0-9a-fA-F]{6}$/;
+  const CLIPS = ["none", "sphere", "box"];
+  const LIGHTS = ["studio", "headlight", "top", "scene"];
+  const num = (s, lo, hi) => {
+    if (typeof s !== "string" || !/^[-+0-9.eE]{1,32}$/.test(s)) return null;
+    const x = Number(s);
+    return Number.isFinite(x) && x >= lo && x <= hi ? x : null;
+  };
+  const hex = (rgb) => rgb.map((c) => Math.round(Math.max(0, Math.min(1, c)) * 255)
+    .toString(16).padStart(2, "0")).join("");
+  const rgb = (h) => [0, 2, 4].map((i) => parseInt(h.slice(i, i + 2), 16) / 255);
+  const short = (x) => String(Number(x.toPrecision(12)));
+
+  // the view -> the text after "#"
+  function encode(view) {
+    const o = view.orbit, op = view.options;
+    const q = new URLSearchParams();
+    q.set("v", "1");
+    q.set("eq", view.equation);
+    q.set("name", view.name);
+    q.set("params", view.params);
+    q.set("values", Object.entries(view.values).map(([k, v]) => `${k}:${short(v)}`).join(","));
+    q.set("cam", [o.yaw, o.pitch, o.distance, ...o.target, o.fov].map(short).join(","));
+    q.set("clip", op.clip === "none" ? "none" : `${op.clip}:${short(op.clip_size)}${op.cut ? ":cut" : ""}`);
+    q.set("color", hex(op.color));
+    q.set("inside", hex(op.inside));
+    q.set("bg", hex(op.background));
+    q.set("lights", op.lights);
+    return q.toString();
+  }
+
+  // the text after "#" -> {view: the fields that passed, bad: the names of those that did not}
+  function decode(fragment) {
+    const text = (fragment || "").replace(/^#/, "");
+    const view = {}, bad = [];
+    if (!text) return { view, bad };
+    if (text.length > MAX_LINK) return { view, bad: ["the link (too long)"] };
+    let q;
+    try { q = new URLSearchParams(text); } catch (e) { return { view, bad: ["the link"] }; }
+    if (q.get("v") !== "1") return { view, bad: ["the link (not a view link)"] };
+    const eq = q.get("eq");
+    if (eq !== null) { if (eq.length <= MAX_EQUATION && eq.trim()) view.equation = eq; else bad.push("eq"); }
+    const name = q.get("name");
+    if (name !== null) { if (NAME.test(name)) view.name = name; else bad.push("name"); }
+    const params = q.get("params");
+    if (params !== null) { if (params.length <= 4096) view.params = params; else bad.push("params"); }
+    const values = q.get("values");
+    if (values !== null) {
+      const out = {};
+      const parts = values ? values.split(",") : [];
+      for (const part of parts.slice(0, MAX_PARAMS)) {
+        const [k, v] = part.split(":");
+        const x = num(v, -1e300, 1e300);
+        if (NAME.test(k || "") && x !== null) out[k] = x; else bad.push(`values (${part.slice(0, 20)})`);
+      }
+      view.values = out;
+    }
+    const cam = q.get("cam");
+    if (cam !== null) {
+      const c = cam.split(",");
+      const nums = [[-1e6, 1e6], [-89, 89], [1e-3, 1e6], [-1e6, 1e6], [-1e6, 1e6], [-1e6, 1e6], [1, 150]]
+        .map(([lo, hi], i) => num(c[i], lo, hi));
+      if (c.length === 7 && nums.every((x) => x !== null)) {
+        view.orbit = { yaw: nums[0], pitch: nums[1], distance: nums[2], target: nums.slice(3, 6), fov: nums[6] };
+      } else bad.push("cam");
+    }
+    const options = {};
+    const clip = q.get("clip");
+    if (clip !== null) {
+      const [kind, size, cut] = clip.split(":");
+      const r = num(size, 1e-3, 1e6);
+      if (kind === "none") options.clip = "none";
+      else if (CLIPS.includes(kind) && r !== null && (cut === undefined || cut === "cut")) {
+        Object.assign(options, { clip: kind, clip_size: r, cut: cut === "cut" });
+      } else bad.push("clip");
+    }
+    for (const [key, field] of [["color", "color"], ["inside", "inside"], ["bg", "background"]]) {
+      const h = q.get(key);
+      if (h !== null) { if (HEX.test(h)) options[field] = rgb(h); else bad.push(key); }
+    }
+    const lights = q.get("lights");
+    if (lights !== null) { if (LIGHTS.includes(lights)) options.lights = lights; else bad.push("lights"); }
+    if (Object.keys(options).length) view.options = options;
+    return { view, bad };
+  }
+
+  return { encode, decode };
+})();
