@@ -209,6 +209,33 @@ static void put_hit(void *hit, unsigned int N, unsigned int i, const double n[3]
     *ray_u(hit, N, H_INST, i) = instID;
 }
 
+/* A candidate hit per lane and the arguments that hand it to Embree's filters (rtcFilterIntersection,
+   rtcFilterOcclusion): every lane off until the lane being tried is switched on. */
+typedef struct {
+    union {
+        float f;
+        unsigned int u;
+    } cand[IG_EMBREE_MAX_N * H_FIELDS] IG_ALIGNED;
+    int fvalid[IG_EMBREE_MAX_N] IG_ALIGNED;
+    struct RTCFilterFunctionNArguments fa;
+} filter_call;
+
+static int filter_begin(filter_call *fc, void *geometryUserPtr, struct RTCIntersectContext *context, void *ray,
+                        unsigned int N)
+{
+    if (N > IG_EMBREE_MAX_N)
+        return 0;
+    memset(fc->fvalid, 0, sizeof fc->fvalid);
+    memset(fc->cand, 0, sizeof fc->cand);
+    fc->fa.valid = fc->fvalid;
+    fc->fa.geometryUserPtr = geometryUserPtr;
+    fc->fa.context = context;
+    fc->fa.ray = (struct RTCRayN *)ray;
+    fc->fa.hit = (struct RTCHitN *)fc->cand;
+    fc->fa.N = N;
+    return 1;
+}
+
 /* ------------------------------------------------------------------ the callbacks */
 
 void ig_embree_intersect(const struct RTCIntersectFunctionNArguments *args)
@@ -217,22 +244,9 @@ void ig_embree_intersect(const struct RTCIntersectFunctionNArguments *args)
     const ig_embree_prim *p = &g->prims[args->primID];
     unsigned int N = args->N, i, instID = args->context->instID[0];
     void *ray = args->rayhit, *hits = (float *)args->rayhit + R_FIELDS * N;
-    union {
-        float f;
-        unsigned int u;
-    } cand[IG_EMBREE_MAX_N * H_FIELDS] IG_ALIGNED;
-    int fvalid[IG_EMBREE_MAX_N] IG_ALIGNED;
-    struct RTCFilterFunctionNArguments fa;
-    if (N > IG_EMBREE_MAX_N)
+    filter_call fc;
+    if (!filter_begin(&fc, args->geometryUserPtr, args->context, ray, N))
         return;
-    fa.valid = fvalid;
-    fa.geometryUserPtr = args->geometryUserPtr;
-    fa.context = args->context;
-    fa.ray = (struct RTCRayN *)ray;
-    fa.hit = (struct RTCHitN *)cand;
-    fa.N = N;
-    memset(fvalid, 0, sizeof fvalid);
-    memset(cand, 0, sizeof cand);
     for (i = 0; i < N; ++i) {
         double o[3], d[3], oo[3], u[3], L, lo, hi, t, n[3];
         float *tfar = ray_f(ray, N, R_TFAR, i);
@@ -254,14 +268,14 @@ void ig_embree_intersect(const struct RTCIntersectFunctionNArguments *args)
         for (tries = 0; tries <= p->prep.degree && next_root(p, oo, u, L, lo, open, hi, &t); ++tries) {
             float old = *tfar;
             hit_normal(p, oo, u, L, t, d, n);
-            put_hit(cand, N, i, n, args->primID, args->geomID, instID);
-            fvalid[i] = -1;
+            put_hit(fc.cand, N, i, n, args->primID, args->geomID, instID);
+            fc.fvalid[i] = -1;
             *tfar = (float)t;
-            rtcFilterIntersection(args, &fa);
-            if (fvalid[i] != 0) {
+            rtcFilterIntersection(args, &fc.fa);
+            if (fc.fvalid[i] != 0) {
                 unsigned int k;
                 for (k = 0; k < H_FIELDS; ++k)
-                    *ray_u(hits, N, (int)k, i) = cand[k * N + i].u;
+                    *ray_u(hits, N, (int)k, i) = fc.cand[k * N + i].u;
                 if (rec) {
                     rec->t = t;
                     memcpy(rec->n, n, sizeof rec->n);
@@ -269,7 +283,7 @@ void ig_embree_intersect(const struct RTCIntersectFunctionNArguments *args)
                     rec->primID = args->primID;
                     rec->instID = instID;
                 }
-                fvalid[i] = 0;
+                fc.fvalid[i] = 0;
                 break;
             }
             *tfar = old; /* rejected by a filter: the next root along the ray */
@@ -285,22 +299,9 @@ void ig_embree_occluded(const struct RTCOccludedFunctionNArguments *args)
     const ig_embree_prim *p = &g->prims[args->primID];
     unsigned int N = args->N, i, instID = args->context->instID[0];
     void *ray = args->ray;
-    union {
-        float f;
-        unsigned int u;
-    } cand[IG_EMBREE_MAX_N * H_FIELDS] IG_ALIGNED;
-    int fvalid[IG_EMBREE_MAX_N] IG_ALIGNED;
-    struct RTCFilterFunctionNArguments fa;
-    if (N > IG_EMBREE_MAX_N)
+    filter_call fc;
+    if (!filter_begin(&fc, args->geometryUserPtr, args->context, ray, N))
         return;
-    fa.valid = fvalid;
-    fa.geometryUserPtr = args->geometryUserPtr;
-    fa.context = args->context;
-    fa.ray = (struct RTCRayN *)ray;
-    fa.hit = (struct RTCHitN *)cand;
-    fa.N = N;
-    memset(fvalid, 0, sizeof fvalid);
-    memset(cand, 0, sizeof cand);
     for (i = 0; i < N; ++i) {
         double o[3], d[3], oo[3], u[3], L, lo, hi, t, n[3];
         float *tfar = ray_f(ray, N, R_TFAR, i);
@@ -316,13 +317,13 @@ void ig_embree_occluded(const struct RTCOccludedFunctionNArguments *args)
         for (tries = 0; tries <= p->prep.degree && next_root(p, oo, u, L, lo, open, hi, &t); ++tries) {
             float old = *tfar;
             hit_normal(p, oo, u, L, t, d, n);
-            put_hit(cand, N, i, n, args->primID, args->geomID, instID);
-            fvalid[i] = -1;
+            put_hit(fc.cand, N, i, n, args->primID, args->geomID, instID);
+            fc.fvalid[i] = -1;
             *tfar = (float)t;
-            rtcFilterOcclusion(args, &fa);
-            if (fvalid[i] != 0) {
+            rtcFilterOcclusion(args, &fc.fa);
+            if (fc.fvalid[i] != 0) {
                 *tfar = -INFINITY; /* Embree's mark of an occluded ray */
-                fvalid[i] = 0;
+                fc.fvalid[i] = 0;
                 break;
             }
             *tfar = old;
