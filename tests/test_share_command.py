@@ -166,6 +166,16 @@ def test_params_ranges_and_clip_from_the_options(tmp_path, capsys):
     assert selected == "box"
 
 
+def test_a_slider_runs_over_the_spec_s_own_range(tmp_path, capsys):
+    """The gallery's Kummer quartic names its range of mu (0.65 to 1.7): the slider runs over it, widened to
+    hold a value given outside it."""
+    out = tmp_path / "k.html"
+    assert share(tmp_path, str(SHAPES_DIR / "kummer.yaml"), "-o", str(out), capsys=capsys)[0] == 0
+    assert [(q["name"], q["min"], q["max"]) for q in page_data(parse_page(out)[1])["params"]] == [("mu", 0.65, 1.7)]
+    assert share(tmp_path, str(SHAPES_DIR / "kummer.yaml"), "--param", "mu=1.8", "-o", str(out), capsys=capsys)[0] == 0
+    assert [(q["min"], q["max"]) for q in page_data(parse_page(out)[1])["params"]] == [(0.65, 1.8)]
+
+
 def test_an_object_of_a_scene_by_name(tmp_path, capsys):
     """The scene's torus: its params start the sliders, its material gives the outside colour."""
     out = tmp_path / "t.html"

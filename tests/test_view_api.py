@@ -29,6 +29,7 @@ from implgen.view.document import Document
 from implgen.view.protocol import MAX_MESSAGE
 from implgen.view.server import create_app, origin_allowed
 from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_ONE, KIND_SAVE, Session
+from view_fixtures import BALLS_SCENE
 
 SCENES = ROOT / "examples" / "scenes"
 
@@ -500,16 +501,7 @@ def test_a_scene_s_object_is_picked_in_the_picture_or_from_the_list(tmp_path) ->
     """Two balls, left and right of the camera's axis, on a floor: a click on a ball's centre (where the camera
     projects it, worked out here) picks that ball, a click above the floor's horizon picks nothing, the list picks
     by index; the edits of each object are kept when another one is picked."""
-    scene = {
-        "image": {"width": 64, "height": 48},
-        "camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "fov": 40},
-        "lights": [{"position": [0, 5, 5], "color": [1, 1, 1]}],
-        "objects": [
-            {"equation": "y + 2", "name": "floor"},
-            {"equation": "(x + 2)^2 + y^2 + z^2 - 1", "name": "left"},
-            {"equation": "(x - 2)^2 + y^2 + z^2 - 1", "name": "right"},
-        ],
-    }
+    scene = BALLS_SCENE
     path = tmp_path / "balls.yaml"
     path.write_text(yaml.safe_dump(scene))
     half = np.tan(np.radians(20))  # the pixel of (x, 0, 0) at distance 10, in a 640 x 480 picture
@@ -565,3 +557,39 @@ def test_pace_sizes_live_frames_for_about_30_ms() -> None:
     p.pixels = 1000.0
     p.new_shape()
     assert p.pixels == 250.0
+
+
+def test_export_page_is_the_shared_page_of_this_view(client) -> None:
+    """Export page: `implgen share`'s page (share/page.py) with the shape, the param values, the camera, the clip
+    and the colours the page shows now; the sliders over the spec's range or the page's default one."""
+    with client.websocket_connect("/ws") as ws:
+        hello = reply(ws)
+        values = {k: v * 1.1 for k, v in hello["values"].items()}
+        options = dict(hello["options"], clip="box", clip_size=2.5, color=[0.2, 0.7, 0.4])
+        orbit = dict(hello["orbit"], yaw=40.0, pitch=20.0, distance=9.0)
+        ws.send_text(render_msg(hello, seq=1, w=64, h=48, values=values, options=options, orbit=orbit))
+        while frame(picture(ws))[1] != KIND_FULL:
+            pass
+        ws.send_text(json.dumps({"type": "export_page"}))
+        page = reply(ws)
+    assert page["type"] == "page" and page["name"] == f"{hello['name']}.html"
+    html = page["text"]
+    start = html.index('<script type="application/json" id="ig-data">')
+    data = json.loads(html[html.index(">", start) + 1 : html.index("</script>", start)])
+    assert data["orbit"] == {**orbit, "target": list(orbit["target"])}
+    assert data["clip"] == {"kind": "box", "size": 2.5}
+    assert {p["name"]: p["value"] for p in data["params"]} == pytest.approx(values)
+    for p in data["params"]:
+        assert p["min"] <= p["value"] <= p["max"]
+    assert "#33b366" in html  # the outside colour, (0.2, 0.7, 0.4)
+    assert "http://" not in html and "https://" not in html
+
+
+def test_the_gallery_list_is_served_as_plain_json(client) -> None:
+    from implgen.codegen import gallery
+
+    listing = client.get("/gallery.json").json()
+    assert [g["name"] for g in listing] == [e.name for e in gallery.entries()] and len(listing) >= 20
+    kummer = next(g for g in listing if g["name"] == "kummer")
+    assert kummer["ranges"] == {"mu": [0.65, 1.7]} and kummer["params"] == {"mu": 1.3}
+    assert set(kummer) == {"name", "title", "description", "reference", "equation", "params", "ranges", "bounds"}

@@ -10,8 +10,6 @@ from __future__ import annotations
 import math
 import os
 import shutil
-import subprocess
-import sys
 import time
 
 import numpy as np
@@ -19,6 +17,7 @@ import pytest
 import yaml
 
 from test_view_browser import canvas_pixels, frame_state, page_colour, wait, wait_full_after
+from view_fixtures import BALLS_SCENE, view_process
 
 pytestmark = pytest.mark.needs_program("chromium", "chromedriver")
 CHMUTOV12 = (
@@ -46,14 +45,8 @@ def fresh_server(tmp_path_factory):
     """`implgen view` in its own process with an empty build cache (its first run) and room for one page."""
     cache = tmp_path_factory.mktemp("cache")
     env = dict(os.environ, IMPLGEN_CACHE=str(cache), IMPLGEN_VIEW_MAX_PAGES=str(PAGES))
-    cmd = [sys.executable, "-m", "implgen.cli", "view", "--no-browser", "--port", "0"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True, env=env)
-    try:
-        line = proc.stdout.readline()
-        yield "http://" + line.split("http://", 1)[1].split()[0]
-    finally:
-        proc.terminate()
-        proc.wait(30)
+    with view_process(env=env) as url:
+        yield url
 
 
 @pytest.fixture(scope="module")
@@ -406,26 +399,10 @@ def test_a_share_link_reopens_the_same_view_and_a_bad_one_is_read_safely(fresh_s
 @pytest.fixture(scope="module")
 def balls_server(tmp_path_factory):
     """`implgen view` of a scene file: a floor and two balls, left and right of the camera's axis."""
-    scene = {
-        "image": {"width": 64, "height": 48},
-        "camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "fov": 40},
-        "lights": [{"position": [0, 5, 5], "color": [1, 1, 1]}],
-        "objects": [
-            {"equation": "y + 2", "name": "floor"},
-            {"equation": "(x + 2)^2 + y^2 + z^2 - 1", "name": "left"},
-            {"equation": "(x - 2)^2 + y^2 + z^2 - 1", "name": "right"},
-        ],
-    }
     path = tmp_path_factory.mktemp("scene") / "balls.yaml"
-    path.write_text(yaml.safe_dump(scene))
-    cmd = [sys.executable, "-m", "implgen.cli", "view", str(path), "--no-browser", "--port", "0"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True)
-    try:
-        line = proc.stdout.readline()
-        yield "http://" + line.split("http://", 1)[1].split()[0]
-    finally:
-        proc.terminate()
-        proc.wait(30)
+    path.write_text(yaml.safe_dump(BALLS_SCENE))
+    with view_process(str(path)) as url:
+        yield url
 
 
 def test_a_scene_s_object_is_picked_by_a_click_or_from_the_list(balls_server, driver) -> None:
@@ -436,6 +413,7 @@ def test_a_scene_s_object_is_picked_by_a_click_or_from_the_list(balls_server, dr
 
     open_page(driver, balls_server)
     assert not driver.find_element("id", "object-row").get_attribute("hidden")
+    assert driver.execute_script("return document.getElementById('gallery-row').hidden")  # shapes of the file
     chosen = Select(driver.find_element("id", "object"))
     assert [o.text.split(" ")[0] for o in chosen.options] == ["floor", "left", "right"]
     canvas = driver.find_element("id", "view")
@@ -450,3 +428,29 @@ def test_a_scene_s_object_is_picked_by_a_click_or_from_the_list(balls_server, dr
     assert driver.find_element("id", "shape-name").get_attribute("value") == "right"
     chosen.select_by_index(1)
     wait(driver, lambda d: "(x + 2)^2" in d.find_element("id", "equation").get_attribute("value"), "no list pick")
+
+
+def test_the_gallery_picks_a_famous_surface_with_its_source(fresh_server, driver) -> None:
+    """Issue 24's gallery: at least 20 famous surfaces in the page's picker; picking one shows its equation,
+    its name, a slider over the spec's own range and its source, and draws it."""
+    from selenium.webdriver.support.ui import Select
+
+    from implgen.codegen import gallery
+
+    seq = open_page(driver, fresh_server)
+    picker = Select(driver.find_element("id", "gallery"))
+    titles = [o.text for o in picker.options][1:]  # the first is the prompt
+    assert titles == [e.title for e in gallery.entries()] and len(titles) >= 20
+    kummer = gallery.entry("kummer")
+    picker.select_by_visible_text(kummer.title)
+    wait(driver, lambda d: text(d, "degree") == "degree 4", "the Kummer quartic was not accepted")
+    seq = wait_full_after(driver, seq)
+    assert driver.find_element("id", "shape-name").get_attribute("value") == "kummer"
+    assert driver.find_element("id", "equation").get_attribute("value") == " ".join(kummer.data["equation"].split())
+    lo, hi = driver.execute_script(
+        "const r = document.querySelector('#sliders input[type=range]'); return [Number(r.min), Number(r.max)]"
+    )
+    assert (lo, hi) == (0.65, 1.7)
+    assert "Kummer" in text(driver, "gallery-note") and "1864" in text(driver, "gallery-note")
+    assert "no real points" not in text(driver, "message")
+    assert driver.execute_script("return document.getElementById('gallery-row').hidden") is False

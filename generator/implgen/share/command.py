@@ -61,7 +61,8 @@ def sliders(
     spec: Spec, params: list[str], ranges: list[str], source: str, start: dict[str, float] | None = None
 ) -> list[Slider]:
     """The params' starting values (`start`, a scene object's, else the spec's defaults, then the options) and
-    slider ranges; the values checked against the shape."""
+    slider ranges (--range, else the spec's `ranges`, else the value +- max(1, |value|)); the values checked
+    against the shape."""
     given = {k: _num(f"--param {k}={v}", v) for k, v in _pairs("--param", params, spec).items()}
     values = {**spec.params, **(start or {}), **given}
     if given:
@@ -79,6 +80,8 @@ def sliders(
                 raise UserError(label, f"LOW must be below HIGH (got {lo:g} and {hi:g})")
             if not lo <= value <= hi:
                 raise UserError(label, f"the range does not hold {name}'s value {value:g}")
+        elif name in spec.ranges:  # the spec's own range, widened to hold a value given outside it
+            lo, hi = min(spec.ranges[name][0], value), max(spec.ranges[name][1], value)
         else:
             lo, hi = default_range(value)
         out.append(Slider(name, value, lo, hi))

@@ -9,6 +9,7 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
     {"type": "save_png", "width": 1920, "height": 1080, "spp": 16}    the current view through render()
     {"type": "save_yaml", "width": 640, "height": 480}               the view as a scene file (its full frame)
     {"type": "show_c"}                                                the generated C
+    {"type": "export_page"}                                           the view as `implgen share`'s page
     {"type": "pick", "x": 120, "y": 80, "width": 640, "height": 480}  a scene file: edit the object at a pixel
     {"type": "object", "index": 2}                                    a scene file: edit this leaf
 
@@ -39,7 +40,7 @@ MAX_FRAME = (2048, 2048)  # the largest interactive frame
 MAX_SAVE = (8192, 8192)  # the largest saved picture
 MAX_SAVE_PIXELS = 8192 * 4608  # 8K at 16:9
 MAX_SAVE_SPP = 64
-TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object")
+TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object", "export_page")
 PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
 
 _parsed: OrderedDict[str, Spec | UserError] = OrderedDict()

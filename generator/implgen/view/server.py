@@ -1,5 +1,5 @@
 """The viewer's web server: Starlette routes for the page's own files (the page, its script, its style, its
-icon) and one WebSocket per page.
+icon), the gallery's list (gallerylist.py) and one WebSocket per page.
 
 Nothing else is served: the static files are a fixed table read from the package, not a folder mapped onto
 URLs. Messages are bounded (uvicorn's ws_max_size and protocol.MAX_MESSAGE); each page gets its own Session,
@@ -32,6 +32,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect, WebSocketState
 from implgen.errors import UserError
 from implgen.view import protocol
 from implgen.view.document import Document
+from implgen.view.gallerylist import gallery_json
 from implgen.view.session import Session
 from implgen.view.work import Limits, Work
 
@@ -178,6 +179,12 @@ def create_app(
                 pages["open"] -= 1
 
     routes = [Route(path, _static(name, media, token)) for path, (name, media) in STATIC.items()]
+    listing = gallery_json()  # the gallery specs' YAML, read once: no equation is parsed here
+
+    async def serve_gallery(request) -> Response:
+        return Response(listing, media_type="application/json", headers=HEADERS)
+
+    routes.append(Route("/gallery.json", serve_gallery))
     routes.append(WebSocketRoute("/ws", frames))
     app = Starlette(routes=routes)
     app.state.work = work

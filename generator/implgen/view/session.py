@@ -37,7 +37,7 @@ from implgen.scene.model import Scene
 from implgen.scene.render import usable_cores
 from implgen.scene.renderjob import RenderJob
 from implgen.scene.tracer import CScene
-from implgen.view import dump, fit, pick, protocol
+from implgen.view import dump, fit, pick, protocol, sharepage
 from implgen.view.document import Document
 from implgen.view.pace import CUT, Pace
 from implgen.view.work import Ticket, Work
@@ -177,6 +177,9 @@ class Session:
                 await self.send({"type": "yaml", "mode": self._mode(), "text": text})
             elif kind in ("pick", "object"):
                 await self._pick(data)
+            elif kind == "export_page":
+                name, html = await self.work.call(self.work.parse, sharepage.page_text, replace(self.doc))
+                await self.send({"type": "page", "name": name, "text": html})
             elif kind == "show_c":
                 await self.send(
                     {"type": "c", "text": await self.work.call(self.work.parse, dump.c_text, self.doc.spec)}

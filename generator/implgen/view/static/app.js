@@ -313,6 +313,7 @@
       fitCanvas();
       setOptions(msg.options);
       sceneMode = msg.mode === "scene";
+      $("gallery-row").hidden = sceneMode || gallery.length === 0;
       $("object-row").hidden = !sceneMode;
       if (sceneMode) showObjects(msg.objects, msg.object);
       if (msg.mode !== "scene") $("lights").querySelector("option[value=scene]").disabled = true;
@@ -351,6 +352,8 @@
       }
     } else if (msg.type === "yaml") {
       download(new Blob([msg.text], { type: "application/yaml" }), `${$("shape-name").value.replace(/[^A-Za-z0-9_]/g, "") || "scene"}.yaml`);
+    } else if (msg.type === "page") {
+      download(new Blob([msg.text], { type: "text/html" }), msg.name);
     } else if (msg.type === "c") {
       $("code").textContent = msg.text;
       $("code-dialog").showModal();
@@ -450,6 +453,28 @@
   // a link pasted into this page's address (only the part after "#" differs: no reload) opens its view too
   window.addEventListener("hashchange", () => { if (ws && !openLink()) requestRender(true); });
   $("object").addEventListener("change", () => send({ type: "object", index: Number($("object").value) }));
+
+  // ---------------------------------------------------------------- the gallery (gallery.json: docs/surfaces.md)
+  let gallery = [];
+  function showGallery(list) {
+    gallery = Array.isArray(list) ? list : [];
+    $("gallery-row").hidden = sceneMode || gallery.length === 0;
+    $("gallery").append(...gallery.map((g, i) => Object.assign(document.createElement("option"),
+      { value: String(i), textContent: String(g.title) })));
+  }
+  fetch("/gallery.json").then((r) => (r.ok ? r.json() : [])).then(showGallery).catch(() => showGallery([]));
+  $("gallery").addEventListener("change", () => {
+    const g = gallery[Number($("gallery").value)];
+    $("gallery").value = "";
+    if (!g) return;
+    const params = g.params || {};
+    $("equation").value = g.equation;
+    $("params-text").value = Object.entries(params).map(([k, v]) => `${k} = ${v}`).join(", ");
+    state.ranges = Object.assign({}, g.ranges || {});
+    $("gallery-note").textContent = `${g.title}: ${g.description} (${g.reference})`;
+    userName = false;
+    send({ type: "shape", equation: g.equation, name: g.name, params, bounds: g.bounds || null, fit: !userClip });
+  });
   $("copy-link").addEventListener("click", () => {
     keepLink();
     navigator.clipboard.writeText(location.href).then(() => showMessage("link copied: it reopens this view", false),
@@ -459,6 +484,7 @@
   $("shape-name").addEventListener("input", () => { userName = true; });
   $("shape-name").addEventListener("keydown", (e) => { if (e.key === "Enter") applyShape(); });
   $("show-c").addEventListener("click", () => send({ type: "show_c" }));
+  $("export-page").addEventListener("click", () => send({ type: "export_page" }));
   $("close-code").addEventListener("click", () => $("code-dialog").close());
 
   // ---------------------------------------------------------------- the picture's size: the window's
