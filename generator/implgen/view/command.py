@@ -110,8 +110,8 @@ def serve(
         timeout_graceful_shutdown=SHUTDOWN_GRACE,
     )
     work = app.state.work
-    # the event loop's turn at the GIL comes sooner while SymPy parses on the parse pool (5 ms by default: a page
-    # orbiting beside three pages sending heavy equations measured 20 frames/s at 5 ms, 42 at 1 ms)
+    # the event loop's turn at the GIL comes sooner while SymPy parses on the parse pool (5 ms by default; the
+    # heavy-neighbours measure of bench/view_latency.py is the check)
     switch = sys.getswitchinterval()
     sys.setswitchinterval(0.001)
 
