@@ -585,6 +585,22 @@ def test_export_page_is_the_shared_page_of_this_view(client) -> None:
     assert "http://" not in html and "https://" not in html
 
 
+def test_export_page_of_a_gallery_shape_keeps_its_slider_range(client) -> None:
+    """A gallery pick sends the spec's ranges with its shape (the page's message); the exported page's slider runs
+    over them (Kummer's mu: 0.65 to 1.7), not over the default one (0.3 to 2.3)."""
+    kummer = next(g for g in client.get("/gallery.json").json() if g["name"] == "kummer")
+    with client.websocket_connect("/ws") as ws:
+        reply(ws)
+        shape = {k: kummer[k] for k in ("equation", "name", "params", "ranges", "bounds")}
+        ws.send_text(json.dumps({"type": "shape", **shape, "fit": True}))
+        assert reply(ws)["name"] == "kummer"
+        ws.send_text(json.dumps({"type": "export_page"}))
+        html = reply(ws)["text"]
+    start = html.index('<script type="application/json" id="ig-data">')
+    data = json.loads(html[html.index(">", start) + 1 : html.index("</script>", start)])
+    assert [(p["name"], p["min"], p["max"]) for p in data["params"]] == [("mu", 0.65, 1.7)]
+
+
 def test_the_gallery_list_is_served_as_plain_json(client) -> None:
     from implgen.codegen import gallery
 

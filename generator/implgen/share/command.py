@@ -18,7 +18,7 @@ from implgen.codegen.spec import parse_spec
 from implgen.codegen.specmodel import Spec
 from implgen.errors import UserError
 from implgen.outputs import atomic_write, check_output_file
-from implgen.share.page import CLIPS, Look, Slider, default_range, framing, render_page
+from implgen.share.page import CLIPS, Look, Slider, framing, render_page, slider
 from implgen.yamlfile import read_yaml
 
 SUFFIXES = (".html", ".htm")
@@ -80,10 +80,9 @@ def sliders(
                 raise UserError(label, f"LOW must be below HIGH (got {lo:g} and {hi:g})")
             if not lo <= value <= hi:
                 raise UserError(label, f"the range does not hold {name}'s value {value:g}")
-        elif name in spec.ranges:  # the spec's own range, widened to hold a value given outside it
-            lo, hi = min(spec.ranges[name][0], value), max(spec.ranges[name][1], value)
         else:
-            lo, hi = default_range(value)
+            out.append(slider(name, value, spec.ranges))
+            continue
         out.append(Slider(name, value, lo, hi))
     return out
 

@@ -93,6 +93,14 @@ def default_range(value: float) -> tuple[float, float]:
     return value - span, value + span
 
 
+def slider(name: str, value: float, ranges: dict[str, tuple[float, float]]) -> Slider:
+    """A param's slider over the spec's own range (`ranges`), widened to hold the value, else default_range."""
+    if name not in ranges:
+        return Slider(name, value, *default_range(value))
+    lo, hi = ranges[name]
+    return Slider(name, value, min(lo, value), max(hi, value))
+
+
 def framing(
     spec: Spec, values: dict[str, float], clip_size: float | None = None, clip: str = "sphere"
 ) -> tuple[dict, float]:

@@ -135,9 +135,11 @@ def _parse_used(mapping: dict[str, Any]) -> Spec:
     spec = _parse(mapping)
     used = _used(spec)
     if len(used) < len(spec.params):
-        mapping = {**mapping, "params": {k: v for k, v in mapping["params"].items() if k in used}}
-        if not mapping["params"]:
-            del mapping["params"]
+        mapping = {
+            k: {p: v for p, v in mapping[k].items() if p in used} if k in ("params", "ranges") else v
+            for k, v in mapping.items()
+        }
+        mapping = {k: v for k, v in mapping.items() if v or k not in ("params", "ranges")}
         spec = _parse(mapping)
     return spec
 
@@ -150,6 +152,8 @@ def parse_shape(data: dict, current: Spec) -> Spec:
     mapping: dict[str, Any] = {"name": data.get("name", current.name), "equation": data.get("equation")}
     if data.get("params"):
         mapping["params"] = _mapping("params", data["params"])
+        if data.get("ranges"):  # a gallery spec's own slider ranges, checked by the spec parser
+            mapping["ranges"] = _mapping("ranges", data["ranges"])
     if data.get("bounds") is not None:  # given: checked like a spec file's
         return _parse_used({**mapping, "bounds": data["bounds"]})
     spec = _parse_used(mapping)

@@ -9,20 +9,14 @@ from __future__ import annotations
 
 from dataclasses import asdict
 
-from implgen.share.page import CLIPS, Look, Slider, default_range, render_page
+from implgen.share.page import CLIPS, Look, render_page, slider
 from implgen.view.document import Document
-
-
-def _slider(name: str, value: float, ranges: dict[str, tuple[float, float]]) -> Slider:
-    lo, hi = ranges.get(name, default_range(value))
-    return Slider(name, value, min(lo, value), max(hi, value))
 
 
 def page_text(doc: Document) -> tuple[str, str]:
     """(file name, the page's HTML) for the document's current view."""
     spec, o = doc.spec, doc.options
-    ranges = getattr(spec, "ranges", None) or {}
-    sliders = [_slider(name, float(doc.values.get(name, default)), ranges) for name, default in spec.params.items()]
+    sliders = [slider(name, float(doc.values.get(name, default)), spec.ranges) for name, default in spec.params.items()]
     clip = o.clip if o.clip in CLIPS else "sphere"
     look = Look(clip=clip, clip_size=o.clip_size, outside=o.color, inside=o.inside, background=o.background)
     orbit = asdict(doc.orbit)

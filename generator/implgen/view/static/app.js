@@ -473,7 +473,8 @@
     state.ranges = Object.assign({}, g.ranges || {});
     $("gallery-note").textContent = `${g.title}: ${g.description} (${g.reference})`;
     userName = false;
-    send({ type: "shape", equation: g.equation, name: g.name, params, bounds: g.bounds || null, fit: !userClip });
+    send({ type: "shape", equation: g.equation, name: g.name, params, ranges: g.ranges || {}, bounds: g.bounds || null,
+      fit: !userClip });
   });
   $("copy-link").addEventListener("click", () => {
     keepLink();
