@@ -1,5 +1,6 @@
 /* Batch forms of ig_shape_roots and of the shape's value and gradient. See shape_batch.h. */
 #include "shape_batch.h"
+#include <math.h>
 
 #include <stddef.h>
 
@@ -20,12 +21,14 @@ void ig_shape_roots_many(const ig_shape *shape, const double *params, long n, co
 
 void ig_shape_eval_many(const ig_shape *shape, const double *params, long n, const double *p, double *f, double *g)
 {
-    if (!shape || !p || !f || !shape->value)
+    if (!shape || !p || !f)
         return;
-    for (long i = 0; i < n; ++i) {
-        f[i] = shape->value(p + 3 * (size_t)i, params);
+    for (long i = 0; i < n; ++i) { /* a shape without value or gradient gives NaN, never leaves them unwritten */
+        f[i] = shape->value ? shape->value(p + 3 * (size_t)i, params) : NAN;
         if (g && shape->gradient)
             shape->gradient(p + 3 * (size_t)i, params, g + 3 * (size_t)i);
+        else if (g)
+            g[3 * (size_t)i] = g[3 * (size_t)i + 1] = g[3 * (size_t)i + 2] = NAN;
     }
 }
 

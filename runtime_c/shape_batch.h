@@ -12,7 +12,8 @@
 void ig_shape_roots_many(const ig_shape *shape, const double *params, long n, const double *o, const double *d,
                          const double *tmin, const double *tmax, ig_root_method method, double *roots, int *counts);
 
-/* For each point i: f(p_i) into f[i] and grad f(p_i) into g[3 i ...] (g may be NULL: values only). */
+/* For each point i: f(p_i) into f[i] and grad f(p_i) into g[3 i ...] (g may be NULL: values only); NaN where
+ * the shape has no value or gradient function. */
 void ig_shape_eval_many(const ig_shape *shape, const double *params, long n, const double *p, double *f, double *g);
 
 /* f at every point (x[i], y[j], z[k]) of a grid into f[(i * ny + j) * nz + k] (C order): a grid's values

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from implgen.mesh.crossings import clip_values
 from implgen.mesh.region import Clip
 from implgen.mesh.shapelib import ShapeLib
 
@@ -147,10 +146,3 @@ def outside_pieces(lib: ShapeLib, clips: list[Clip], p: np.ndarray, mask: np.nda
             v = v / np.maximum(np.linalg.norm(clips[j - 1].gradient(p), axis=1), 1e-300)
         out |= ((v > 1e-12 * size) & ~((mask >> j) & 1).astype(bool)).astype(np.int64) << j
     return out
-
-
-def on_boundary(lib: ShapeLib, clips: list[Clip], p: np.ndarray) -> np.ndarray:
-    """max(f, clips) at p: 0 on the solid's boundary."""
-    g = lib.value(p)
-    cv = clip_values(clips, p)
-    return np.maximum(g, cv.max(axis=0)) if len(cv) else g

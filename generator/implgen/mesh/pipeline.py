@@ -67,9 +67,10 @@ def mesh_spec(
     return Result(mesh, lib, clips, sing, {"build": t1 - t0, "mesh": t2 - t1, "singular": t3 - t2})
 
 
-def snap_to_singular(mesh: Mesh, points: np.ndarray, clips: list[Clip]) -> int:
+def snap_to_singular(mesh: Mesh, points: np.ndarray, clips: list[Clip]) -> None:
     """Put the vertices of the cell that holds a singular point (inside every clip) on it: the mesh then passes
-    through each node, its cones meeting there. Returns how many vertices moved (mesh.stats["snapped"])."""
+    through each node whose cell holds a vertex, its cones meeting there. How many moved:
+    mesh.stats["snapped_to_singular"]."""
     moved = 0
     if len(points) and mesh.cell is not None:
         cv = clip_values(clips, points)
@@ -83,7 +84,6 @@ def snap_to_singular(mesh: Mesh, points: np.ndarray, clips: list[Clip]) -> int:
             mesh.vertices[v] = where[int(mesh.cell[v])]
             moved += 1
     mesh.stats["snapped_to_singular"] = moved
-    return moved
 
 
 def singular_in_solid(result: Result) -> np.ndarray:

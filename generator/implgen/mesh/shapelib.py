@@ -43,7 +43,6 @@ class ShapeLib:
         self._lib = lib
         self._shape = lib.rt_scene_shape(0)
         self._params = np.ascontiguousarray(np.asarray(list(params) or [0.0], dtype=np.float64))
-        self.degree = spec.degree
 
     def roots(self, o: np.ndarray, d: np.ndarray, tmin: np.ndarray, tmax: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """All distinct roots in [tmin, tmax] of each ray o + t d: (roots (n, IG_MAX_DEGREE), NaN past each
