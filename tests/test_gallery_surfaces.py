@@ -14,9 +14,8 @@ import pytest
 import sympy as sp
 
 from implgen.codegen.gallery import entry
+from implgen.codegen.spec import X, Y, Z
 from surface_nodes import real_nodes
-
-X, Y, Z = sp.symbols("x y z", real=True)
 
 
 def poly(name: str, **values: float) -> sp.Expr:
@@ -28,14 +27,8 @@ def poly(name: str, **values: float) -> sp.Expr:
     return sp.expand(f)
 
 
-def xyz(f: sp.Expr) -> sp.Expr:
-    """f in this file's x, y, z (the spec's symbols carry the same names and assumptions)."""
-    names = {s.name: s for s in f.free_symbols}
-    return f.subs({names[n]: v for n, v in zip("xyz", (X, Y, Z)) if n in names})
-
-
 def f_of(name: str, **values: float) -> sp.Expr:
-    return xyz(poly(name, **values))
+    return poly(name, **values)
 
 
 @pytest.mark.parametrize(

@@ -295,7 +295,8 @@ def test_parses_are_cached_by_text_and_params(monkeypatch) -> None:
             await s.close()
 
     asyncio.run(two_pages())
-    assert [r["type"] for r in replies] == ["shape", "error"] * 2
+    # (a first build of the runtime in this cache also sends its progress: status lines, not answers)
+    assert [r["type"] for r in replies if r["type"] != "status"] == ["shape", "error"] * 2
     assert replies[1] == replies[3]  # the cached refusal says the same
     assert len(calls) == 2, calls
 

@@ -5,7 +5,7 @@ Headless Chromium gives WebGL2 through ANGLE on SwiftShader, a CPU emulation of 
 GPU's float arithmetic gives, the frame times are not a GPU's. The flags (FLAGS) ask for SwiftShader
 explicitly, so the same renderer is used with or without a GPU on the machine.
 
-`WebGL.rays(fragment, origins, dirs, uniforms)` runs a fragment shader once per ray: origin and direction
+`WebGL.run(fragment, size, uniforms, origins, dirs)` runs a fragment shader once per ray: origin and direction
 come in as RGBA32F textures (xyz, and w = tmin for the origin, tmax for the direction), the shader writes an
 RGBA32F pixel, and the pixels come back as a float32 array, tile by tile (a long draw is split into bands of
 rows, each finished and read before the next, so no single draw runs long enough for a watchdog).
