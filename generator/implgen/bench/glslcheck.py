@@ -132,20 +132,11 @@ class Judge:
 
     def __init__(self, case: Case) -> None:
         self.case = case
-        self.terms = exactray.exact_terms(case.spec, case.params)
-        self.box = exactray.padded_box(case.spec.box(case.params))
+        self.shape = exactray.Placed.of(case.spec, case.params)
 
     def __call__(self, row: int, col: int) -> bool:
         c = self.case
-        return exactray.ray_hits(
-            self.terms,
-            c.spec.degree,
-            self.box,
-            c.origins[row, col],
-            c.dirs[row, col],
-            c.tmin[row, col],
-            c.tmax[row, col],
-        )
+        return self.shape.meets(c.origins[row, col], c.dirs[row, col], c.tmin[row, col], c.tmax[row, col])
 
 
 @dataclass
