@@ -109,7 +109,7 @@ def _run(job: Job) -> Path:
     except OSError as err:
         raise UserError("CC", f"cannot run the C compiler {cmd[0]!r} on {job.what}: {err.strerror or err}") from None
     if proc.returncode != 0:
-        _remove(tmp)
+        cachedir.unlink_quietly(tmp)
         raise UserError(
             "CC", f"{cmd[0]} failed on {job.what} (exit status {proc.returncode}): {_first_error(proc.stderr)}"
         )
@@ -120,16 +120,9 @@ def _run(job: Job) -> Path:
             "CC", f"{cmd[0]} exited 0 on {job.what} but wrote nothing; is CC a C compiler? nothing was cached"
         ) from None
     except OSError as err:
-        _remove(tmp)
+        cachedir.unlink_quietly(tmp)
         raise UserError(cachedir.label(), f"cannot write {job.target.name}: {err.strerror or err}") from None
     return job.target
-
-
-def _remove(path: Path) -> None:
-    try:
-        os.unlink(path)
-    except OSError:
-        pass
 
 
 def _writable(folder: Path) -> None:
