@@ -18,6 +18,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from implgen.abi import grown_box
 from implgen.codegen.spec import exact_polynomial, param_symbol
 from implgen.roots.descartes import has_root
 
@@ -67,14 +68,11 @@ def integer_ray_poly(terms: Terms, deg: int, oo: Sequence[Fraction], dd: Sequenc
 
 
 def padded_box(box) -> list[tuple[Fraction | None, Fraction | None]] | None:
-    """The spec box grown by 1e-9 of its extent, in doubles as runtime_c/shape.c does (and the POV-Ray
-    exporter's clipped_by), as exact rationals; None bounds for infinite ones."""
+    """The spec box grown in doubles as runtime_c/shape.c grows it (implgen.abi.grown_box; the POV-Ray
+    exporter's clipped_by too), as exact rationals; None bounds for infinite ones."""
     if box is None:
         return None
-    box = np.asarray(box, dtype=float)
-    lo, hi = box[:3], box[3:]
-    scale = np.maximum(np.where(np.isfinite(lo), np.abs(lo), 0.0), np.where(np.isfinite(hi), np.abs(hi), 0.0))
-    lo, hi = lo - 1e-9 * scale, hi + 1e-9 * scale
+    lo, hi = grown_box(box)
     return [
         (Fraction(float(a)) if np.isfinite(a) else None, Fraction(float(b)) if np.isfinite(b) else None)
         for a, b in zip(lo, hi)

@@ -13,6 +13,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
+from implgen.abi import grown_box
 from implgen.roots.solvers import first_root_batch, real_roots_batch
 
 CoeffsFn = Callable[[np.ndarray, np.ndarray], np.ndarray]
@@ -23,10 +24,7 @@ def _clip(box: np.ndarray | None, o: np.ndarray, d: np.ndarray, t0: np.ndarray, 
     valid = t0 <= t1
     if box is None:
         return t0, t1, valid
-    lo, hi = box[:3], box[3:]
-    # the box grows by 1e-9 of its finite extent, as in shape.c: a surface touching its box keeps that root
-    scale = np.maximum(np.where(np.isfinite(lo), np.abs(lo), 0.0), np.where(np.isfinite(hi), np.abs(hi), 0.0))
-    lo, hi = lo - 1e-9 * scale, hi + 1e-9 * scale
+    lo, hi = grown_box(box)  # as shape.c grows it: a surface touching its box keeps that root
     with np.errstate(divide="ignore", invalid="ignore"):
         inv = 1.0 / d
         ta = (lo - o) * inv
