@@ -114,10 +114,7 @@ def nearest_hit(
     method: str = "auto",
 ) -> np.ndarray:
     """Nearest root t in [tmin, tmax] per ray (np.inf for a miss), shape = broadcast batch shape."""
-    batch, t, counts = _solve(coeffs_fn, box, o, d, tmin, tmax, method)
-    first = t[:, 0] if t.shape[1] else np.full(t.shape[0], np.nan)
-    out = np.where(counts > 0, first, np.inf)
-    return out.reshape(batch)
+    return _nearest(coeffs_fn, box, o, d, tmin, tmax, method, first=False)
 
 
 def first_hit(
@@ -131,8 +128,14 @@ def first_hit(
 ) -> np.ndarray:
     """nearest_hit through the first-root solver (`ig_first_root`: it stops at the smallest root instead of
     isolating all of them): nearest root t in [tmin, tmax] per ray, np.inf for a miss."""
-    batch, t, counts = _solve(coeffs_fn, box, o, d, tmin, tmax, method, first=True)
-    return np.where(counts > 0, t[:, 0], np.inf).reshape(batch)
+    return _nearest(coeffs_fn, box, o, d, tmin, tmax, method, first=True)
+
+
+def _nearest(coeffs_fn, box, o, d, tmin, tmax, method: str, first: bool) -> np.ndarray:
+    """The smallest root per ray, np.inf where there is none, in the broadcast batch shape."""
+    batch, t, counts = _solve(coeffs_fn, box, o, d, tmin, tmax, method, first=first)
+    near = t[:, 0] if t.shape[1] else np.full(t.shape[0], np.inf)  # degree 0: no root column
+    return np.where(counts > 0, near, np.inf).reshape(batch)
 
 
 def all_hits(
