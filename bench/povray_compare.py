@@ -57,6 +57,7 @@ _ensure_current_install()
 from implgen.bench.machine import cpu_model  # noqa: E402
 from implgen.export import povray as pv  # noqa: E402
 from implgen.roots.exactray import ExactJudge, Placed  # noqa: E402
+from implgen.scene.camera import camera_rays  # noqa: E402
 from implgen.scene.load import load_scene  # noqa: E402
 
 # --------------------------------------------------------------------------------------------- POV-Ray
@@ -129,17 +130,7 @@ def run_ours(scene: Path, out: Path, w: int, h: int, threads: int) -> tuple[floa
 
 def camera_ray(scene, x: float, y: float, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
     """Primary ray through image point (x, y) (pixel centre = +0.5), as runtime_c/tracer_render.c builds it."""
-    cam = scene.camera
-    eye = np.array(cam.position, float)
-    wv = eye - np.array(cam.look_at, float)
-    wv /= np.sqrt(wv @ wv)
-    u = np.cross(np.array(cam.up, float), wv)
-    u /= np.sqrt(u @ u)
-    v = np.cross(wv, u)
-    tan_half = np.tan(0.5 * cam.fov * np.pi / 180.0)
-    px = (2.0 * x / w - 1.0) * tan_half * (w / h)
-    py = (1.0 - 2.0 * y / h) * tan_half
-    return eye, px * u + py * v - wv
+    return camera_rays(scene.camera, w, h, x, y)
 
 
 def our_mask(scene_path: Path, w: int, h: int, threads: int) -> np.ndarray:
