@@ -91,10 +91,10 @@ def grid(n: int, seed: int = 1) -> Scene:
 
 def build_driver(out: Path, sanitize: bool) -> Path:
     """tests/c/embree_check.c with the runtime, the shapes it names and Embree, with the project's warnings."""
-    from implgen.compile.clib import WARNING_FLAGS, compiler
+    from implgen.compile.clib import SANITIZE_FLAGS, WARNING_FLAGS, compiler
     from implgen.resources import EMBREE_SOURCES, SHAPE_SOURCES, SOLVER_SOURCES, TRACER_SOURCES, runtime_sources
 
-    flags = ["-O1", "-g", "-fsanitize=address,undefined", "-fno-sanitize-recover=all"] if sanitize else ["-O2"]
+    flags = list(SANITIZE_FLAGS) if sanitize else ["-O2"]
     sources = [ROOT / "tests/c/embree_check.c"]
     sources += runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES, TRACER_SOURCES, EMBREE_SOURCES)
     sources += [ROOT / "generated" / f"{s}.c" for s in SHAPES]

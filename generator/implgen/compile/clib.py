@@ -38,6 +38,14 @@ from implgen.errors import UserError
 # and what `implgen demo` says it compiled with.
 WARNING_FLAGS: tuple[str, ...] = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic")
 BASE_FLAGS: tuple[str, ...] = (*WARNING_FLAGS, "-O3", "-fPIC")
+# AddressSanitizer and UndefinedBehaviorSanitizer, any report fatal: the tests' C drivers and the Embree checks
+SANITIZE_FLAGS: tuple[str, ...] = (
+    "-O1",
+    "-g",
+    "-fsanitize=address,undefined",
+    "-fno-sanitize-recover=all",
+    "-fno-omit-frame-pointer",
+)
 KEY_FORMAT = "clib-2"  # part of every key: entries of an earlier layout are never taken for these
 
 # The libraries this process holds loaded (a live ctypes handle): eviction leaves them alone. Weak, so a library
