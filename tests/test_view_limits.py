@@ -378,7 +378,8 @@ def test_idle_sockets_time_out(servers) -> None:
         with pytest.raises(ConnectionClosed) as closed:
             while True:
                 ws.recv(GUARD)
-        assert "idle" in (closed.value.rcvd.reason if closed.value.rcvd else ""), closed.value
+        reason = closed.value.rcvd.reason if closed.value.rcvd else ""
+        assert reason.startswith("idle for 2 s") and "reload" in reason, closed.value  # the page says so
 
 
 def _first_page_in(srv: Server, why: str) -> Page:
