@@ -18,6 +18,8 @@ from pathlib import Path
 
 import pytest
 
+from implgen_proc import Ran, assert_one_line
+
 ROOT = Path(__file__).resolve().parent.parent
 SPHERE = ROOT / "examples" / "shapes" / "sphere.yaml"
 
@@ -58,13 +60,10 @@ def cache_command(cache: Path, *args: str, **env: str) -> subprocess.CompletedPr
 
 
 def one_line_error(proc: subprocess.CompletedProcess, *fragments: str) -> str:
-    """Exit status 2, exactly one line on stderr saying each fragment, no traceback."""
-    assert proc.returncode == 2, (proc.returncode, proc.stdout, proc.stderr)
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
-    return lines[0]
+    """The bad-input contract (implgen_proc.assert_one_line): exit status 2, one line on stderr saying each
+    fragment, no traceback. Returns the line."""
+    assert_one_line(Ran(proc.returncode, proc.stdout, proc.stderr, 0.0), *fragments)
+    return proc.stderr.strip()
 
 
 def libraries(cache: Path) -> list[Path]:
