@@ -323,8 +323,14 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
             continue;
         b = &s->bvh[stack[sp]];
         if (b->left < 0) {
-            for (i = b->first; i < b->first + b->count; ++i)
+            for (i = b->first; i < b->first + b->count; ++i) {
+                /* A leaf's box holds its objects' boxes, which may be far apart (a scene's objects to the left
+                 * and right of the one in the middle): each object's own box first, before its solve sets up. */
+                double o0 = tmin, o1 = best;
+                if (b->count > 1 && !ray_box(s->nodes[s->objects[s->order[i]]].wbox, &ray, &o0, &o1))
+                    continue;
                 RT_TAKE(s->order[i])
+            }
         } else if (sp + 2 <= (int)(sizeof stack / sizeof stack[0])) {
             /* visit the nearer child first: push it last */
             const rt_bvh_node *l = &s->bvh[b->left], *r = &s->bvh[b->right];
