@@ -452,7 +452,7 @@ def main() -> int:
         "",
     ]
     lines += drag_lines(drag_new, drag_old, args.drag_rounds, args.compare)
-    lines[-1:] = [f"Load average (1 min) before the drags {drag_load:.2f}, after {drag_load_after:.2f}.", ""]
+    lines += [f"Load average (1 min) before the drags {drag_load:.2f}, after {drag_load_after:.2f}.", ""]
     if busy is not None:
         lines += [
             f"With heavy neighbours: {NEIGHBOURS} other pages kept sending `{NEIGHBOUR_EQUATION} + n/k` (a new "
