@@ -30,10 +30,6 @@ class Mesh:
     cell: np.ndarray | None = None  # per vertex, the flat index of its cell's lower corner (-1: added by faces.py)
 
 
-def _corner_offsets(strides: np.ndarray) -> np.ndarray:
-    return np.array([((c & 1) * strides[0] + (c >> 1 & 1) * strides[1] + (c >> 2 & 1) * strides[2]) for c in range(8)])
-
-
 def _face_bits(lib, clips, grid: Grid, cell_idx: np.ndarray, config: np.ndarray) -> np.ndarray:
     """Bit f when face f of the cell is ambiguous and the solid's value at its centre is inside. The centre is
     computed from the face's global index, so the two cells that share it read the same point."""
@@ -68,35 +64,35 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     ins = inside.view(np.uint8)
     n0, n1, n2 = grid.n
     config = np.zeros((n0, n1, n2), dtype=np.uint8)
-    for c in range(8):
-        dx, dy, dz = c & 1, c >> 1 & 1, c >> 2 & 1
+    for c, (dx, dy, dz) in enumerate(cells.CORNER_OFFSETS):
         config |= ins[dx : dx + n0, dy : dy + n1, dz : dz + n2] << np.uint8(c)
-    cidx = np.argwhere((config != 0) & (config != 255))
-    conf = config[tuple(cidx.T)].astype(np.int64)
-    cflat = np.ravel_multi_index(tuple(cidx.T), shape)
+    cflat = np.flatnonzero((config != 0) & (config != 255))  # in the cells' own (n0, n1, n2) numbering
+    cidx = np.stack(np.unravel_index(cflat, grid.n), axis=1)
+    conf = config.reshape(-1)[cflat].astype(np.int64)
+    cflat = cidx @ strides  # now the flat index of each cell's lower corner among the grid's vertices
     key = conf | _face_bits(lib, clips, grid, cidx, conf) << 8
     row, table, nsheets = cells.cell_table(key)
-    sheets = table[row]  # (C, 12)
+    sheets = table[row]  # (C, 12) int8: the sheet of each edge in its cell, -1 where not active
     count = nsheets[row]
     base = np.concatenate([[0], np.cumsum(count)[:-1]])
-    cellvert = np.where(sheets >= 0, base[:, None] + sheets, -1)
     nverts = int(count.sum())
 
     clock.append(time.perf_counter())
     # every sheet's crossings -> QEF point -> onto the surface
-    corner = _corner_offsets(strides)
-    vids, cps, cns, cpieces = [], [], [], []
+    corner = cells.CORNER_OFFSETS @ strides
+    offset = np.cumsum([0] + [c.edges.size for c in cross])
+    vids, cids = [], []
     for e in range(12):
-        has = np.nonzero(cellvert[:, e] >= 0)[0]
+        col = sheets[:, e]
+        has = np.flatnonzero(col >= 0)
         a = e // 4
         start, _ = cells.edge_corners(e)
-        edge = cflat[has] + corner[start]
-        k = np.searchsorted(cross[a].edges, edge)
-        vids.append(cellvert[has, e])
-        cps.append(cross[a].points[k])
-        cns.append(cross[a].normals[k])
-        cpieces.append(cross[a].piece[k])
-    vid, cp, cn, cpiece = (np.concatenate(x) for x in (vids, cps, cns, cpieces))
+        vids.append(base[has] + col[has])
+        cids.append(offset[a] + np.searchsorted(cross[a].edges, cflat[has] + corner[start]))
+    vid, cid = np.concatenate(vids), np.concatenate(cids)
+    cp = np.concatenate([c.points for c in cross])[cid]
+    cn = np.concatenate([c.normals for c in cross])[cid]
+    cpiece = np.concatenate([c.piece for c in cross])[cid]
     cell_of_vertex = np.repeat(np.arange(len(cidx)), count)
     lower = grid.origin + grid.h * cidx[cell_of_vertex]
     qef = qef_points(vid, cp, cn, nverts, lower, grid.h)
@@ -128,7 +124,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         for q, (db, dc) in enumerate(AROUND):
             r = rowof[edges - db * strides[b] - dc * strides[c]]
             u, v = (db, dc) if lo_ax == b else (dc, db)  # the edge's offsets inside that cell
-            quad[:, q] = cellvert[r, 4 * a + u + 2 * v]
+            quad[:, q] = base[r] + sheets[r, 4 * a + u + 2 * v]
         flip = ~inside.reshape(-1)[edges]  # outside below: the outside is toward -a
         parts.append((quad, np.full(edges.size, a), edges, flip, cross[a].points, cross[a].piece))
     quads = Quads(*(np.concatenate([p[i] for p in parts]) for i in range(6)))

@@ -32,9 +32,8 @@ def qef_points(
     mass = np.stack([np.bincount(vid, points[:, k], minlength=nverts) for k in range(3)], axis=1) / count[:, None]
     mean_n = np.stack([np.bincount(vid, normals[:, k], minlength=nverts) for k in range(3)], axis=1)
     mean_n /= np.maximum(np.linalg.norm(mean_n, axis=1, keepdims=True), 1e-300)
-    spread = np.ones(nverts)
-    np.minimum.at(spread, vid, (normals * mean_n[vid]).sum(axis=1))
-    sharp = spread < CREASE
+    off = np.einsum("ij,ij->i", normals, mean_n[vid]) < CREASE  # a crossing normal off its sheet's mean
+    sharp = np.bincount(vid, off, minlength=nverts) > 0
     sel = np.nonzero(sharp[vid])[0]
     out = mass.copy()
     if sel.size:
