@@ -30,7 +30,7 @@ from implgen.bench.machine import load_average, write_results
 from implgen.codegen.emit import generate
 from implgen.codegen.speccache import load_spec
 from implgen.mesh.contour import contour
-from implgen.mesh.crossings import clip_values
+from implgen.mesh.crossings import boundary_value_gradient
 from implgen.mesh.pipeline import closed_and_euler
 from implgen.mesh.region import make_grid, parse_clip
 from implgen.mesh.shapelib import ShapeLib
@@ -60,15 +60,7 @@ def python_module(spec, folder: Path):
 
 
 def boundary_distance(lib: ShapeLib, clips, verts: np.ndarray) -> np.ndarray:
-    f, g = lib.value_gradient(verts)
-    cv = clip_values(clips, verts)
-    if len(cv):
-        top = cv.argmax(axis=0)
-        use = cv.max(axis=0) > f
-        f = np.where(use, cv.max(axis=0), f)
-        for k, c in enumerate(clips):
-            sel = use & (top == k)
-            g[sel] = c.gradient(verts[sel])
+    f, g = boundary_value_gradient(lib, clips, verts)
     return np.abs(f) / np.maximum(np.linalg.norm(g, axis=1), 1e-300)
 
 

@@ -44,3 +44,40 @@ void ig_shape_values_grid(const ig_shape *shape, const double *params, const dou
                 f[((size_t)i * (size_t)ny + (size_t)j) * (size_t)nz + (size_t)k] = shape->value(p, params);
             }
 }
+
+/* One point's Newton steps of least norm onto f = 0; 1 when it converged (see shape_batch.h). */
+static int project_one(const ig_shape *shape, const double *params, double *p, int steps, double tol, double noise)
+{
+    double prev = INFINITY, size = INFINITY;
+    for (int k = 0; k < steps; ++k) {
+        double g[3], s[3];
+        double f = shape->value(p, params);
+        shape->gradient(p, params, g);
+        double gg = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        if (!(gg > 0)) /* no direction to step in */
+            return 0;
+        double c = -(f / gg);
+        for (int i = 0; i < 3; ++i)
+            s[i] = c * g[i];
+        if (!isfinite(s[0]) || !isfinite(s[1]) || !isfinite(s[2]))
+            return 0;
+        for (int i = 0; i < 3; ++i)
+            p[i] += s[i];
+        size = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+        if (size <= tol || (size > 0.5 * prev && size <= noise))
+            return 1;
+        prev = size;
+    }
+    return size <= noise;
+}
+
+void ig_shape_project_many(const ig_shape *shape, const double *params, long n, double *p, int steps, double tol,
+                           double noise, unsigned char *ok)
+{
+    if (!shape || !p || !ok)
+        return;
+    for (long i = 0; i < n; ++i)
+        ok[i] = shape->value && shape->gradient
+                    ? (unsigned char)project_one(shape, params, p + 3 * (size_t)i, steps, tol, noise)
+                    : 0;
+}

@@ -18,7 +18,6 @@ from functools import cache
 
 import numpy as np
 
-
 # corner c's offsets along the three axes (the numbering above)
 CORNER_OFFSETS = np.array([[c & 1, c >> 1 & 1, c >> 2 & 1] for c in range(8)], dtype=np.int64)
 

@@ -40,6 +40,9 @@ class ShapeLib:
         lib.ig_shape_eval_many.argtypes = [_VP, _DP, ctypes.c_long, _DP, _DP, _DP]
         lib.ig_shape_values_grid.restype = None
         lib.ig_shape_values_grid.argtypes = [_VP, _DP, _DP, ctypes.c_long, _DP, ctypes.c_long, _DP, ctypes.c_long, _DP]
+        lib.ig_shape_project_many.restype = None
+        lib.ig_shape_project_many.argtypes = [_VP, _DP, ctypes.c_long, _DP, ctypes.c_int, ctypes.c_double,
+                                              ctypes.c_double, ctypes.c_void_p]  # fmt: skip
         self._lib = lib
         self._shape = lib.rt_scene_shape(0)
         self._params = np.ascontiguousarray(np.asarray(list(params) or [0.0], dtype=np.float64))
@@ -84,3 +87,14 @@ class ShapeLib:
             self._shape, _ptr(self._params), _ptr(x), x.size, _ptr(y), y.size, _ptr(z), z.size, _ptr(f)
         )
         return f
+
+    def project(self, p: np.ndarray, steps: int, tol: float, noise: float) -> tuple[np.ndarray, np.ndarray]:
+        """Each point moved onto f = 0 by at most `steps` Newton steps of least norm: (points, converged flags);
+        converged: a step at most `tol`, or at most `noise` and no longer halving (f's rounding), or a last step
+        at most `noise` (ig_shape_project_many)."""
+        out = np.array(p, dtype=np.float64, order="C").reshape(-1, 3)
+        ok = np.zeros(len(out), dtype=np.uint8)
+        self._lib.ig_shape_project_many(
+            self._shape, _ptr(self._params), len(out), _ptr(out), steps, tol, noise, ok.ctypes.data
+        )
+        return out, ok.astype(bool)
