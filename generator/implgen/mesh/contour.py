@@ -11,7 +11,7 @@ import numpy as np
 
 from implgen.mesh import cells
 from implgen.mesh.crossings import Crossings, axis_crossings, grid_flags, inside_flags
-from implgen.mesh.dual import outside_pieces, piece_mask, project, qef_points
+from implgen.mesh.dual import CREASE, DROP, outside_pieces, project
 from implgen.mesh.faces import Quads, triangulate
 from implgen.mesh.region import Clip, Grid
 from implgen.mesh.shapelib import ShapeLib
@@ -78,25 +78,15 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     nverts = int(count.sum())
 
     clock.append(time.perf_counter())
-    # every sheet's crossings -> QEF point -> onto the surface
-    corner = cells.CORNER_OFFSETS @ strides
-    offset = np.cumsum([0] + [c.edges.size for c in cross])
-    vids, cids = [], []
-    for e in range(12):
-        col = sheets[:, e]
-        has = np.flatnonzero(col >= 0)
-        a = e // 4
-        start, _ = cells.edge_corners(e)
-        vids.append(base[has] + col[has])
-        cids.append(offset[a] + np.searchsorted(cross[a].edges, cflat[has] + corner[start]))
-    vid, cid = np.concatenate(vids), np.concatenate(cids)
-    cp = np.concatenate([c.points for c in cross])[cid]
-    cn = np.concatenate([c.normals for c in cross])[cid]
-    cpiece = np.concatenate([c.piece for c in cross])[cid]
-    cell_of_vertex = np.repeat(np.arange(len(cidx)), count)
-    lower = grid.origin + grid.h * cidx[cell_of_vertex]
-    qef = qef_points(vid, cp, cn, nverts, lower, grid.h)
-    mask = piece_mask(vid, cpiece, nverts)
+    # every sheet's crossings -> QEF point (one C loop over the cells) -> onto the surface
+    nv = int(np.prod(shape))
+    keys = np.concatenate([a * nv + c.edges for a, c in enumerate(cross)])
+    cp = np.concatenate([c.points for c in cross])
+    cn = np.concatenate([c.normals for c in cross])
+    cpiece = np.concatenate([c.piece for c in cross])
+    qef, mask, nearest = lib.sheet_points(
+        cflat, sheets, base, strides, nv, keys, cp, cn, cpiece, grid.origin, grid.h, CREASE, DROP, nverts
+    )
     clock.append(time.perf_counter())
     verts, projected = project(lib, clips, qef, mask, grid.h, grid.size)
     extra = outside_pieces(lib, clips, verts, mask, grid.size)
@@ -106,10 +96,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         verts[redo], projected[redo] = project(lib, clips, verts[redo], mask[redo], grid.h, grid.size)
     failed = ~projected
     if failed.any():  # Newton strayed (near a node, a thin neck): the sheet's crossing nearest the QEF point,
-        d = np.linalg.norm(cp - qef[vid], axis=1)  # which lies on the surface exactly
-        order = np.lexsort((d, vid))
-        first = order[np.unique(vid[order], return_index=True)[1]]
-        verts[failed] = cp[first][failed]
+        verts[failed] = cp[nearest[failed]]  # which lies on the surface exactly
 
     clock.append(time.perf_counter())
     # one quad per active edge, from the sheets of its four cells
@@ -143,5 +130,5 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         "split_sides": split,
     }
     cell = np.full(len(verts), -1, dtype=np.int64)
-    cell[:nverts] = cflat[cell_of_vertex]
+    cell[:nverts] = np.repeat(cflat, count)
     return Mesh(vertices=verts, faces=faces, grid=grid, stats=stats, cell=cell)

@@ -3,7 +3,7 @@
 First the QEF of dual contouring (Ju, Losasso, Schaefer and Warren 2002): the point nearest, in least squares,
 to the tangent planes at the sheet's crossings (exact points, unit normals from the generated gradient), with
 the small eigenvalues of the normal matrix dropped (a flat or curved piece keeps to the crossings' mass point
-along it; a crease or a corner is located), clamped to the cell. Then onto the surface itself: Newton steps of
+along it; a crease or a corner is located), clamped to the cell; computed in C (ShapeLib.sheet_points). Then onto the surface itself: Newton steps of
 least norm on the pieces that bound the sheet (f alone on a smooth sheet; f and a clip on a cap's rim, two clip
 planes on a box's edge), so every vertex lies on the true boundary up to rounding. A projection that does not
 converge or strays beyond a cell is reported, and contour.py puts that vertex on the sheet's nearest crossing.
@@ -17,43 +17,10 @@ from implgen.mesh.crossings import piece_value_gradient
 from implgen.mesh.region import Clip
 from implgen.mesh.shapelib import ShapeLib
 
+# The QEF is one C loop over the cells (ig_mesh_sheet_points, runtime_c/shape_batch.c), given these two:
 DROP = 0.1  # eigenvalues below DROP x the largest are dropped (the usual truncation of the QEF's SVD)
 CREASE = 0.9  # a sheet whose crossing normals all lie within acos(0.9) = 26 degrees of their mean is smooth
 NOISE = 1e-10  # a Newton step still this large (times the box) after the last step: f's rounding, accepted
-
-
-def qef_points(
-    vid: np.ndarray, points: np.ndarray, normals: np.ndarray, nverts: int, lower: np.ndarray, h: float
-) -> np.ndarray:
-    """Minimisers, one per vertex, of sum (n . (x - p))^2 over the crossings (vid[i], points[i], normals[i]),
-    about their mass point, clamped to each vertex's cell [lower, lower + h]. Where the normals all lie
-    within CREASE of their mean (a smooth piece) the QEF would only slide the point along the surface, so the
-    mass point is kept and the eigen-solve is spent on creases, rims and singular points."""
-    count = np.maximum(np.bincount(vid, minlength=nverts).astype(np.float64), 1.0)
-    mass = np.stack([np.bincount(vid, points[:, k], minlength=nverts) for k in range(3)], axis=1) / count[:, None]
-    mean_n = np.stack([np.bincount(vid, normals[:, k], minlength=nverts) for k in range(3)], axis=1)
-    mean_n /= np.maximum(np.linalg.norm(mean_n, axis=1, keepdims=True), 1e-300)
-    off = np.einsum("ij,ij->i", normals, mean_n[vid]) < CREASE  # a crossing normal off its sheet's mean
-    sharp = np.bincount(vid, off, minlength=nverts) > 0
-    sel = np.nonzero(sharp[vid])[0]
-    out = mass.copy()
-    if sel.size:
-        verts = np.nonzero(sharp)[0]
-        local = np.searchsorted(verts, vid[sel])
-        n = normals[sel]
-        q = points[sel] - mass[vid[sel]]
-        nq = (n * q).sum(axis=1)
-        m = verts.size
-        ata = np.zeros((m, 3, 3))
-        atb = np.zeros((m, 3))
-        for i in range(3):
-            atb[:, i] = np.bincount(local, n[:, i] * nq, minlength=m)
-            for j in range(i, 3):
-                ata[:, i, j] = ata[:, j, i] = np.bincount(local, n[:, i] * n[:, j], minlength=m)
-        w, v = np.linalg.eigh(ata)
-        inv = np.where(w > DROP * w[:, -1:], 1.0 / np.where(w > 0, w, 1.0), 0.0)
-        out[verts] += np.einsum("nij,nj,nkj,nk->ni", v, inv, v, atb)
-    return np.clip(out, lower, lower + h)
 
 
 def piece_mask(vid: np.ndarray, piece: np.ndarray, nverts: int) -> np.ndarray:

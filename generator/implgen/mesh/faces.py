@@ -40,9 +40,9 @@ SIDE_NORMAL = (1, 2, 1, 2)
 
 def _simple(q: np.ndarray, verts: np.ndarray, flip: np.ndarray) -> np.ndarray:
     q = np.where(flip[:, None], q[:, ::-1], q)
-    d02 = np.linalg.norm(verts[q[:, 0]] - verts[q[:, 2]], axis=1)
-    d13 = np.linalg.norm(verts[q[:, 1]] - verts[q[:, 3]], axis=1)
-    alt = (d13 < d02)[:, None]
+    v02 = verts[q[:, 0]] - verts[q[:, 2]]
+    v13 = verts[q[:, 1]] - verts[q[:, 3]]
+    alt = (np.einsum("ij,ij->i", v13, v13) < np.einsum("ij,ij->i", v02, v02))[:, None]
     t1 = np.where(alt, q[:, [1, 2, 3]], q[:, [0, 1, 2]])
     t2 = np.where(alt, q[:, [1, 3, 0]], q[:, [0, 2, 3]])
     return np.concatenate([t1, t2])
@@ -62,12 +62,14 @@ def triangulate(
     cell has an ambiguous face (only a quad with all its sides' cells so can hold a doubled side)."""
     q = quads.verts
     dup = np.zeros((len(q), 4), dtype=bool)
-    sides = np.stack([np.sort(np.stack([q[:, k], q[:, (k + 1) % 4]], axis=1), axis=1) for k in range(4)], axis=1)
     cand = np.nonzero(near_amb[q].any(axis=1))[0]
-    if cand.size:
-        key = sides[cand, :, 0] * len(verts) + sides[cand, :, 1]
-        _, inv, cnt = np.unique(key.reshape(-1), return_inverse=True, return_counts=True)
-        dup[cand] = (cnt[inv.reshape(-1)] > 2).reshape(-1, 4)
+    if cand.size == 0:
+        return verts, _simple(q, verts, quads.flip), 0
+    qc = q[cand]
+    sides = np.sort(np.stack([qc, np.roll(qc, -1, axis=1)], axis=2), axis=2)  # (cand, 4, 2): side k's two ends
+    key = sides[:, :, 0] * len(verts) + sides[:, :, 1]
+    _, inv, cnt = np.unique(key.reshape(-1), return_inverse=True, return_counts=True)
+    dup[cand] = (cnt[inv.reshape(-1)] > 2).reshape(-1, 4)
     hit = dup.any(axis=1)
     if not hit.any():
         return verts, _simple(q, verts, quads.flip), 0
@@ -91,7 +93,8 @@ def triangulate(
     lo_in = inside.reshape(-1)[quads.edge[qi]]
     strides = np.array([shape[1] * shape[2], shape[2], 1])
     corner = np.where(lo_in != c_in, quads.edge[qi], quads.edge[qi] + strides[a])
-    key = np.stack([sides[qi, ks, 0], sides[qi, ks, 1], corner, normal], axis=1)
+    side = sides[np.searchsorted(cand, qi), ks]
+    key = np.stack([side[:, 0], side[:, 1], corner, normal], axis=1)
     ukey, mid_of = np.unique(key, axis=0, return_inverse=True)
     mid_of = mid_of.reshape(-1)
     nmid = len(ukey)
