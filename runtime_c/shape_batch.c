@@ -233,3 +233,26 @@ void ig_mesh_sheet_points(long ncells, const long *corner, const signed char *sh
         }
     }
 }
+
+static double dist2(const double *a, const double *b)
+{
+    double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+void ig_mesh_split_quads(long m, const long *quads, const unsigned char *flip, const double *verts, long *tris)
+{
+    static const int keep[2][2][3] = {{{0, 1, 2}, {0, 2, 3}}, {{1, 2, 3}, {1, 3, 0}}};
+    if (!quads || !flip || !verts || !tris)
+        return;
+    for (long i = 0; i < m; ++i) {
+        long q[4];
+        for (int k = 0; k < 4; ++k)
+            q[k] = quads[4 * (size_t)i + (size_t)(flip[i] ? 3 - k : k)];
+        int alt = dist2(verts + 3 * (size_t)q[1], verts + 3 * (size_t)q[3]) <
+                  dist2(verts + 3 * (size_t)q[0], verts + 3 * (size_t)q[2]);
+        for (int t = 0; t < 2; ++t)
+            for (int k = 0; k < 3; ++k)
+                tris[3 * ((size_t)t * (size_t)m + (size_t)i) + (size_t)k] = q[keep[alt][t][k]];
+    }
+}

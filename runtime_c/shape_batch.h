@@ -41,4 +41,8 @@ void ig_mesh_sheet_points(long ncells, const long *corner, const signed char *sh
                           const double *normals, const int *piece, const double *origin, double h, double crease,
                           double drop, double *out, long *mask, long *nearest);
 
+/* Quads (m x 4 vertex ids, counter-clockwise about their edge's axis; flip[i]: reversed) into triangles on the
+ * shorter diagonal: tris[3 i ...] the first of quad i, tris[3 (m + i) ...] the second. */
+void ig_mesh_split_quads(long m, const long *quads, const unsigned char *flip, const double *verts, long *tris);
+
 #endif

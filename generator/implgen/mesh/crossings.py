@@ -117,6 +117,8 @@ def _candidates(lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, starts:
     for k in range(len(clips)):
         others = np.maximum(others, np.where(piece == k + 1, -np.inf, cvals[k]))
     keep = others <= 0
+    if not keep[lines.size :].any():  # no clip bounds the solid on these lines: f's roots, already in order
+        return lines[keep[: lines.size]], t[: lines.size][keep[: lines.size]], piece[: lines.size][keep[: lines.size]]
     order = np.lexsort((t[keep], line[keep]))
     return line[keep][order], t[keep][order], piece[keep][order]
 

@@ -3,10 +3,11 @@
 First the QEF of dual contouring (Ju, Losasso, Schaefer and Warren 2002): the point nearest, in least squares,
 to the tangent planes at the sheet's crossings (exact points, unit normals from the generated gradient), with
 the small eigenvalues of the normal matrix dropped (a flat or curved piece keeps to the crossings' mass point
-along it; a crease or a corner is located), clamped to the cell; computed in C (ShapeLib.sheet_points). Then onto the surface itself: Newton steps of
-least norm on the pieces that bound the sheet (f alone on a smooth sheet; f and a clip on a cap's rim, two clip
-planes on a box's edge), so every vertex lies on the true boundary up to rounding. A projection that does not
-converge or strays beyond a cell is reported, and contour.py puts that vertex on the sheet's nearest crossing.
+along it; a crease or a corner is located), clamped to the cell: one C loop over the cells
+(ShapeLib.sheet_points). Then onto the surface itself: Newton steps of least norm on the pieces that bound the
+sheet (f alone on a smooth sheet, in C too; f and a clip on a cap's rim, two clip planes on a box's edge), so
+every vertex lies on the true boundary up to rounding. A projection that does not converge or strays beyond a
+cell is reported, and contour.py puts that vertex on the sheet's nearest crossing.
 """
 
 from __future__ import annotations
@@ -109,13 +110,15 @@ def _newton_pieces(
 def outside_pieces(lib: ShapeLib, clips: list[Clip], p: np.ndarray, mask: np.ndarray, size: float) -> np.ndarray:
     """Bit mask, per point, of the pieces not in `mask` that are positive there by more than 1e-12 of the box
     (to first order): a cap vertex outside f, a surface vertex outside a clip. Each piece is evaluated only at
-    the points whose mask lacks it."""
+    the points whose mask lacks it, its gradient only where it is positive."""
     out = np.zeros(len(p), dtype=np.int64)
     for j in range(len(clips) + 1):
         sel = np.flatnonzero(((mask >> j) & 1) == 0)
+        v = lib.value(p[sel]) if j == 0 else clips[j - 1].value(p[sel])
+        sel = sel[v > 0]
         if sel.size == 0:
             continue
-        v, g = _pieces_eval(lib, clips, [j], p[sel])
-        dist = v[:, 0] / np.maximum(np.linalg.norm(g[:, 0], axis=1), 1e-300)
+        v, g = piece_value_gradient(lib, clips, j, p[sel])
+        dist = v / np.maximum(np.linalg.norm(g, axis=1), 1e-300)
         out[sel[dist > 1e-12 * size]] |= np.int64(1) << np.int64(j)
     return out

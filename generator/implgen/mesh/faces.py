@@ -38,16 +38,6 @@ class Quads:
 SIDE_NORMAL = (1, 2, 1, 2)
 
 
-def _simple(q: np.ndarray, verts: np.ndarray, flip: np.ndarray) -> np.ndarray:
-    q = np.where(flip[:, None], q[:, ::-1], q)
-    v02 = verts[q[:, 0]] - verts[q[:, 2]]
-    v13 = verts[q[:, 1]] - verts[q[:, 3]]
-    alt = (np.einsum("ij,ij->i", v13, v13) < np.einsum("ij,ij->i", v02, v02))[:, None]
-    t1 = np.where(alt, q[:, [1, 2, 3]], q[:, [0, 1, 2]])
-    t2 = np.where(alt, q[:, [1, 3, 0]], q[:, [0, 2, 3]])
-    return np.concatenate([t1, t2])
-
-
 def triangulate(
     quads: Quads,
     verts: np.ndarray,
@@ -64,7 +54,7 @@ def triangulate(
     dup = np.zeros((len(q), 4), dtype=bool)
     cand = np.nonzero(near_amb[q].any(axis=1))[0]
     if cand.size == 0:
-        return verts, _simple(q, verts, quads.flip), 0
+        return verts, lib.split_quads(q, quads.flip, verts), 0
     qc = q[cand]
     sides = np.sort(np.stack([qc, np.roll(qc, -1, axis=1)], axis=2), axis=2)  # (cand, 4, 2): side k's two ends
     key = sides[:, :, 0] * len(verts) + sides[:, :, 1]
@@ -72,7 +62,7 @@ def triangulate(
     dup[cand] = (cnt[inv.reshape(-1)] > 2).reshape(-1, 4)
     hit = dup.any(axis=1)
     if not hit.any():
-        return verts, _simple(q, verts, quads.flip), 0
+        return verts, lib.split_quads(q, quads.flip, verts), 0
     shape = inside.shape
     qi, ks = np.nonzero(dup)
     a = quads.axis[qi]
@@ -119,5 +109,5 @@ def triangulate(
             tris.append(t[::-1] if quads.flip[qn] else t)
     out_verts = np.concatenate([verts, mids, quads.point[fan]])
     keep = ~hit
-    faces = np.concatenate([_simple(q[keep], verts, quads.flip[keep]), np.array(tris, dtype=np.int64)])
+    faces = np.concatenate([lib.split_quads(q[keep], quads.flip[keep], verts), np.array(tris, dtype=np.int64)])
     return out_verts, faces, nmid

@@ -48,6 +48,8 @@ class ShapeLib:
         lib.ig_mesh_sheet_points.argtypes = [ctypes.c_long, _VP, _VP, _VP, _VP, ctypes.c_long, ctypes.c_long, _VP,
                                              _DP, _DP, _VP, _DP, ctypes.c_double, ctypes.c_double, ctypes.c_double,
                                              _DP, _VP, _VP]  # fmt: skip
+        lib.ig_mesh_split_quads.restype = None
+        lib.ig_mesh_split_quads.argtypes = [ctypes.c_long, _VP, _VP, _DP, _VP]
         self._lib = lib
         self._shape = lib.rt_scene_shape(0)
         self._params = np.ascontiguousarray(np.asarray(list(params) or [0.0], dtype=np.float64))
@@ -127,3 +129,15 @@ class ShapeLib:
             drop, _ptr(out), mask.ctypes.data, nearest.ctypes.data,
         )  # fmt: skip
         return out, mask.astype(np.int64), nearest.astype(np.int64)
+
+    def split_quads(self, quads: np.ndarray, flip: np.ndarray, verts: np.ndarray) -> np.ndarray:
+        """Quads (m, 4) into triangles (2 m, 3) on their shorter diagonals, reversed where flip
+        (ig_mesh_split_quads)."""
+        quads = np.ascontiguousarray(quads, dtype=_LONG).reshape(-1, 4)
+        flip = np.ascontiguousarray(flip, dtype=np.uint8)
+        verts = np.ascontiguousarray(verts, dtype=np.float64)
+        if len(flip) != len(quads) or (quads.size and not 0 <= quads.min() <= quads.max() < len(verts)):
+            raise ValueError("split_quads: quads and flags disagree, or a vertex id is out of range")
+        tris = np.empty((2 * len(quads), 3), dtype=_LONG)
+        self._lib.ig_mesh_split_quads(len(quads), quads.ctypes.data, flip.ctypes.data, _ptr(verts), tris.ctypes.data)
+        return tris.astype(np.int64, copy=False)
