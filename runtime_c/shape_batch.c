@@ -72,14 +72,17 @@ static int project_one(const ig_shape *shape, const double *params, double *p, i
 }
 
 void ig_shape_project_many(const ig_shape *shape, const double *params, long n, double *p, int steps, double tol,
-                           double noise, unsigned char *ok)
+                           double noise, double reach, unsigned char *ok)
 {
     if (!shape || !p || !ok)
         return;
-    for (long i = 0; i < n; ++i)
-        ok[i] = shape->value && shape->gradient
-                    ? (unsigned char)project_one(shape, params, p + 3 * (size_t)i, steps, tol, noise)
-                    : 0;
+    for (long i = 0; i < n; ++i) {
+        double *q = p + 3 * (size_t)i, start[3] = {q[0], q[1], q[2]};
+        int done = shape->value && shape->gradient && project_one(shape, params, q, steps, tol, noise);
+        for (int k = 0; k < 3; ++k) /* NaN fails this test too */
+            done = done && fabs(q[k] - start[k]) <= reach;
+        ok[i] = (unsigned char)done;
+    }
 }
 
 /* The eigenvalues w and unit eigenvectors (columns of v) of the symmetric 3x3 matrix a, by cyclic Jacobi
@@ -125,10 +128,16 @@ static void sym3_eigen(double a[3][3], double w[3], double v[3][3])
         w[i] = a[i][i];
 }
 
-/* The index of edge key `key` in the ascending keys[0 .. n), or -1. */
-static long find_key(const long *keys, long n, long key)
+/* The index of edge key `key` in the ascending keys[0 .. n), or -1. *at: where the last search for this edge of
+ * the cell ended; the cells come in ascending order, so the next key is usually a few entries further on. */
+static long find_key(const long *keys, long n, long key, long *at)
 {
     long lo = 0, hi = n;
+    if (*at < n && keys[*at] <= key) { /* a few steps forward, then a binary search in what is left */
+        lo = *at;
+        for (int k = 0; k < 8 && lo < n && keys[lo] < key; ++k)
+            ++lo;
+    }
     while (lo < hi) {
         long mid = lo + (hi - lo) / 2;
         if (keys[mid] < key)
@@ -136,6 +145,7 @@ static long find_key(const long *keys, long n, long key)
         else
             hi = mid;
     }
+    *at = lo;
     return lo < n && keys[lo] == key ? lo : -1;
 }
 
@@ -147,6 +157,7 @@ void ig_mesh_sheet_points(long ncells, const long *corner, const signed char *sh
     if (!corner || !sheets || !first || !strides || !keys || !points || !normals || !piece || !origin || !out ||
         !mask || !nearest)
         return;
+    long at[12] = {0};
     for (long c = 0; c < ncells; ++c) {
         const signed char *sh = sheets + 12 * (size_t)c;
         long idx[12];
@@ -158,7 +169,7 @@ void ig_mesh_sheet_points(long ncells, const long *corner, const signed char *sh
                 continue;
             int a = e / 4, u = e % 2, v = (e / 2) % 2;
             int b = a == 0 ? 1 : 0, d = a == 2 ? 1 : 2;
-            idx[e] = find_key(keys, ncross, a * nvertices + corner[c] + u * strides[b] + v * strides[d]);
+            idx[e] = find_key(keys, ncross, a * nvertices + corner[c] + u * strides[b] + v * strides[d], at + e);
             if (sh[e] + 1 > nsheets)
                 nsheets = sh[e] + 1;
         }

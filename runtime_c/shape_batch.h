@@ -22,11 +22,11 @@ void ig_shape_values_grid(const ig_shape *shape, const double *params, const dou
                           long ny, const double *z, long nz, double *f);
 
 /* Each point p_i moved onto f = 0 by Newton steps of least norm, p += -f grad f / |grad f|^2, at most `steps` of
- * them, in place. ok[i] = 1 when it converged: a step of at most `tol`, or a step at most `noise` that did not
- * halve the one before (f's rounding), or a last step at most `noise`; 0 otherwise, and when a step is not
- * finite (the point is left where that step would have started). The caller judges how far a point went. */
+ * them, in place. ok[i] = 1 when it converged -- a step of at most `tol`, or a step at most `noise` that did not
+ * halve the one before (f's rounding), or a last step at most `noise` -- and moved at most `reach` along each
+ * axis; 0 otherwise, and when a step is not finite (the point is left where that step would have started). */
 void ig_shape_project_many(const ig_shape *shape, const double *params, long n, double *p, int steps, double tol,
-                           double noise, unsigned char *ok);
+                           double noise, double reach, unsigned char *ok);
 
 /* The dual vertex of every sheet of every active cell of a grid (implgen mesh, dual.py). Cell c has its lower
  * corner at grid vertex corner[c] (flat, C order, strides[3] the grid's vertex strides, nvertices vertices),

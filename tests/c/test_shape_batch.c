@@ -35,7 +35,14 @@ static int check_projection(const double params[2])
     }
     start[0] = start[1] = start[2] = 0.0; /* the centre: grad f = 0 there, no step to take */
     memcpy(p, start, sizeof p);
-    ig_shape_project_many(&shape_torus_fixture, params, N, p, 40, 1e-13, 1e-10, ok);
+    ig_shape_project_many(&shape_torus_fixture, params, N, p, 40, 1e-13, 1e-10, 1e-3, ok);
+    for (int i = 1; i < N; ++i)
+        if (ok[i] != 0 && torus_distance(start + 3 * i, 1.0, 0.25) > 2e-3) { /* had to go further than reach */
+            printf("point %d: projected, beyond the reach\n", i);
+            ++failures;
+        }
+    memcpy(p, start, sizeof p);
+    ig_shape_project_many(&shape_torus_fixture, params, N, p, 40, 1e-13, 1e-10, 0.1, ok);
     if (ok[0] != 0 || memcmp(p, start, 3 * sizeof *p) != 0) {
         printf("the centre of the torus: projected (%d) or moved\n", ok[0]);
         ++failures;

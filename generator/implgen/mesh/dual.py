@@ -57,12 +57,11 @@ def project(
         sel = np.nonzero(mask == m)[0]
         if not ids or len(ids) > 3:
             continue
-        if ids == [0]:  # f alone (most vertices): the same steps in one C loop
-            p, ok = lib.project(start[sel], steps, tol, NOISE * scale)
+        if ids == [0]:  # f alone (most vertices): the same steps in one C loop, the same reach
+            p, ok = lib.project(start[sel], steps, tol, NOISE * scale, 2 * h)
         else:
             p, ok = _newton_pieces(lib, clips, ids, start[sel], steps, tol, scale)
-        far = np.abs(p - start[sel]).max(axis=1) > 2 * h
-        ok &= ~far & np.isfinite(p).all(axis=1)
+            ok &= (np.abs(p - start[sel]) <= 2 * h).all(axis=1)  # NaN fails it too
         out[sel[ok]] = p[ok]
         done[sel[ok]] = True
     return out, done
@@ -114,7 +113,8 @@ def outside_pieces(lib: ShapeLib, clips: list[Clip], p: np.ndarray, mask: np.nda
     out = np.zeros(len(p), dtype=np.int64)
     for j in range(len(clips) + 1):
         sel = np.flatnonzero(((mask >> j) & 1) == 0)
-        v = lib.value(p[sel]) if j == 0 else clips[j - 1].value(p[sel])
+        at = p if sel.size == len(p) else p[sel]  # most often every point: no copy
+        v = lib.value(at) if j == 0 else clips[j - 1].value(at)
         sel = sel[v > 0]
         if sel.size == 0:
             continue

@@ -43,7 +43,7 @@ class ShapeLib:
         lib.ig_shape_values_grid.argtypes = [_VP, _DP, _DP, ctypes.c_long, _DP, ctypes.c_long, _DP, ctypes.c_long, _DP]
         lib.ig_shape_project_many.restype = None
         lib.ig_shape_project_many.argtypes = [_VP, _DP, ctypes.c_long, _DP, ctypes.c_int, ctypes.c_double,
-                                              ctypes.c_double, ctypes.c_void_p]  # fmt: skip
+                                              ctypes.c_double, ctypes.c_double, _VP]  # fmt: skip
         lib.ig_mesh_sheet_points.restype = None
         lib.ig_mesh_sheet_points.argtypes = [ctypes.c_long, _VP, _VP, _VP, _VP, ctypes.c_long, ctypes.c_long, _VP,
                                              _DP, _DP, _VP, _DP, ctypes.c_double, ctypes.c_double, ctypes.c_double,
@@ -95,14 +95,16 @@ class ShapeLib:
         )
         return f
 
-    def project(self, p: np.ndarray, steps: int, tol: float, noise: float) -> tuple[np.ndarray, np.ndarray]:
+    def project(
+        self, p: np.ndarray, steps: int, tol: float, noise: float, reach: float
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Each point moved onto f = 0 by at most `steps` Newton steps of least norm: (points, converged flags);
         converged: a step at most `tol`, or at most `noise` and no longer halving (f's rounding), or a last step
-        at most `noise` (ig_shape_project_many)."""
+        at most `noise`, and moved at most `reach` along each axis (ig_shape_project_many)."""
         out = np.array(p, dtype=np.float64, order="C").reshape(-1, 3)
         ok = np.zeros(len(out), dtype=np.uint8)
         self._lib.ig_shape_project_many(
-            self._shape, _ptr(self._params), len(out), _ptr(out), steps, tol, noise, ok.ctypes.data
+            self._shape, _ptr(self._params), len(out), _ptr(out), steps, tol, noise, reach, ok.ctypes.data
         )
         return out, ok.astype(bool)
 
