@@ -142,24 +142,20 @@ def axis_crossings(
     key = base[line] + step * strides[axis]
     at = np.minimum(np.searchsorted(active, key), max(active.size - 1, 0))
     on = (active[at] == key) if active.size else np.zeros(key.size, dtype=bool)
-    hidden = int(np.unique(key[~on]).size)
-    keep = np.flatnonzero(on)
-    # in order of line and t: one edge's points are consecutive; sorted by edge, stably
-    keep = keep[np.argsort(key[keep], kind="stable")]
-    key = key[keep]
-    new = np.flatnonzero(np.concatenate([[True], key[1:] != key[:-1]])) if key.size else np.zeros(0, dtype=np.int64)
-    count = np.diff(np.append(new, key.size))
-    uniq, pick = key[new], keep[new + count // 2]  # an edge with several points: the middle one
-    pos = np.searchsorted(uniq, active)
+    # in order of line and t, one edge's points are consecutive: runs of one key
+    run = np.flatnonzero(np.concatenate([[True], key[1:] != key[:-1]])) if key.size else np.zeros(0, dtype=np.int64)
+    count = np.diff(np.append(run, key.size))
+    hidden = int((~on[run]).sum())  # edges whose ends agree but that hold points
+    run, count = run[on[run]], count[on[run]]
+    pick = run + count // 2  # an edge with several points: the middle one
+    slot = at[run]
     found = np.zeros(active.size, dtype=bool)
-    if uniq.size:
-        found = (pos < uniq.size) & (uniq[np.minimum(pos, uniq.size - 1)] == active)
-    src = pick[pos[found]]
+    found[slot] = True
     points = np.empty((active.size, 3))
     pieces = np.zeros(active.size, dtype=np.int32)
-    points[found] = starts[line[src]]
-    points[found, axis] += t[src]
-    pieces[found] = piece[src]
+    points[slot] = starts[line[pick]]
+    points[slot, axis] += t[pick]
+    pieces[slot] = piece[pick]
     miss = np.nonzero(~found)[0]
     if miss.size:  # an end within rounding of the surface: the end nearer it
         lo_v = active[miss]
@@ -167,8 +163,8 @@ def axis_crossings(
         gf = g.reshape(-1)
         end = np.where(np.abs(gf[lo_v]) <= np.abs(gf[hi_v]), lo_v, hi_v)
         points[miss] = grid.point(end)
-    grad = np.empty((active.size, 3))
-    for j in np.unique(pieces):
+    _, grad = lib.value_gradient(points)  # then the clips' own where they bound the solid
+    for j in np.unique(pieces[pieces != 0]):
         sel = np.flatnonzero(pieces == j)
         grad[sel] = piece_value_gradient(lib, clips, int(j), points[sel])[1]
     return Crossings(
