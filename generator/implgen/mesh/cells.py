@@ -104,6 +104,9 @@ def components(key: int) -> tuple[int, ...]:
 def cell_table(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For an array of cell keys: (row of each key in the table, table (K, 12) of sheet ids (int8), sheets per
     key)."""
-    uniq, row = np.unique(keys, return_inverse=True)
+    seen = np.zeros(1 << 14, dtype=bool)  # keys are 8 corner bits and 6 face bits: a table, not a sort
+    seen[keys] = True
+    uniq = np.flatnonzero(seen)
+    row = np.cumsum(seen)[keys] - 1
     table = np.array([components(int(k)) for k in uniq], dtype=np.int8).reshape(-1, 12)
     return row, table, table.max(axis=1) + 1

@@ -107,15 +107,14 @@ def _candidates(lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, starts:
     line = np.concatenate(ls)
     t = np.concatenate(ts)
     piece = np.concatenate(pieces)
-    p = starts[line].copy()
-    p[:, axis] += t
     # the piece bounds the solid there only where every other piece is <= 0
-    cvals = clip_values(clips, p)
-    others = np.full(len(p), -np.inf)
+    others = np.full(len(t), -np.inf)
     on_clip = np.flatnonzero(piece != 0)
-    others[on_clip] = lib.value(p[on_clip])
-    for k in range(len(clips)):
-        others = np.maximum(others, np.where(piece == k + 1, -np.inf, cvals[k]))
+    p = starts[line[on_clip]]
+    p[:, axis] += t[on_clip]
+    others[on_clip] = lib.value(p)
+    for k, c in enumerate(clips):
+        others = np.maximum(others, np.where(piece == k + 1, -np.inf, c.along(axis, starts, line, t)))
     keep = others <= 0
     if not keep[lines.size :].any():  # no clip bounds the solid on these lines: f's roots, already in order
         return lines[keep[: lines.size]], t[: lines.size][keep[: lines.size]], piece[: lines.size][keep[: lines.size]]
