@@ -64,8 +64,10 @@ def boundary_distance(lib: ShapeLib, clips, verts: np.ndarray) -> np.ndarray:
     return np.abs(f) / np.maximum(np.linalg.norm(g, axis=1), 1e-300)
 
 
-def ours(lib, clips, grid):
+def ours(lib, clips, grid, phases=None):
     m = contour(lib, clips, grid)
+    if phases is not None:
+        phases.append(m.stats["seconds"])
     return m.vertices, m.faces
 
 
@@ -119,11 +121,12 @@ def run_surface(label, path, clip_text, euler, runs, cells, folder):
                 row[name] = {"closed": closed, "euler": e, "max": float(d.max()), "median": float(np.median(d))}
                 row["size"] = grid.size
     grid, clips = make_grid(spec.box(), user, cells, path)
-    t_ours, t_mc = [], []
+    t_ours, t_mc, phases = [], [], []
     for _ in range(runs):  # interleaved
-        t_ours.append(timed(ours, lib, clips, grid)[0])
+        t_ours.append(timed(ours, lib, clips, grid, phases)[0])
         t_mc.append(timed(marching, module, spec.params, clips, grid)[0])
     row["t_ours"], row["t_mc"] = statistics.median(t_ours), statistics.median(t_mc)
+    row["phases"] = {k: statistics.median(p[k] for p in phases) for k in phases[0]}
     row["smallest"] = smallest
     row["right_at"] = right_at
     return row
@@ -148,6 +151,19 @@ def table(rows, cells: int) -> list[str]:
             f"| {o['max'] / s:.1e} / {m['max'] / s:.1e} | {o['median'] / s:.1e} / {m['median'] / s:.1e} "
             f"| {yn(o['closed'])} / {yn(m['closed'])} | {o['euler']} / {m['euler']} ({known}) | {small} |"
         )
+    return out
+
+
+def phase_table(rows, cells: int) -> list[str]:
+    """Where our time goes: each phase of contour() (its stats' seconds), median over the timed runs."""
+    names = list(rows[0]["phases"])
+    out = [
+        f"| surface | {' | '.join(names)} | total (s), N = {cells} |",
+        "|---|" + "---|" * (len(names) + 1),
+    ]
+    for r in rows:
+        ph = r["phases"]
+        out.append(f"| {r['label']} | " + " | ".join(f"{ph[k]:.3f}" for k in names) + f" | {sum(ph.values()):.3f} |")
     return out
 
 
@@ -206,6 +222,14 @@ def main() -> int:
         "the known Euler characteristic.",
         "",
         *table(rows, args.cells),
+        "",
+        "Where our time goes (seconds per phase of the contour, medians of the timed runs): signs -- f at every "
+        "grid vertex; crossings -- every root on every grid line (the certified solver) and the gradient at each "
+        "edge's crossing; sheets -- cells' corner patterns, ambiguous faces' centres, the sheet table; qef -- "
+        "each sheet's point (one C loop over the cells); projection -- Newton onto the surface (C for f alone); "
+        "faces -- quads into triangles.",
+        "",
+        *phase_table(rows, args.cells),
         "",
         "Known Euler characteristics: " + "; ".join(f"{r['label']}: {r['why']}" for r in rows) + ".",
         "Barth's sextic has no Euler characteristic to check against: its 50 nodes make it not a manifold, and a mesh "

@@ -116,7 +116,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         parts.append((quad, np.full(edges.size, a), edges, flip, cross[a].points, cross[a].piece))
     quads = Quads(*(np.concatenate([p[i] for p in parts]) for i in range(6)))
     near_amb = np.repeat(cells.AMBIGUOUS[conf] != 0, count)  # sheets of cells with an ambiguous face
-    verts, faces, split = triangulate(quads, verts, near_amb, inside, grid, lib, clips, AROUND)
+    verts, faces, split = triangulate(quads, verts, near_amb, inside, grid, lib, clips, AROUND, rowof, key)
     clock.append(time.perf_counter())
     phases = ("signs", "crossings", "sheets", "qef", "projection", "faces")
     stats = {

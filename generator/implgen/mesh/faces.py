@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from implgen.mesh.crossings import inside_flags
 from implgen.mesh.dual import piece_mask, project
 from implgen.mesh.region import Clip, Grid
 from implgen.mesh.shapelib import ShapeLib
@@ -47,9 +46,12 @@ def triangulate(
     lib: ShapeLib,
     clips: list[Clip],
     around,
+    rowof: np.ndarray,
+    cell_key: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """(vertices with any added, triangles, how many quad sides were split). near_amb: per vertex, whether its
-    cell has an ambiguous face (only a quad with all its sides' cells so can hold a doubled side)."""
+    cell has an ambiguous face (only a quad with all its sides' cells so can hold a doubled side); rowof: the
+    row of each cell (by the flat index of its lower corner) in cell_key, the cells' keys (cells.components)."""
     q = quads.verts
     dup = np.zeros((len(q), 4), dtype=bool)
     cand = np.nonzero(near_amb[q].any(axis=1))[0]
@@ -67,21 +69,17 @@ def triangulate(
     qi, ks = np.nonzero(dup)
     a = quads.axis[qi]
     normal = (a + np.array(SIDE_NORMAL)[ks]) % 3
-    third = 3 - a - normal
-    e_idx = np.stack(np.unravel_index(quads.edge[qi], shape), axis=1)
-    # the face between the two cells of this side: its centre, computed from global indices
+    # the face between the two cells of this side is ambiguous: whether its centre is inside is bit 8 + f of
+    # the key of the cell AROUND[k] (contour._face_bits), f its face there: across `normal`, on the edge's side
     around = np.array(around)
     off_b, off_c = around[ks, 0], around[ks, 1]
-    b_axis = (a + 1) % 3
-    d_third = np.where(third == b_axis, off_b, off_c)
-    centre = e_idx.astype(np.float64)
-    rows = np.arange(len(qi))
-    centre[rows, a] += 0.5
-    centre[rows, third] += 0.5 - d_third
-    c_in, _ = inside_flags(lib, clips, grid.origin + grid.h * centre)
+    b_axis, c_axis = (a + 1) % 3, (a + 2) % 3
+    strides = np.array([shape[1] * shape[2], shape[2], 1])
+    cell = quads.edge[qi] - off_b * strides[b_axis] - off_c * strides[c_axis]
+    face = 2 * normal + np.where(normal == b_axis, off_b, off_c)
+    c_in = ((cell_key[rowof[cell]] >> (8 + face)) & 1).astype(bool)
     # the corner the side's curve cuts off: the edge's end whose flag differs from the centre's
     lo_in = inside.reshape(-1)[quads.edge[qi]]
-    strides = np.array([shape[1] * shape[2], shape[2], 1])
     corner = np.where(lo_in != c_in, quads.edge[qi], quads.edge[qi] + strides[a])
     side = sides[np.searchsorted(cand, qi), ks]
     key = np.stack([side[:, 0], side[:, 1], corner, normal], axis=1)
