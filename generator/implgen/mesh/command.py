@@ -123,6 +123,12 @@ def main(argv: Sequence[str]) -> int:
     values.update(_params(spec, args.param))
     result = mesh_spec(spec, values, args.cells, clips, singular=not args.no_singular, what=args.file)
     verts, faces = result.mesh.vertices, result.mesh.faces
+    if not len(faces):
+        hidden = result.mesh.stats["hidden_crossing_edges"]
+        raise UserError(
+            f"--cells {args.cells}",
+            f"no grid vertex lies in the solid, so the mesh is empty ({hidden} grid edges hold crossings): raise it",
+        )
     normals = vertex_normals(result.lib, result.clips, verts)
     if matrix is not None:  # object -> world; normals by the inverse transpose; a mirror turns the faces
         lin = matrix[:, :3]

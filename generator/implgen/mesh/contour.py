@@ -74,7 +74,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     row, table, nsheets = cells.cell_table(key)
     sheets = table[row]  # (C, 12) int8: the sheet of each edge in its cell, -1 where not active
     count = nsheets[row]
-    base = np.concatenate([[0], np.cumsum(count)[:-1]])
+    base = np.cumsum(count) - count  # each cell's first vertex
     nverts = int(count.sum())
 
     clock.append(time.perf_counter())
