@@ -185,25 +185,24 @@ def coarse_table(rows) -> list[str]:
     """Below the smallest right grid: what each method got, and how many grid edges held crossings that their
     two ends did not show (ours; the detail both methods miss)."""
     out = [
-        "| surface | grids where ours and MC agree on closed + Euler | largest wrong grid below ours' smallest "
-        "right one | Euler there ours / MC (known) | edges with crossings their ends do not show there |",
+        "| surface | grids where both are closed: with the same Euler characteristic | largest wrong grid below ours' "
+        "smallest right one | Euler there ours / MC (known) | edges with crossings their ends do not show there |",
         "|---|---|---|---|---|",
     ]
     for r in rows:
         if r["known"] is None:
             continue
         g = r["grids"]
-        agree = sum(1 for o, m, _ in g.values() if o == m)
+        both = [(o, m) for o, m, _ in g.values() if o is not None and m is not None]
+        agree = f"{len(both)} of {len(g)}: {sum(1 for o, m in both if o == m)}"
         small = r["smallest"]["ours"]
         below = [n for n in g if small is None or n < small]
         if below:
             n = max(below)
             o, m, hidden = g[n]
-            out.append(
-                f"| {r['label']} | {agree} of {len(g)} | {n} | {_euler(o)} / {_euler(m)} ({r['known']}) | {hidden} |"
-            )
+            out.append(f"| {r['label']} | {agree} | {n} | {_euler(o)} / {_euler(m)} ({r['known']}) | {hidden} |")
         else:
-            out.append(f"| {r['label']} | {agree} of {len(g)} | - (right at {small}) | | |")
+            out.append(f"| {r['label']} | {agree} | - (right at {small}) | | |")
     return out
 
 

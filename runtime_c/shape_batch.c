@@ -152,7 +152,7 @@ static long find_key(const long *keys, long n, long key, long *at)
 void ig_mesh_sheet_points(long ncells, const long *corner, const signed char *sheets, const long *first,
                           const long *strides, long nvertices, long ncross, const long *keys, const double *points,
                           const double *normals, const int *piece, const double *origin, double h, double crease,
-                          double drop, double *out, long *mask, long *nearest)
+                          double drop, long nverts, double *out, long *mask, long *nearest)
 {
     if (!corner || !sheets || !first || !strides || !keys || !points || !normals || !piece || !origin || !out ||
         !mask || !nearest)
@@ -175,6 +175,8 @@ void ig_mesh_sheet_points(long ncells, const long *corner, const signed char *sh
         }
         for (int s = 0; s < nsheets; ++s) {
             long vid = first[c] + s;
+            if (vid < 0 || vid >= nverts) /* the caller's numbering disagrees: nothing written out of bounds */
+                continue;
             double mass[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
             int count = 0, sharp = 0;
             long m = 0;

@@ -82,15 +82,22 @@ static int check_sheet_points(void)
     long mask[1], nearest[1];
     int failures = 0;
     ig_mesh_sheet_points(1, corner, plane_sheets, first, strides, 8, 4, plane_keys, plane_points, plane_normals,
-                         plane_piece, origin, 1.0, 0.9, 0.1, out, mask, nearest);
+                         plane_piece, origin, 1.0, 0.9, 0.1, 1, out, mask, nearest);
     if (!near3(out, 0.5, 0.5, 0.3) || mask[0] != 1 || nearest[0] != 0) {
         printf("plane cell: (%g, %g, %g), mask %ld, nearest %ld\n", out[0], out[1], out[2], mask[0], nearest[0]);
         ++failures;
     }
     ig_mesh_sheet_points(1, corner, crease_sheets, first, strides, 8, 4, crease_keys, crease_points, crease_normals,
-                         crease_piece, origin, 1.0, 0.9, 0.1, out, mask, nearest);
+                         crease_piece, origin, 1.0, 0.9, 0.1, 1, out, mask, nearest);
     if (!near3(out, 0.4, 0.6, 0.5) || mask[0] != 3 || nearest[0] != 2) {
         printf("crease cell: (%g, %g, %g), mask %ld, nearest %ld\n", out[0], out[1], out[2], mask[0], nearest[0]);
+        ++failures;
+    }
+    mask[0] = -7; /* a sheet numbered past nverts: skipped, nothing written */
+    ig_mesh_sheet_points(1, corner, crease_sheets, first, strides, 8, 4, crease_keys, crease_points, crease_normals,
+                         crease_piece, origin, 1.0, 0.9, 0.1, 0, out, mask, nearest);
+    if (mask[0] != -7) {
+        printf("a sheet past nverts was written\n");
         ++failures;
     }
     return failures;

@@ -47,7 +47,7 @@ class ShapeLib:
         lib.ig_mesh_sheet_points.restype = None
         lib.ig_mesh_sheet_points.argtypes = [ctypes.c_long, _VP, _VP, _VP, _VP, ctypes.c_long, ctypes.c_long, _VP,
                                              _DP, _DP, _VP, _DP, ctypes.c_double, ctypes.c_double, ctypes.c_double,
-                                             _DP, _VP, _VP]  # fmt: skip
+                                             ctypes.c_long, _DP, _VP, _VP]  # fmt: skip
         lib.ig_mesh_split_quads.restype = None
         lib.ig_mesh_split_quads.argtypes = [ctypes.c_long, _VP, _VP, _DP, _VP]
         self._lib = lib
@@ -128,7 +128,7 @@ class ShapeLib:
         self._lib.ig_mesh_sheet_points(
             len(corner), corner.ctypes.data, sheets.ctypes.data, first.ctypes.data, strides.ctypes.data, nvertices,
             len(keys), keys.ctypes.data, _ptr(points), _ptr(normals), piece.ctypes.data, _ptr(origin), h, crease,
-            drop, _ptr(out), mask.ctypes.data, nearest.ctypes.data,
+            drop, nverts, _ptr(out), mask.ctypes.data, nearest.ctypes.data,
         )  # fmt: skip
         return out, mask.astype(np.int64), nearest.astype(np.int64)
 
