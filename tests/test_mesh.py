@@ -218,3 +218,18 @@ def test_the_piriform_cusp():
         assert through == (cells == 48) and result.mesh.stats["snapped_to_singular"] == (cells == 48)
         tm = trimesh.Trimesh(result.mesh.vertices, result.mesh.faces, process=False)
         assert tm.is_watertight and tm.euler_number == 2
+
+
+def test_clip_values_along_grid_lines():
+    """A clip's value at points on grid lines (Clip.along, which skips building the points for a plane) equals
+    its value at those points, for a ball and every side of a box, lines along each axis."""
+    rng = np.random.default_rng(7)
+    clips = parse_clip("sphere:1.3") + parse_clip("box:0.9")
+    starts = rng.uniform(-2.0, 2.0, size=(40, 3))
+    line = rng.integers(0, len(starts), size=200)
+    t = rng.uniform(0.0, 4.0, size=200)
+    for axis in range(3):
+        p = starts[line].copy()
+        p[:, axis] += t
+        for c in clips:
+            assert np.array_equal(c.along(axis, starts, line, t), c.value(p))
