@@ -83,7 +83,7 @@ def unit(v: np.ndarray) -> np.ndarray:
     return u
 
 
-def _candidates(lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, starts: np.ndarray):
+def line_points(lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, starts: np.ndarray):
     """Every boundary point of the solid on the lines along `axis` starting at `starts` (L, 3): (line, t,
     piece), t measured from the line's start, in order of line and, without clips, of t along it."""
     length = grid.n[axis] * grid.h
@@ -136,7 +136,7 @@ def axis_crossings(
     base_idx = np.indices(tuple(1 if a == axis else s for a, s in enumerate(shape))).reshape(3, -1)
     base = np.ravel_multi_index(tuple(base_idx), shape)
     starts = grid.point(base)
-    line, t, piece = _candidates(lib, clips, grid, axis, starts)
+    line, t, piece = line_points(lib, clips, grid, axis, starts)
     step = np.clip(np.floor(t / grid.h).astype(np.int64), 0, shape[axis] - 2)
     key = base[line] + step * strides[axis]
     at = np.minimum(np.searchsorted(active, key), max(active.size - 1, 0))
