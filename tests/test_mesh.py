@@ -233,3 +233,15 @@ def test_clip_values_along_grid_lines():
         p[:, axis] += t
         for c in clips:
             assert np.array_equal(c.along(axis, starts, line, t), c.value(p))
+
+
+def test_closed_and_euler_on_small_complexes():
+    """A tetrahedron (closed, V - E + F = 4 - 6 + 4 = 2), with unused vertices around it; without a face (open);
+    with a face twice (edges in three faces) or turned over (an edge twice the same way); two tetrahedra (4)."""
+    tet = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]])
+    assert closed_and_euler(tet, 4) == (True, 2)
+    assert closed_and_euler(tet + 3, 10) == (True, 2)
+    assert closed_and_euler(tet[1:], 4) == (False, 4 - 6 + 3)
+    assert not closed_and_euler(np.concatenate([tet, tet[:1]]), 4)[0]
+    assert not closed_and_euler(np.concatenate([tet[:1, ::-1], tet[1:]]), 4)[0]
+    assert closed_and_euler(np.concatenate([tet, tet + 4]), 8) == (True, 4)
