@@ -27,9 +27,10 @@ def to_trimesh(verts: np.ndarray, faces: np.ndarray, normals: np.ndarray | None 
 
     mesh = trimesh.Trimesh(vertices=verts, faces=faces, process=False, validate=False)
     if normals is not None:
-        fallback = np.asarray(mesh.vertex_normals)  # area-weighted face normals
         bad = np.linalg.norm(normals, axis=1) == 0
-        mesh.vertex_normals = np.where(bad[:, None], fallback, normals)
+        if bad.any():  # the faces' area-weighted normals there (trimesh computes them for the whole mesh)
+            normals = np.where(bad[:, None], np.asarray(mesh.vertex_normals), normals)
+        mesh.vertex_normals = normals
     return mesh
 
 
