@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from implgen.roots.exactray import ExactJudge, Placed
+
 ROOT = Path(__file__).resolve().parents[1]
 SHAPES = ("blobs10", "chmutov8", "heart", "piriform", "sphere", "torus_y", "torus_z")  # what the driver links
 
@@ -89,10 +91,10 @@ def grid(n: int, seed: int = 1) -> Scene:
 
 def build_driver(out: Path, sanitize: bool) -> Path:
     """tests/c/embree_check.c with the runtime, the shapes it names and Embree, with the project's warnings."""
-    from implgen.compile.clib import WARNING_FLAGS, compiler
+    from implgen.compile.clib import SANITIZE_FLAGS, WARNING_FLAGS, compiler
     from implgen.resources import EMBREE_SOURCES, SHAPE_SOURCES, SOLVER_SOURCES, TRACER_SOURCES, runtime_sources
 
-    flags = ["-O1", "-g", "-fsanitize=address,undefined", "-fno-sanitize-recover=all"] if sanitize else ["-O2"]
+    flags = list(SANITIZE_FLAGS) if sanitize else ["-O2"]
     sources = [ROOT / "tests/c/embree_check.c"]
     sources += runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES, TRACER_SOURCES, EMBREE_SOURCES)
     sources += [ROOT / "generated" / f"{s}.c" for s in SHAPES]
@@ -123,53 +125,17 @@ def read_agree(path: Path, n: int) -> dict[str, np.ndarray]:
     }
 
 
-class ExactJudge:
-    """Which object does a ray truly meet first? Each object's f(o + t d) over Q (the float ray and the double
-    matrix taken exactly), clipped to its padded box exactly, roots located by Descartes and bisection
-    (implgen.roots.exactray, the judge of bench/povray_compare.py)."""
+def exact_judge(scene: Scene) -> ExactJudge:
+    """The exact judge (implgen.roots.exactray.ExactJudge) of the scene's objects, in order, the ground square
+    last: each object's f(o + t d) over Q, the float ray and the double matrix taken exactly, clipped to its
+    padded box exactly, roots located by Descartes and bisection."""
+    from implgen.codegen.spec import load_spec
 
-    def __init__(self, scene: Scene):
-        import sympy as sp
-
-        from implgen.codegen.spec import load_spec
-        from implgen.roots.exactray import exact_terms, padded_box
-
-        self.items = []
-        for o in scene.objects:
-            spec = load_spec(ROOT / "examples/shapes" / f"{o.shape}.yaml")
-            params = dict(zip(spec.params, o.params))
-            m = sp.Matrix(3, 4, [sp.Rational(Fraction(v)) for v in o.m])
-            inv = m[:, :3].inv()
-            inv_f = [[Fraction(int(sp.numer(inv[i, j])), int(sp.denom(inv[i, j]))) for j in range(3)] for i in range(3)]
-            tr = [Fraction(o.m[4 * i + 3]) for i in range(3)]
-            self.items.append((exact_terms(spec, params), spec.degree, padded_box(spec.box(params)), inv_f, tr))
-        if scene.ground:
-            h = Fraction(scene.ground)
-            eye = [[Fraction(int(i == j)) for j in range(3)] for i in range(3)]
-            box = [(-h, h), (Fraction(-1), Fraction(1)), (-h, h)]
-            self.items.append(([((0, 1, 0), Fraction(1))], 1, box, eye, [Fraction(0)] * 3))
-
-    def has_root(self, k: int, o, d, t0: Fraction, t1: Fraction | None) -> bool:
-        """Does object k (the ground after the shapes) meet the world ray o + t d for t in [t0, t1]?"""
-        from implgen.roots.descartes import has_root
-        from implgen.roots.exactray import box_span, integer_ray_poly
-
-        terms, deg, box, inv, tr = self.items[k]
-        ow = [Fraction(float(v)) - tr[i] for i, v in enumerate(o)]
-        dw = [Fraction(float(v)) for v in d]
-        oo = [sum(inv[i][j] * ow[j] for j in range(3)) for i in range(3)]
-        dd = [sum(inv[i][j] * dw[j] for j in range(3)) for i in range(3)]
-        span = box_span(box, oo, dd, t0, t1)
-        return span is not None and has_root(integer_ray_poly(terms, deg, oo, dd), *span)
-
-    def right(self, claim: tuple[int, float], other: tuple[int, float], o, d, rel: float = 1e-9) -> bool:
-        """Is the claim (object, t; object -1: a miss) true where the other answer disagrees: its object meets
-        the ray within rel of t, and the other answer's object does not meet it before?"""
-        obj, t = claim
-        oobj, ot = other
-        if obj < 0:  # a miss: the other object is not met at all
-            return not self.has_root(oobj, o, d, Fraction(0), None)
-        near = Fraction(t * (1 - rel))
-        if not self.has_root(obj, o, d, near, Fraction(t * (1 + rel))):
-            return False
-        return oobj < 0 or oobj == obj or not self.has_root(oobj, o, d, Fraction(0), near)
+    objects = []
+    for o in scene.objects:
+        spec = load_spec(ROOT / "examples/shapes" / f"{o.shape}.yaml")
+        objects.append(Placed.of(spec, dict(zip(spec.params, o.params)), o.m))
+    if scene.ground:
+        h = Fraction(scene.ground)
+        objects.append(Placed([((0, 1, 0), Fraction(1))], 1, [(-h, h), (Fraction(-1), Fraction(1)), (-h, h)]))
+    return ExactJudge(objects)

@@ -43,12 +43,16 @@ def _use_runtime(runtime: Path) -> None:
     import os
 
     import implgen.compile.clib as cbuild
+    import implgen.compile.library as library
     import implgen.resources as resources
     import implgen.scene.build as build
 
     runtime = runtime.resolve()
     build.runtime_dir = lambda: runtime  # type: ignore[assignment]
     resources.runtime_dir = lambda: runtime  # type: ignore[assignment]
+    # the include folder too: its headers are part of every object's key, so a source file that is the same in
+    # both runtimes gets an object of its own for each (else one built against the other runtime's headers)
+    library.runtime_dir = lambda: runtime  # type: ignore[assignment]
     if os.environ.get("PICTURE_DIFF_DEBUG") and "-g" not in cbuild.BASE_FLAGS:
         cbuild.BASE_FLAGS = (*cbuild.BASE_FLAGS, "-g")
 

@@ -34,7 +34,6 @@ import sys
 import tempfile
 import time
 from dataclasses import dataclass
-from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -56,10 +55,9 @@ def _ensure_current_install() -> None:
 _ensure_current_install()
 
 from implgen.bench.machine import cpu_model  # noqa: E402
-from implgen.codegen.spec import param_symbol  # noqa: E402,F401 -- tests/test_povray_compare.py uses pc.param_symbol
 from implgen.export import povray as pv  # noqa: E402
-from implgen.roots.descartes import has_root  # noqa: E402
-from implgen.roots.exactray import box_span, exact_terms, integer_ray_poly, padded_box  # noqa: E402
+from implgen.roots.exactray import ExactJudge, Placed  # noqa: E402
+from implgen.scene.camera import camera_rays  # noqa: E402
 from implgen.scene.load import load_scene  # noqa: E402
 
 # --------------------------------------------------------------------------------------------- POV-Ray
@@ -132,17 +130,7 @@ def run_ours(scene: Path, out: Path, w: int, h: int, threads: int) -> tuple[floa
 
 def camera_ray(scene, x: float, y: float, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
     """Primary ray through image point (x, y) (pixel centre = +0.5), as runtime_c/tracer_render.c builds it."""
-    cam = scene.camera
-    eye = np.array(cam.position, float)
-    wv = eye - np.array(cam.look_at, float)
-    wv /= np.sqrt(wv @ wv)
-    u = np.cross(np.array(cam.up, float), wv)
-    u /= np.sqrt(u @ u)
-    v = np.cross(wv, u)
-    tan_half = np.tan(0.5 * cam.fov * np.pi / 180.0)
-    px = (2.0 * x / w - 1.0) * tan_half * (w / h)
-    py = (1.0 - 2.0 * y / h) * tan_half
-    return eye, px * u + py * v - wv
+    return camera_rays(scene.camera, w, h, x, y)
 
 
 def our_mask(scene_path: Path, w: int, h: int, threads: int) -> np.ndarray:
@@ -168,56 +156,19 @@ def pov_mask(png: Path) -> np.ndarray:
     return np.asarray(Image.open(png).convert("L"), dtype=np.uint8) > 127
 
 
-class ExactJudge:
-    """Does the primary ray of a pixel truly hit an object inside its box? Decided in exact rational arithmetic:
-    f(o + t d) expanded over Q, t clipped to the object's box (as exported with `clipped_by`), and the integer
-    Descartes/bisection test of implgen.roots.descartes on that interval (implgen.roots.exactray)."""
+class PixelJudge:
+    """Does the primary ray of a pixel truly hit an object inside its box? The exact judge of the scene's shapes
+    (implgen.roots.exactray.ExactJudge: f(o + t d) expanded over Q, t clipped to the object's box as exported with
+    `clipped_by`, and the integer Descartes/bisection test on that interval); the ground plane is left out, as
+    the coverage masks leave it out."""
 
     def __init__(self, scene, w: int, h: int):
-        import sympy as sp
-
         self.scene, self.w, self.h = scene, w, h
-        self.objects = []
-        for leaf in scene.leaves():
-            if leaf.spec.degree == 1 and leaf.spec.name == "ground":
-                continue
-            terms = exact_terms(leaf.spec, leaf.params)
-            m = sp.Matrix(3, 4, [sp.Rational(Fraction(float(v))) for v in np.asarray(leaf.matrix).ravel()])
-            inv = m[:, :3].inv()
-            frac = lambda v: Fraction(int(sp.numer(v)), int(sp.denom(v)))  # noqa: E731
-            inv_f = [[frac(inv[i, j]) for j in range(3)] for i in range(3)]
-            tr_f = [frac(m[i, 3]) for i in range(3)]
-            self.objects.append((terms, inv_f, tr_f, leaf.spec.degree, _padded_box(leaf.spec.box(leaf.params))))
-
-    @staticmethod
-    def object_ray(obj, o: np.ndarray, d: np.ndarray) -> tuple[list[Fraction], list[Fraction]]:
-        """The world ray (doubles, taken exactly) in the object's space, exactly."""
-        _, inv, tr, _, _ = obj
-        ow = [Fraction(float(v)) - tr[k] for k, v in enumerate(o)]
-        dw = [Fraction(float(v)) for v in d]
-        oo = [sum(inv[i][j] * ow[j] for j in range(3)) for i in range(3)]
-        dd = [sum(inv[i][j] * dw[j] for j in range(3)) for i in range(3)]
-        return oo, dd
-
-    def ray_poly(self, obj, o: np.ndarray, d: np.ndarray) -> list[int]:
-        """Integer coefficients (lowest first) of a positive multiple of f(o' + t d'), o', d' the object-space
-        ray (implgen.roots.exactray.integer_ray_poly)."""
-        terms, _, _, deg, _ = obj
-        return integer_ray_poly(terms, deg, *self.object_ray(obj, o, d))
+        leaves = [lf for lf in scene.leaves() if not (lf.spec.degree == 1 and lf.spec.name == "ground")]
+        self.exact = ExactJudge([Placed.of(lf.spec, lf.params, lf.matrix) for lf in leaves])
 
     def hits(self, px: int, py: int) -> bool:
-        o, d = camera_ray(self.scene, px + 0.5, py + 0.5, self.w, self.h)
-        return any(self.ray_hits(obj, o, d) for obj in self.objects)
-
-    def ray_hits(self, obj, o, d) -> bool:
-        span = _box_span(obj[4], *self.object_ray(obj, o, d))
-        if span is None:
-            return False
-        return has_root(self.ray_poly(obj, o, d), *span)  # a tangent root counts
-
-
-_padded_box = padded_box  # the names this script and its tests have used
-_box_span = box_span
+        return self.exact.hits(*camera_ray(self.scene, px + 0.5, py + 0.5, self.w, self.h))
 
 
 # ------------------------------------------------------------------------------------- degree family
@@ -524,7 +475,7 @@ def compare_coverage(
     dis = np.argwhere(mo != mp)
     disagreement_image(mo, mp, opt.out / f"{name}_disagreement.png")
     sample = dis if len(dis) <= opt.max_verdicts else dis[rng.choice(len(dis), opt.max_verdicts, replace=False)]
-    judge = ExactJudge(scene, opt.w, opt.h)
+    judge = PixelJudge(scene, opt.w, opt.h)
     t0 = time.perf_counter()
     ours_right, pov_right, examples = decide_disputed(judge, sample, mo, mp)
     edge = silhouette(mo)
@@ -555,7 +506,7 @@ def compare_coverage(
     return c
 
 
-def decide_disputed(judge: ExactJudge, sample: np.ndarray, mo: np.ndarray, mp: np.ndarray) -> tuple[int, int, list]:
+def decide_disputed(judge: PixelJudge, sample: np.ndarray, mo: np.ndarray, mp: np.ndarray) -> tuple[int, int, list]:
     """Each sampled disputed pixel (row, column) decided exactly: how many implgen's mask has right, how many
     POV-Ray's, and the first five as examples."""
     ours_right = pov_right = 0
@@ -590,7 +541,7 @@ def silhouette(mo: np.ndarray) -> np.ndarray:
 
 
 def check_agreed_silhouette(
-    judge: ExactJudge, agreed: np.ndarray, mo: np.ndarray, n: int, rng: np.random.Generator
+    judge: PixelJudge, agreed: np.ndarray, mo: np.ndarray, n: int, rng: np.random.Generator
 ) -> tuple[int, int]:
     """A check on the agreement itself: up to n silhouette pixels both programs agree on (mask `agreed`),
     decided exactly; (how many checked, on how many both are wrong)."""

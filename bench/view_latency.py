@@ -243,7 +243,7 @@ def drags(rounds: int, compare: Path | None) -> tuple[dict, dict | None]:
     return med["new"], med.get("old")
 
 
-def drag_lines(new: dict, old: dict | None, rounds: int) -> list[str]:
+def drag_lines(new: dict, old: dict | None, rounds: int, compare: Path | None = None) -> list[str]:
     head = (
         "| drag | coarse frames/s | longest gap (s) | coarse width (px) | release → full size, 1 spp (s) | "
         "release → 4 spp (s) |"
@@ -254,14 +254,23 @@ def drag_lines(new: dict, old: dict | None, rounds: int) -> list[str]:
         "frames/s, refined ≤ 0.4 s after the release for degree ≤ 8. The server sends the full size at 1 sample "
         "per pixel first when its 4-sample frame is expected to take longer than 0.4 s.",
         "",
-        head if old is None else head + " before: frames/s | before: longest gap (s) |",
-        "|---|---|---|---|---|---|" + ("---|---|" if old else ""),
+        head
+        if old is None
+        else head + " before: frames/s | before: longest gap (s) | before: width (px) | before: 1 spp (s) | "
+        "before: 4 spp (s) |",
+        "|---|---|---|---|---|---|" + ("---|---|---|---|---|" if old else ""),
     ]
     for name, m in new.items():
         row = f"| {name} | {m['fps']:.1f} | {m['gap']:.3f} | {m['width']:.0f} | {m['sharp']:.3f} | {m['release']:.3f} |"
         if old is not None:
-            row += f" {old[name]['fps']:.1f} | {old[name]['gap']:.3f} |"
+            o = old[name]
+            row += f" {o['fps']:.1f} | {o['gap']:.3f} | {o['width']:.0f} | {o['sharp']:.3f} | {o['release']:.3f} |"
         lines.append(row)
+    if old is not None and compare is not None:
+        lines += [
+            "",
+            f"Before: the same drags against the server of `{compare}`, interleaved case by case and round by round.",
+        ]
     return lines + [""]
 
 
@@ -356,10 +365,12 @@ def main() -> int:
     if args.drag_only:
         load = os.getloadavg()[0]
         new, old = drags(args.drag_rounds, args.compare)
-        print("\n".join(drag_lines(new, old, args.drag_rounds)))
+        print("\n".join(drag_lines(new, old, args.drag_rounds, args.compare)))
         print(f"load average (1 min) {load:.2f} before, {os.getloadavg()[0]:.2f} after; {machine()}")
         return 0
+    drag_load = os.getloadavg()[0]
     drag_new, drag_old = drags(args.drag_rounds, args.compare)
+    drag_load_after = os.getloadavg()[0]
     specs = [s for s in (load_spec(p) for p in sorted(SHAPES.glob("*.yaml"))) if s.degree <= MAX_DEGREE]
     nonce = time.time_ns() % 10**9
     load_before = os.getloadavg()[0]
@@ -440,7 +451,8 @@ def main() -> int:
         f"{MAX_RENDERS_PER_SECOND} renders a second per page, which caps the orbit rate.",
         "",
     ]
-    lines += drag_lines(drag_new, drag_old, args.drag_rounds)
+    lines += drag_lines(drag_new, drag_old, args.drag_rounds, args.compare)
+    lines += [f"Load average (1 min) before the drags {drag_load:.2f}, after {drag_load_after:.2f}.", ""]
     if busy is not None:
         lines += [
             f"With heavy neighbours: {NEIGHBOURS} other pages kept sending `{NEIGHBOUR_EQUATION} + n/k` (a new "

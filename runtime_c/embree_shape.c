@@ -49,7 +49,7 @@ int ig_embree_prim_init(ig_embree_prim *prim, const ig_shape *shape, const doubl
                         const double *object_to_geometry)
 {
     static const double eye[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
-    double obox[6] = {-INFINITY, -INFINITY, -INFINITY, INFINITY, INFINITY, INFINITY}, ext = 0.0, mag = 0.0, pad;
+    double obox[6] = {-INFINITY, -INFINITY, -INFINITY, INFINITY, INFINITY, INFINITY};
     int a, i;
     memset(prim, 0, sizeof *prim);
     if (!shape || !shape->coeffs || !shape->bounds || (shape->nparams > 0 && !params))
@@ -69,29 +69,8 @@ int ig_embree_prim_init(ig_embree_prim *prim, const ig_shape *shape, const doubl
     prim->shape = shape;
     prim->params = params;
     ig_shape_prepare(shape, params, &prim->prep);
-    /* the box through m: its 8 corners, then padded by 1e-9 of its size (rounding of the corners' images is
-     * ~1e-16 relative); the bounds callback rounds it outward to float */
-    for (a = 0; a < 3; ++a) {
-        prim->box[a] = INFINITY;
-        prim->box[a + 3] = -INFINITY;
-    }
-    for (i = 0; i < 8; ++i) {
-        double c[3] = {obox[(i & 1) ? 3 : 0], obox[(i & 2) ? 4 : 1], obox[(i & 4) ? 5 : 2]}, w[3];
-        ig_affine_point(prim->m, c, w);
-        for (a = 0; a < 3; ++a) {
-            prim->box[a] = fmin(prim->box[a], w[a]);
-            prim->box[a + 3] = fmax(prim->box[a + 3], w[a]);
-        }
-    }
-    for (a = 0; a < 3; ++a) {
-        ext = fmax(ext, prim->box[a + 3] - prim->box[a]);
-        mag = fmax(mag, fmax(fabs(prim->box[a]), fabs(prim->box[a + 3])));
-    }
-    pad = 1e-9 * (ext + mag) + DBL_MIN;
-    for (a = 0; a < 3; ++a) {
-        prim->box[a] -= pad;
-        prim->box[a + 3] += pad;
-    }
+    /* the box through m, padded, as the tracer's world boxes; the bounds callback rounds it outward to float */
+    ig_affine_box(prim->m, obox, prim->box);
     return 0;
 }
 
@@ -110,25 +89,13 @@ void ig_embree_bounds(const struct RTCBoundsFunctionArguments *args)
 
 /* ------------------------------------------------------------------ one lane */
 
-/* A lane's ray in the primitive's object space: origin oo and unit direction u; returns the length L of the
- * object-space direction (the solve's parameter is s = t L), or 0 when it is not positive and finite. */
+/* A lane's ray in the primitive's object space: origin oo and unit direction u, as the tracer moves it; returns
+ * the length L of the object-space direction (the solve's parameter is s = t L), or 0 when it is not positive
+ * and finite. */
 static double lane_ray(const ig_embree_prim *p, const double o[3], const double d[3], double oo[3], double u[3])
 {
-    double od[3], L;
-    if (p->identity) {
-        memcpy(oo, o, sizeof od);
-        memcpy(od, d, sizeof od);
-    } else {
-        ig_affine_point(p->minv, o, oo);
-        ig_affine_vector(p->minv, d, od);
-    }
-    L = sqrt(od[0] * od[0] + od[1] * od[1] + od[2] * od[2]);
-    if (!(L > 0.0) || !isfinite(L))
-        return 0.0;
-    u[0] = od[0] / L;
-    u[1] = od[1] / L;
-    u[2] = od[2] / L;
-    return L;
+    double L = ig_affine_unit_ray(p->identity ? NULL : p->minv, o, d, oo, u);
+    return (L > 0.0 && isfinite(L)) ? L : 0.0;
 }
 
 /* The first root t of the lane's ray with lo <= t <= hi (lo excluded when open): 1, or 0. */
@@ -152,8 +119,8 @@ static int next_root(const ig_embree_prim *p, const double oo[3], const double u
     return 0;
 }
 
-/* The unit normal at the lane's hit in the geometry's space (grad f through m's inverse transpose), in
- * double; facing the ray where grad f vanishes (a cone's apex). */
+/* The unit normal at the lane's hit in the geometry's space (grad f through m's inverse transpose, as the
+ * tracer's), in double; facing the ray where grad f vanishes (a cone's apex). */
 static void hit_normal(const ig_embree_prim *p, const double oo[3], const double u[3], double L, double t,
                        const double d[3], double n[3])
 {
@@ -161,17 +128,11 @@ static void hit_normal(const ig_embree_prim *p, const double oo[3], const double
     int i;
     for (i = 0; i < 3; ++i)
         po[i] = oo[i] + (t * L) * u[i];
-    if (ig_shape_normal(p->shape, p->params, po, no)) {
-        for (i = 0; i < 3; ++i)
-            n[i] = p->minv[i] * no[0] + p->minv[4 + i] * no[1] + p->minv[8 + i] * no[2];
-    } else {
-        for (i = 0; i < 3; ++i)
-            n[i] = -d[i];
-    }
-    len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (len > 0.0 && isfinite(len))
-        for (i = 0; i < 3; ++i)
-            n[i] /= len;
+    if (ig_shape_normal(p->shape, p->params, po, no) && ig_affine_normal(p->minv, no, n))
+        return;
+    len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (i = 0; i < 3; ++i)
+        n[i] = -d[i] / len;
 }
 
 static void lane_in(void *ray, unsigned int N, unsigned int i, double o[3], double d[3])
@@ -195,9 +156,10 @@ static ig_embree_hit *record(const ig_embree_shapes *g, struct RTCIntersectConte
     return id < c->nhits ? &c->hits[id] : NULL;
 }
 
-/* A candidate hit in lane i of an N-wide hit buffer. */
+/* A candidate hit in lane i of an N-wide hit buffer: every field of the lane, so nothing else of the buffer
+ * needs clearing (filters read only the valid lane). */
 static void put_hit(void *hit, unsigned int N, unsigned int i, const double n[3], unsigned int primID,
-                    unsigned int geomID, unsigned int instID)
+                    unsigned int geomID, const unsigned int *instID)
 {
     int k;
     for (k = 0; k < 3; ++k)
@@ -206,7 +168,8 @@ static void put_hit(void *hit, unsigned int N, unsigned int i, const double n[3]
     *ray_f(hit, N, H_V, i) = 0.0f;
     *ray_u(hit, N, H_PRIM, i) = primID;
     *ray_u(hit, N, H_GEOM, i) = geomID;
-    *ray_u(hit, N, H_INST, i) = instID;
+    for (k = 0; k < RTC_MAX_INSTANCE_LEVEL_COUNT; ++k)
+        *ray_u(hit, N, H_INST + k, i) = instID[k];
 }
 
 /* A candidate hit per lane and the arguments that hand it to Embree's filters (rtcFilterIntersection,
@@ -225,8 +188,8 @@ static int filter_begin(filter_call *fc, void *geometryUserPtr, struct RTCInters
 {
     if (N > IG_EMBREE_MAX_N)
         return 0;
-    memset(fc->fvalid, 0, sizeof fc->fvalid);
-    memset(fc->cand, 0, sizeof fc->cand);
+    /* only the N lanes in use: a lane's candidate is written whole before it is switched on (put_hit) */
+    memset(fc->fvalid, 0, N * sizeof fc->fvalid[0]);
     fc->fa.valid = fc->fvalid;
     fc->fa.geometryUserPtr = geometryUserPtr;
     fc->fa.context = context;
@@ -268,7 +231,7 @@ void ig_embree_intersect(const struct RTCIntersectFunctionNArguments *args)
         for (tries = 0; tries <= p->prep.degree && next_root(p, oo, u, L, lo, open, hi, &t); ++tries) {
             float old = *tfar;
             hit_normal(p, oo, u, L, t, d, n);
-            put_hit(fc.cand, N, i, n, args->primID, args->geomID, instID);
+            put_hit(fc.cand, N, i, n, args->primID, args->geomID, args->context->instID);
             fc.fvalid[i] = -1;
             *tfar = (float)t;
             rtcFilterIntersection(args, &fc.fa);
@@ -297,7 +260,7 @@ void ig_embree_occluded(const struct RTCOccludedFunctionNArguments *args)
 {
     const ig_embree_shapes *g = (const ig_embree_shapes *)args->geometryUserPtr;
     const ig_embree_prim *p = &g->prims[args->primID];
-    unsigned int N = args->N, i, instID = args->context->instID[0];
+    unsigned int N = args->N, i;
     void *ray = args->ray;
     filter_call fc;
     if (!filter_begin(&fc, args->geometryUserPtr, args->context, ray, N))
@@ -317,7 +280,7 @@ void ig_embree_occluded(const struct RTCOccludedFunctionNArguments *args)
         for (tries = 0; tries <= p->prep.degree && next_root(p, oo, u, L, lo, open, hi, &t); ++tries) {
             float old = *tfar;
             hit_normal(p, oo, u, L, t, d, n);
-            put_hit(fc.cand, N, i, n, args->primID, args->geomID, instID);
+            put_hit(fc.cand, N, i, n, args->primID, args->geomID, args->context->instID);
             fc.fvalid[i] = -1;
             *tfar = (float)t;
             rtcFilterOcclusion(args, &fc.fa);

@@ -5,12 +5,14 @@
  * - error-free transformations: a + b and a * b as an unevaluated sum of two doubles, exactly;
  * - Horner's rule, plain and compensated (as accurate as Horner in twice the working precision);
  * - one axis of the slab test of a ray against an axis-aligned box;
- * - affine 3x4 maps (row-major, as tracer.h): a point, a vector, the inverse (the tracer and the Embree adapter
- *   move rays into object space with these, so both see the same object-space ray to the last bit).
+ * - affine 3x4 maps (row-major, as tracer.h): a point, a vector, the inverse, a ray's unit object-space
+ *   direction, a normal, a box (the tracer and the Embree adapter move rays into object space, normals and
+ *   boxes into world space with these, so both see the same numbers to the last bit).
  */
 #ifndef IMPLGEN_NUMERICS_H
 #define IMPLGEN_NUMERICS_H
 
+#include <float.h>
 #include <math.h>
 
 /* s + e == a + b exactly, s = fl(a + b) (Knuth's TwoSum: no condition on the magnitudes). */
@@ -146,6 +148,107 @@ static inline int ig_affine_invert(const double m[12], double inv[12])
     inv[3] = -t[0];
     inv[7] = -t[1];
     inv[11] = -t[2];
+    return 1;
+}
+
+/* The ray o + t d in the object space of the map whose inverse is minv (NULL: the identity), as the solves take
+ * it: the origin oo and the unit direction u. Returns the length L of the object-space direction (the solve's
+ * parameter is s = t L); u is set only when L is positive and finite, which the caller checks. */
+static inline double ig_affine_unit_ray(const double *minv, const double o[3], const double d[3], double oo[3],
+                                        double u[3])
+{
+    double od[3], L;
+    int i;
+    if (minv) {
+        ig_affine_point(minv, o, oo);
+        ig_affine_vector(minv, d, od);
+    } else {
+        for (i = 0; i < 3; ++i) {
+            oo[i] = o[i];
+            od[i] = d[i];
+        }
+    }
+    L = sqrt(od[0] * od[0] + od[1] * od[1] + od[2] * od[2]);
+    if (!(L > 0.0) || !isfinite(L))
+        return L;
+    for (i = 0; i < 3; ++i)
+        u[i] = od[i] / L;
+    return L;
+}
+
+/* The unit world normal n = minv^T g / |minv^T g| of the object-space normal g (normals map by the inverse
+ * transpose). Returns 0 (n unnormalised) when that has no length or is not finite. */
+static inline int ig_affine_normal(const double minv[12], const double g[3], double n[3])
+{
+    double len;
+    int i;
+    for (i = 0; i < 3; ++i)
+        n[i] = minv[i] * g[0] + minv[4 + i] * g[1] + minv[8 + i] * g[2];
+    len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0.0) || !isfinite(len))
+        return 0;
+    for (i = 0; i < 3; ++i)
+        n[i] /= len;
+    return 1;
+}
+
+/* The box {xmin, ymin, zmin, xmax, ymax, zmax} around the image of the object box ob under m, padded outward by
+ * 1e-9 of its finite size (the rounding of the images is ~1e-16 relative: the padded box holds them with
+ * room). A finite box: its 8 corners through m. Sides of ob may be infinite (an axis the spec leaves open):
+ * then each world axis sums the entries' extremes, an entry of m that is 0 adding nothing, so a world axis that
+ * no open object axis reaches stays finite. Returns 1 when all six sides of the result are finite. */
+static inline int ig_affine_box(const double m[12], const double ob[6], double wb[6])
+{
+    double ext = 0.0, mag = 0.0, pad;
+    int a, i, finite = 1;
+    for (a = 0; a < 6; ++a)
+        finite = finite && isfinite(ob[a]);
+    for (a = 0; a < 3; ++a) {
+        wb[a] = finite ? INFINITY : m[4 * a + 3];
+        wb[a + 3] = finite ? -INFINITY : m[4 * a + 3];
+    }
+    if (finite) {
+        for (i = 0; i < 8; ++i) {
+            double c[3], w[3];
+            c[0] = ob[(i & 1) ? 3 : 0];
+            c[1] = ob[(i & 2) ? 4 : 1];
+            c[2] = ob[(i & 4) ? 5 : 2];
+            ig_affine_point(m, c, w);
+            for (a = 0; a < 3; ++a) {
+                if (w[a] < wb[a])
+                    wb[a] = w[a];
+                if (w[a] > wb[a + 3])
+                    wb[a + 3] = w[a];
+            }
+        }
+    } else {
+        for (a = 0; a < 3; ++a)
+            for (i = 0; i < 3; ++i) {
+                double e = m[4 * a + i], lo, hi;
+                if (e == 0.0)
+                    continue;
+                lo = e * ob[i];
+                hi = e * ob[i + 3];
+                wb[a] += lo < hi ? lo : hi;
+                wb[a + 3] += lo < hi ? hi : lo;
+            }
+    }
+    for (a = 0; a < 3; ++a) {
+        if (isfinite(wb[a + 3] - wb[a]) && wb[a + 3] - wb[a] > ext)
+            ext = wb[a + 3] - wb[a];
+        if (isfinite(wb[a]) && fabs(wb[a]) > mag)
+            mag = fabs(wb[a]);
+        if (isfinite(wb[a + 3]) && fabs(wb[a + 3]) > mag)
+            mag = fabs(wb[a + 3]);
+    }
+    pad = 1e-9 * (ext + mag) + DBL_MIN;
+    for (a = 0; a < 3; ++a) {
+        wb[a] = isnan(wb[a]) ? -INFINITY : wb[a] - pad; /* NaN (inf - inf): open, never an empty box */
+        wb[a + 3] = isnan(wb[a + 3]) ? INFINITY : wb[a + 3] + pad;
+    }
+    for (a = 0; a < 6; ++a)
+        if (!isfinite(wb[a]))
+            return 0;
     return 1;
 }
 

@@ -222,7 +222,7 @@ int ig_roots_stats(const double *c, int n, double lo, double hi, int method, int
         k = solve_reduced(p + m, deg, lo, hi, method, first, fallbacks, r);
     if (m > 0)
         r[k++] = 0.0;
-    if (k > 1)
+    if (k > 1 && (deg != 2 || m > 0)) /* ig_quadratic lists its roots ascending and distinct already */
         k = ig_sort_unique(r, k);
     int cnt = 0, most = first ? 1 : n;
     for (int i = 0; i < k && cnt < most; ++i)

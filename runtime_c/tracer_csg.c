@@ -13,39 +13,62 @@
 #include <math.h>
 #include <string.h>
 
+/* Roots (in t) of a leaf along the object-space ray oo + s u, u the unit direction and s = t L. */
+static inline int leaf_roots_unit(const rt_node *n, const double oo[3], const double u[3], double L, double lo,
+                                  double hi, double *r)
+{
+    int k = ig_shape_solve(n->shape, n->params, &n->prep, oo, u, lo * L, hi * L, IG_ROOTS_AUTO, 0, r, NULL), i;
+    for (i = 0; i < k; ++i)
+        r[i] /= L;
+    return k;
+}
+
 /* Roots of a leaf along an object-space ray, in the ray's own parameter. The solve runs on the unit direction
  * (parameter s = t |d|) so the polynomial does not depend on how much the transform scaled the direction:
  * an object scaled by 1e3 would otherwise hand the solver coefficients c_k ~ 1e-3k. */
 int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r)
 {
     double L = sqrt(rt_dot(od, od)), u[3];
-    int k, i;
     if (!(L > 0.0) || !isfinite(L))
         return 0;
     u[0] = od[0] / L;
     u[1] = od[1] / L;
     u[2] = od[2] / L;
-    k = ig_shape_solve(n->shape, n->params, &n->prep, oo, u, lo * L, hi * L, IG_ROOTS_AUTO, 0, r, NULL);
-    for (i = 0; i < k; ++i)
-        r[i] /= L;
-    return k;
+    return leaf_roots_unit(n, oo, u, L, lo, hi, r);
 }
 
 /* Spans of one leaf solid over [a, b]. */
-static int leaf_spans(const rt_scene *s, int k, const double o[3], const double d[3], double a, double b, rt_span *out,
-                      int max)
+static int leaf_spans(const rt_scene *s, int k, const rt_ray *ray, double a, double b, rt_span *out, int max)
 {
     const rt_node *n = &s->nodes[k];
-    double oo[3], od[3], r[IG_MAX_DEGREE + 2], x[IG_MAX_DEGREE + 2];
+    double own_o[3], own_d[3], own_u[3], r[IG_MAX_DEGREE + 2], x[IG_MAX_DEGREE + 2], L;
+    const double *oo = ray->o, *od = ray->d, *inv = ray->inv, *u = ray->u;
     int f0 = 0, f1 = 0, nr, nx, i, cnt = 0, inside_prev = 0, lo_leaf, hi_leaf;
     rt_end start;
 
-    rt_to_object(n, o, d, oo, od);
-    if (!rt_clip_box(n->obox, oo, od, &a, &b, &f0, &f1))
+    if (!n->identity) { /* an identity leaf takes the world ray as it is, with its inverse and unit direction */
+        rt_xform_point(n->minv, ray->o, own_o);
+        rt_xform_vector(n->minv, ray->d, own_d);
+        oo = own_o;
+        od = own_d;
+        inv = NULL;
+    }
+    if (!rt_clip_slabs(n->obox, oo, od, inv, &a, &b, &f0, &f1))
         return 0;
     if (!(b > a))
         return 0;
-    nr = rt_leaf_roots(n, oo, od, a, b, r);
+    if (n->identity) {
+        L = ray->len;
+    } else {
+        L = sqrt(rt_dot(od, od));
+        if (L > 0.0 && isfinite(L)) {
+            own_u[0] = od[0] / L;
+            own_u[1] = od[1] / L;
+            own_u[2] = od[2] / L;
+        }
+        u = own_u;
+    }
+    nr = (L > 0.0 && isfinite(L)) ? leaf_roots_unit(n, oo, u, L, a, b, r) : 0;
     /* Breakpoints a = x[0] <= roots <= x[nx - 1] = b. A root within rounding of a box face means the surface
      * touches its box there (a cylinder tangent to its box's side): the endpoint is the surface, not the face. */
     lo_leaf = f0 ? k : -1; /* a box face, or open where the ray's range starts inside */
@@ -158,20 +181,21 @@ static int combine(int op, const rt_span *A, int na, const rt_span *B, int nb, r
     return n;
 }
 
-int rt_spans(const rt_scene *s, int k, const double o[3], const double d[3], double a, double b, rt_span *out, int max)
+int rt_spans(const rt_scene *s, int k, const rt_ray *ray, double a, double b, rt_span *out, int max)
 {
     const rt_node *n = &s->nodes[k];
     rt_span L[RT_MAX_SPANS], R[RT_MAX_SPANS];
     int nl, nr;
     if (n->kind == RT_LEAF)
-        return leaf_spans(s, k, o, d, a, b, out, max);
-    /* The node's box bounds everything below it (an unbounded leaf inside an intersection included). */
-    if (n->wbounded && !rt_clip_box(n->wbox, o, d, &a, &b, NULL, NULL))
+        return leaf_spans(s, k, ray, a, b, out, max);
+    /* The node's box bounds everything below it (an unbounded leaf inside an intersection included); an open
+     * side clips nothing. */
+    if (!rt_clip_slabs(n->wbox, ray->o, ray->d, ray->inv, &a, &b, NULL, NULL))
         return 0;
-    nl = rt_spans(s, n->left, o, d, a, b, L, RT_MAX_SPANS);
+    nl = rt_spans(s, n->left, ray, a, b, L, RT_MAX_SPANS);
     if (nl == 0 && n->kind != RT_UNION)
         return 0;
-    nr = rt_spans(s, n->right, o, d, a, b, R, RT_MAX_SPANS);
+    nr = rt_spans(s, n->right, ray, a, b, R, RT_MAX_SPANS);
     if (nr == 0) {
         if (n->kind == RT_INTERSECTION)
             return 0;
@@ -187,12 +211,14 @@ int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d
                   double *t_in, double *t_out, int *leaf_in, int *leaf_out, int max)
 {
     rt_span sp[RT_MAX_SPANS];
+    rt_ray ray;
     int n, i;
     if (!s->committed || node < 0 || node >= s->nnodes)
         return 0;
     if (tmax > s->far)
         tmax = s->far;
-    n = rt_spans(s, node, o, d, tmin, tmax, sp, RT_MAX_SPANS);
+    rt_ray_init(&ray, o, d, s->far);
+    n = rt_spans(s, node, &ray, tmin, tmax, sp, RT_MAX_SPANS);
     if (n > max)
         n = max;
     for (i = 0; i < n; ++i) {
@@ -246,49 +272,33 @@ static int plane_hit(const rt_node *n, int k, const rt_ray *ray, double tmin, do
     return 1;
 }
 
-/* A transformed leaf's ray as ig_shape_solve takes it: the origin oo in object space and the unit
- * object-space direction u. Returns the length L of the object-space direction (the solve's parameter is
- * s = t L); u is set only when L is positive and finite, which the caller checks. */
-static inline double object_unit_ray(const rt_node *n, const rt_ray *ray, double oo[3], double u[3])
-{
-    double od[3], L;
-    rt_xform_point(n->minv, ray->o, oo);
-    rt_xform_vector(n->minv, ray->d, od);
-    L = sqrt(rt_dot(od, od));
-    if (!(L > 0.0) || !isfinite(L))
-        return L;
-    u[0] = od[0] / L;
-    u[1] = od[1] / L;
-    u[2] = od[2] / L;
-    return L;
-}
-
 /* Narrows [*lo, *hi] (in t) to where the ray p + s u, s = t L, is inside the leaf's clip region: 0 when that is
  * empty. The ball: |p + s u - c|^2 = r^2 with u a unit vector; the cube: its three slabs. */
 static inline int clip_range(const rt_node *n, const double *p, const double *u, double L, double *lo, double *hi)
 {
-    double q[3], s0 = -INFINITY, s1 = INFINITY;
-    int a;
-    for (a = 0; a < 3; ++a)
-        q[a] = p[a] - n->clip_c[a];
+    double s0 = -INFINITY, s1 = INFINITY;
     if (n->clip == RT_CLIP_SPHERE) {
-        double b = rt_dot(q, u), c = rt_dot(q, q) - n->clip_r * n->clip_r, disc = b * b - c, h;
+        double q[3], b, c, disc, h;
+        int a;
+        for (a = 0; a < 3; ++a)
+            q[a] = p[a] - n->clip_c[a];
+        b = rt_dot(q, u);
+        c = rt_dot(q, q) - n->clip_r * n->clip_r;
+        disc = b * b - c;
         if (!(disc > 0.0))
             return 0;
         h = sqrt(disc);
         s0 = -b - h;
         s1 = -b + h;
     } else {
+        double cube[6];
+        int a;
         for (a = 0; a < 3; ++a) {
-            if (u[a] == 0.0) {
-                if (fabs(q[a]) > n->clip_r)
-                    return 0;
-                continue;
-            }
-            double e0 = (-n->clip_r - q[a]) / u[a], e1 = (n->clip_r - q[a]) / u[a];
-            s0 = fmax(s0, fmin(e0, e1));
-            s1 = fmin(s1, fmax(e0, e1));
+            cube[a] = n->clip_c[a] - n->clip_r;
+            cube[a + 3] = n->clip_c[a] + n->clip_r;
         }
+        if (!rt_clip_box(cube, p, u, &s0, &s1, NULL, NULL))
+            return 0;
     }
     *lo = fmax(*lo, s0 / L);
     *hi = fmin(*hi, s1 / L);
@@ -334,7 +344,7 @@ static inline int csg_hit(const rt_scene *s, int k, const rt_ray *ray, double tm
                           rt_pending *hit)
 {
     rt_span sp[RT_MAX_SPANS];
-    int ns = rt_spans(s, k, ray->o, ray->d, lo, hi, sp, RT_MAX_SPANS), i;
+    int ns = rt_spans(s, k, ray, lo, hi, sp, RT_MAX_SPANS), i;
     for (i = 0; i < ns; ++i) {
         const rt_end *e = NULL;
         if (sp[i].in.t > tmin && sp[i].in.t < tmax && sp[i].in.leaf >= 0) {
@@ -384,7 +394,7 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
             return got;
     }
     if (!n->identity) {
-        L = object_unit_ray(n, ray, oo, u);
+        L = ig_affine_unit_ray(n->minv, ray->o, ray->d, oo, u);
         po = oo;
         pu = u;
     }

@@ -28,55 +28,15 @@ void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far)
     }
 }
 
-/* Slab clipping of [*t0, *t1] against an axis-aligned box (sides may be infinite), given the ray's inverse
- * direction inv (any value on an axis where d is 0), or NULL to divide only on the axes reached. An empty or
- * NaN box, or a ray parallel to an axis and outside the box on it, gives 0. f0/f1 (may be NULL) receive the
- * outward face code +-(axis + 1) of the face that moved the bound, or keep their value when the bound did not
- * move. Returns 1 when the clipped interval is non-empty. */
-static inline int clip_slabs(const double box[6], const double o[3], const double d[3], const double inv[3], double *t0,
-                             double *t1, int *f0, int *f1)
-{
-    double lo = *t0, hi = *t1;
-    int a;
-    for (a = 0; a < 3; ++a) {
-        double bmin = box[a], bmax = box[a + 3], ta, tb;
-        int fa;
-        if (!(bmin <= bmax))
-            return 0; /* empty or NaN box */
-        if (d[a] == 0.0) {
-            if (!(o[a] >= bmin && o[a] <= bmax))
-                return 0;
-            continue;
-        }
-        /* outward normal of the face the ray enters through: the min face, or the max one when d < 0 */
-        fa = ig_slab(bmin, bmax, o[a], inv ? inv[a] : 1.0 / d[a], &ta, &tb) ? a + 1 : -(a + 1);
-        if (ta > lo) {
-            lo = ta;
-            if (f0)
-                *f0 = fa;
-        }
-        if (tb < hi) {
-            hi = tb;
-            if (f1)
-                *f1 = -fa;
-        }
-        if (!(lo <= hi))
-            return 0;
-    }
-    *t0 = lo;
-    *t1 = hi;
-    return 1;
-}
-
 int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0, int *f1)
 {
-    return clip_slabs(box, o, d, NULL, t0, t1, f0, f1);
+    return rt_clip_slabs(box, o, d, NULL, t0, t1, f0, f1);
 }
 
 /* The BVH's box test: rt_clip_box with the ray's precomputed inverse direction and no face codes. */
 static int ray_box(const double box[6], const rt_ray *r, double *t0, double *t1)
 {
-    return clip_slabs(box, r->o, r->d, r->inv, t0, t1, NULL, NULL);
+    return rt_clip_slabs(box, r->o, r->d, r->inv, t0, t1, NULL, NULL);
 }
 
 /* ------------------------------------------------------------------ hits */
@@ -234,22 +194,6 @@ static inline int object_normal(const rt_node *n, int face, const double po[3], 
     return 0;
 }
 
-/* The unit world normal nw = Minv^T g (normals map by the inverse transpose). Returns 0 when it has no length
- * or is not finite. */
-static inline int world_normal(const rt_node *n, const double g[3], double nw[3])
-{
-    double len;
-    int a;
-    for (a = 0; a < 3; ++a)
-        nw[a] = n->minv[a] * g[0] + n->minv[4 + a] * g[1] + n->minv[8 + a] * g[2];
-    len = sqrt(rt_dot(nw, nw));
-    if (!(len > 0.0) || !isfinite(len))
-        return 0;
-    for (a = 0; a < 3; ++a)
-        nw[a] /= len;
-    return 1;
-}
-
 /* Turns the normals nw and g to their side and returns whether the ray enters the solid at the hit. */
 static inline int orient_normals(const rt_pending *pd, int singular, const double d[3], double nw[3], double g[3])
 {
@@ -284,7 +228,7 @@ void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], c
 
     hit_points(n, pd, o, d, hit, lz);
     singular = object_normal(n, pd->face, hit->po, lz, g);
-    if (!singular && !world_normal(n, g, nw))
+    if (!singular && !ig_affine_normal(n->minv, g, nw)) /* normals map by the inverse transpose */
         singular = 1;
     entering = orient_normals(pd, singular, d, nw, g);
     memcpy(hit->n, nw, sizeof nw);
@@ -379,8 +323,14 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
             continue;
         b = &s->bvh[stack[sp]];
         if (b->left < 0) {
-            for (i = b->first; i < b->first + b->count; ++i)
+            for (i = b->first; i < b->first + b->count; ++i) {
+                /* A leaf's box holds its objects' boxes, which may be far apart (a scene's objects to the left
+                 * and right of the one in the middle): each object's own box first, before its solve sets up. */
+                double o0 = tmin, o1 = best;
+                if (b->count > 1 && !ray_box(s->nodes[s->objects[s->order[i]]].wbox, &ray, &o0, &o1))
+                    continue;
                 RT_TAKE(s->order[i])
+            }
         } else if (sp + 2 <= (int)(sizeof stack / sizeof stack[0])) {
             /* visit the nearer child first: push it last */
             const rt_bvh_node *l = &s->bvh[b->left], *r = &s->bvh[b->right];

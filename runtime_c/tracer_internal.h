@@ -17,17 +17,16 @@ typedef struct rt_node {
     double minv[12];    /* world -> object */
     double mnorm;       /* Frobenius norm of M's linear part: bounds how much M stretches a distance */
     int identity;       /* M is exactly the identity: rays need no transforming */
-    double obox[6];     /* object-space bounds box */
+    double obox[6];     /* object-space bounds box, as the spec gives it (a clip does not change it) */
     int obounded;       /* the spec gives bounds (some sides may still be infinite) */
     ig_shape_prep prep; /* shape.c's per-shape clip and shift data, worked out once (ig_shape_solve) */
     double half;        /* the largest half-extent of prep's finite box axes, 0 without one (rt_hit_error) */
     int clip;           /* RT_CLIP_*: a top-level leaf's surface is shown only inside the clip region */
     double clip_c[3];   /* the clip's centre (object space) */
     double clip_r;      /* its radius, or its half-edge */
-    int operand;        /* a CSG node uses this node */
-    /* any node */
-    double wbox[6]; /* world-space box, slightly padded; valid when wbounded */
-    int wbounded;
+    /* any node (after commit) */
+    double wbox[6]; /* world-space box, slightly padded; a side is infinite where the node is open that way */
+    int wbounded;   /* every side of wbox is finite: the object goes into the BVH */
 } rt_node;
 
 typedef struct rt_bvh_node {
@@ -141,12 +140,51 @@ void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lazy);
 
 /* tracer_csg.c */
 int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r);
-int rt_spans(const rt_scene *s, int node, const double o[3], const double d[3], double a, double b, rt_span *out,
-             int max);
+int rt_spans(const rt_scene *s, int node, const rt_ray *ray, double a, double b, rt_span *out, int max);
 /* The nearest hit of one top-level object with tmin < t < tmax: 1 and *hit filled, or 0. any != 0: a yes/no
  * query for an opaque shadow ray -- on an opaque top-level leaf the hit's t may be left unrefined (any point of
  * the certified piece that holds the root, see IG_ANY_ROOT), so only its existence may be used. */
 int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin, double tmax, int any, rt_pending *hit);
+
+/* Slab clipping of [*t0, *t1] against an axis-aligned box (sides may be infinite), given the ray's inverse
+ * direction inv (any value on an axis where d is 0), or NULL to divide only on the axes reached. An empty or
+ * NaN box, or a ray parallel to an axis and outside the box on it, gives 0. f0/f1 (may be NULL) receive the
+ * outward face code +-(axis + 1) of the face that moved the bound, or keep their value when the bound did not
+ * move. Returns 1 when the clipped interval is non-empty. */
+static inline int rt_clip_slabs(const double box[6], const double o[3], const double d[3], const double inv[3],
+                                double *t0, double *t1, int *f0, int *f1)
+{
+    double lo = *t0, hi = *t1;
+    int a;
+    for (a = 0; a < 3; ++a) {
+        double bmin = box[a], bmax = box[a + 3], ta, tb;
+        int fa;
+        if (!(bmin <= bmax))
+            return 0; /* empty or NaN box */
+        if (d[a] == 0.0) {
+            if (!(o[a] >= bmin && o[a] <= bmax))
+                return 0;
+            continue;
+        }
+        /* outward normal of the face the ray enters through: the min face, or the max one when d < 0 */
+        fa = ig_slab(bmin, bmax, o[a], inv ? inv[a] : 1.0 / d[a], &ta, &tb) ? a + 1 : -(a + 1);
+        if (ta > lo) {
+            lo = ta;
+            if (f0)
+                *f0 = fa;
+        }
+        if (tb < hi) {
+            hi = tb;
+            if (f1)
+                *f1 = -fa;
+        }
+        if (!(lo <= hi))
+            return 0;
+    }
+    *t0 = lo;
+    *t1 = hi;
+    return 1;
+}
 
 /* small vector helpers */
 static inline double rt_dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }

@@ -223,34 +223,34 @@ int rt_scene_add_csg(rt_scene *s, int op, int left, int right, int material)
     n->material = material;
     n->depth = (dl > dr ? dl : dr) + 1;
     n->mnorm = 1.0;
-    s->nodes[left].operand = s->nodes[right].operand = 1;
     return k;
+}
+
+/* Whether a CSG node uses node k (nodes refer only to earlier ones, so only later nodes are looked at). */
+static int is_operand(const rt_scene *s, int k)
+{
+    int i;
+    for (i = k + 1; i < s->nnodes; ++i)
+        if (s->nodes[i].kind != RT_LEAF && (s->nodes[i].left == k || s->nodes[i].right == k))
+            return 1;
+    return 0;
 }
 
 int rt_scene_set_clip(rt_scene *s, int node, int kind, const double center[3], double size)
 {
     rt_node *n;
-    int a;
     if (s->committed)
         return fail(s, "scene already committed");
     if (node < 0 || node >= s->nnodes || s->nodes[node].kind != RT_LEAF)
         return fail(s, "a clip is for a leaf");
     n = &s->nodes[node];
-    if (n->operand)
+    if (is_operand(s, node))
         return fail(s, "a clipped leaf cannot be a CSG operand");
     if (kind != RT_CLIP_NONE && kind != RT_CLIP_SPHERE && kind != RT_CLIP_BOX)
         return fail(s, "unknown clip kind");
-    if (kind != RT_CLIP_NONE) {
-        if (!(size > 0.0) || !isfinite(size) || !isfinite(center[0]) || !isfinite(center[1]) || !isfinite(center[2]))
-            return fail(s, "clip size must be finite and positive, its centre finite");
-        /* the object-space box of what can be seen: the shape's own box cut by the clip region's (both kinds
-         * fit in the cube of half-edge size), so an unbounded shape becomes a bounded object */
-        for (a = 0; a < 3; ++a) {
-            n->obox[a] = fmax(n->obox[a], center[a] - size);
-            n->obox[a + 3] = fmin(n->obox[a + 3], center[a] + size);
-        }
-        n->obounded = 1;
-    }
+    if (kind != RT_CLIP_NONE &&
+        (!(size > 0.0) || !isfinite(size) || !isfinite(center[0]) || !isfinite(center[1]) || !isfinite(center[2])))
+        return fail(s, "clip size must be finite and positive, its centre finite");
     n->clip = kind;
     memcpy(n->clip_c, center, sizeof n->clip_c);
     n->clip_r = size;
@@ -296,82 +296,56 @@ void rt_scene_set_background(rt_scene *s, const double color[3]) { memcpy(s->bac
 
 /* ------------------------------------------------------------------ boxes and BVH */
 
-static void pad_box(double b[6])
+/* The object-space box of what a leaf shows: the spec's box, cut by the clip region's (both kinds fit in the
+ * cube of half-edge clip_r), so a clipped unbounded shape becomes a bounded object. 0 when neither bounds it. */
+static int leaf_box(const rt_node *n, double box[6])
 {
-    double ext = 0.0, mag = 0.0, pad;
     int a;
-    for (a = 0; a < 3; ++a) {
-        if (b[a + 3] - b[a] > ext)
-            ext = b[a + 3] - b[a];
-        if (fabs(b[a]) > mag)
-            mag = fabs(b[a]);
-        if (fabs(b[a + 3]) > mag)
-            mag = fabs(b[a + 3]);
-    }
-    /* Rounding in the corner transform is ~1e-16 relative; 1e-9 keeps the box conservative with room. */
-    pad = 1e-9 * (ext + mag) + DBL_MIN;
-    for (a = 0; a < 3; ++a) {
-        b[a] -= pad;
-        b[a + 3] += pad;
-    }
+    memcpy(box, n->obox, 6 * sizeof(double));
+    if (n->clip != RT_CLIP_NONE)
+        for (a = 0; a < 3; ++a) {
+            box[a] = fmax(box[a], n->clip_c[a] - n->clip_r);
+            box[a + 3] = fmin(box[a + 3], n->clip_c[a] + n->clip_r);
+        }
+    return n->obounded || n->clip != RT_CLIP_NONE;
 }
 
+/* A node's world box. Sides may be infinite: an intersection of a leaf bounded in x and z with one bounded in
+ * y (the glassware's stem) is bounded all round, and goes into the BVH. */
 static void node_box(rt_scene *s, int k)
 {
     rt_node *n = &s->nodes[k];
-    int a, i;
+    int a;
     if (n->kind == RT_LEAF) {
-        n->wbounded = 0;
-        if (!n->obounded)
-            return;
-        for (a = 0; a < 6; ++a)
-            if (!isfinite(n->obox[a]))
-                return;
-        for (a = 0; a < 3; ++a) {
-            n->wbox[a] = INFINITY;
-            n->wbox[a + 3] = -INFINITY;
-        }
-        for (i = 0; i < 8; ++i) {
-            double c[3], w[3];
-            c[0] = n->obox[(i & 1) ? 3 : 0];
-            c[1] = n->obox[(i & 2) ? 4 : 1];
-            c[2] = n->obox[(i & 4) ? 5 : 2];
-            rt_xform_point(n->m, c, w);
+        double box[6];
+        if (leaf_box(n, box)) {
+            n->wbounded = ig_affine_box(n->m, box, n->wbox);
+        } else {
             for (a = 0; a < 3; ++a) {
-                if (w[a] < n->wbox[a])
-                    n->wbox[a] = w[a];
-                if (w[a] > n->wbox[a + 3])
-                    n->wbox[a + 3] = w[a];
+                n->wbox[a] = -INFINITY;
+                n->wbox[a + 3] = INFINITY;
             }
+            n->wbounded = 0;
         }
-        pad_box(n->wbox);
-        n->wbounded = 1;
         return;
     }
     {
         const rt_node *l = &s->nodes[n->left], *r = &s->nodes[n->right];
-        if (n->kind == RT_UNION) {
-            n->wbounded = l->wbounded && r->wbounded;
-            if (n->wbounded)
-                for (a = 0; a < 3; ++a) {
-                    n->wbox[a] = fmin(l->wbox[a], r->wbox[a]);
-                    n->wbox[a + 3] = fmax(l->wbox[a + 3], r->wbox[a + 3]);
-                }
-        } else if (n->kind == RT_INTERSECTION) {
-            n->wbounded = l->wbounded || r->wbounded;
-            if (l->wbounded && r->wbounded) {
-                for (a = 0; a < 3; ++a) {
-                    n->wbox[a] = fmax(l->wbox[a], r->wbox[a]);
-                    n->wbox[a + 3] = fmin(l->wbox[a + 3], r->wbox[a + 3]);
-                }
-            } else if (n->wbounded) {
-                memcpy(n->wbox, l->wbounded ? l->wbox : r->wbox, sizeof n->wbox);
+        for (a = 0; a < 3; ++a) {
+            if (n->kind == RT_UNION) {
+                n->wbox[a] = fmin(l->wbox[a], r->wbox[a]);
+                n->wbox[a + 3] = fmax(l->wbox[a + 3], r->wbox[a + 3]);
+            } else if (n->kind == RT_INTERSECTION) {
+                n->wbox[a] = fmax(l->wbox[a], r->wbox[a]);
+                n->wbox[a + 3] = fmin(l->wbox[a + 3], r->wbox[a + 3]);
+            } else { /* difference: never larger than its left operand */
+                n->wbox[a] = l->wbox[a];
+                n->wbox[a + 3] = l->wbox[a + 3];
             }
-        } else { /* difference: never larger than its left operand */
-            n->wbounded = l->wbounded;
-            if (n->wbounded)
-                memcpy(n->wbox, l->wbox, sizeof n->wbox);
         }
+        n->wbounded = 1;
+        for (a = 0; a < 6; ++a)
+            n->wbounded = n->wbounded && isfinite(n->wbox[a]);
     }
 }
 

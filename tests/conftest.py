@@ -13,6 +13,7 @@ from types import ModuleType
 import numpy as np
 import pytest
 
+from implgen.compile.clib import SANITIZE_FLAGS
 from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, runtime_sources
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -30,7 +31,7 @@ pytest_plugins = ["needs_program"]
 
 
 CDIR = ROOT / "tests" / "c"
-C_SANITIZE = ["-O1", "-g", "-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer"]
+C_SANITIZE = list(SANITIZE_FLAGS)
 
 
 def compile_c(out: Path, sources, *, include=(), sanitize: bool = True, shared: bool = False, flags=()) -> Path:

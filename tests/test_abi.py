@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import ctypes
 
+import numpy as np
+
 from conftest import RUNTIME, compile_c, run_c
 from implgen import abi, resources
 from implgen.codegen.spec import MAX_DEGREE
@@ -89,3 +91,43 @@ def test_every_runtime_source_is_in_exactly_one_library_list():
     listed = [name for group in lists for name in group]
     assert len(listed) == len(set(listed))
     assert sorted(listed) == sorted(p.name for p in RUNTIME.glob("*.c"))
+
+
+def test_grown_box_is_the_box_ig_shape_prepare_clips_to(tmp_path):
+    """abi.grown_box, the Python side's one statement of how far shape.c grows a box (the NumPy ray caster, the
+    exact judge and the POV-Ray clip use it), against ig_shape_prepare's prep.lo and prep.hi, bit for bit: boxes
+    with open sides, a zero side, tiny and huge bounds."""
+    boxes = [
+        (-1.25, -0.25, -1.25, 1.25, 0.25, 1.25),
+        (-np.inf, 0.0, -3.0, np.inf, 2.0, np.inf),
+        (1e-300, -7.5e200, -0.1, 3e-300, 1e201, 0.1),
+        (-np.inf, -np.inf, -np.inf, np.inf, np.inf, np.inf),
+        (0.0, 0.0, -5.0, 0.0, 1.0, -4.0),
+    ]
+    rows = ",\n".join(
+        "    {" + ", ".join(float(v).hex() if np.isfinite(v) else ("-" if v < 0 else "") + "INFINITY" for v in b) + "}"
+        for b in boxes
+    )
+    src = tmp_path / "grow.c"
+    src.write_text(
+        '#include <math.h>\n#include <stdio.h>\n#include <string.h>\n#include "shape.h"\n'
+        f"static const double BOXES[][6] = {{\n{rows}}};\n"
+        "static int bounds(const double *params, double box[6])\n{\n"
+        "    memcpy(box, BOXES[(int)params[0]], sizeof BOXES[0]);\n    return 1;\n}\n"
+        "static void coeffs(const double o[3], const double d[3], const double *p, double *c)\n{\n"
+        "    (void)p;\n    c[0] = o[0];\n    c[1] = d[0];\n}\n"
+        "int main(void)\n{\n"
+        '    const ig_shape shape = {"probe", 1, 1, coeffs, NULL, NULL, bounds};\n'
+        f"    for (int k = 0; k < {len(boxes)}; ++k) {{\n"
+        "        const double params[1] = {k};\n        ig_shape_prep prep;\n"
+        "        ig_shape_prepare(&shape, params, &prep);\n"
+        '        for (int i = 0; i < 3; ++i)\n            printf("%a %a\\n", prep.lo[i], prep.hi[i]);\n'
+        "    }\n    return 0;\n}\n"
+    )
+    sources = [src, *resources.runtime_sources(resources.SOLVER_SOURCES, ("shape.c",))]
+    out = run_c(compile_c(tmp_path / "grow", sources)).split()
+    seen = np.array([float.fromhex(v) for v in out]).reshape(len(boxes), 3, 2)
+    for box, c in zip(boxes, seen):
+        lo, hi = abi.grown_box(box)
+        assert np.array_equal(lo, c[:, 0]) and np.array_equal(hi, c[:, 1]), (box, c)
+    assert abi.grown_box(boxes[0])[1][0] > 1.25  # it does grow: a torus touching |x| = a + b keeps that root

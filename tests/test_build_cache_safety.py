@@ -18,6 +18,8 @@ from pathlib import Path
 
 import pytest
 
+from implgen_proc import Ran, assert_one_line
+
 ROOT = Path(__file__).resolve().parent.parent
 SPHERE = ROOT / "examples" / "shapes" / "sphere.yaml"
 
@@ -58,13 +60,10 @@ def cache_command(cache: Path, *args: str, **env: str) -> subprocess.CompletedPr
 
 
 def one_line_error(proc: subprocess.CompletedProcess, *fragments: str) -> str:
-    """Exit status 2, exactly one line on stderr saying each fragment, no traceback."""
-    assert proc.returncode == 2, (proc.returncode, proc.stdout, proc.stderr)
-    lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
-    return lines[0]
+    """The bad-input contract (implgen_proc.assert_one_line): exit status 2, one line on stderr saying each
+    fragment, no traceback. Returns the line."""
+    assert_one_line(Ran(proc.returncode, proc.stdout, proc.stderr, 0.0), *fragments)
+    return proc.stderr.strip()
 
 
 def libraries(cache: Path) -> list[Path]:
@@ -262,6 +261,36 @@ def test_a_failing_compiler_is_one_line_naming_cc(cache: Path, tmp_path: Path) -
     scene = scene_with_equation(tmp_path, "x + 0.375*y")
     line = one_line_error(render(cache, scene, tmp_path / "out.png", CC="false"), "CC", "false", "failed")
     assert "exit status 1" in line
+
+
+def test_a_compiler_that_fails_after_writing_leaves_no_temporary_file(cache: Path, tmp_path: Path) -> None:
+    """A compiler that writes half an object and then fails: one line, and its output is removed (nothing named
+    .tmp-*, no object), so no later build can take it for an entry."""
+    cc = tmp_path / "halfcc"
+    log = tmp_path / "written.txt"
+    write = f'[ "$1" = -o ] && echo half > "$2" && echo "$2" >> {log}'
+    cc.write_text(f"#!/bin/sh\nwhile [ $# -gt 0 ]; do {write}; shift; done\nexit 1\n")
+    cc.chmod(0o700)
+    before = {p for p in cache.rglob("*") if p.suffix in (".o", ".so")}
+    scene = scene_with_equation(tmp_path, "x + 0.4375*y")
+    one_line_error(render(cache, scene, tmp_path / "out.png", CC=str(cc)), "CC", "halfcc", "failed")
+    after = {p for p in cache.rglob("*") if p.suffix in (".o", ".so") or p.name.startswith(".tmp-")}
+    written = log.read_text().split()
+    assert written and all(Path(w).name.startswith(".tmp-") for w in written)  # it did write, under a temp name
+    assert after == before
+
+
+def test_unlink_quietly_removes_files_and_links_never_their_targets(tmp_path: Path) -> None:
+    from implgen.cachedir import unlink_quietly
+
+    (tmp_path / "f").write_text("x")
+    (tmp_path / "target").write_text("keep")
+    (tmp_path / "link").symlink_to(tmp_path / "target")
+    (tmp_path / "folder").mkdir()
+    for name in ("f", "link", "gone", "folder"):
+        unlink_quietly(tmp_path / name)  # a missing file or a folder: no error
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["folder", "target"]
+    assert (tmp_path / "target").read_text() == "keep"
 
 
 def test_a_compiler_that_writes_nothing_caches_nothing(cache: Path, tmp_path: Path) -> None:

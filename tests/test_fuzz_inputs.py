@@ -244,16 +244,22 @@ def _refusal_through_cli(work: Path, path: Path) -> None:
     assert list(folder.iterdir()) == []  # neither the image nor a temporary file
 
 
+def _scene_loads_or_is_refused_cleanly(work: Path, path: Path) -> None:
+    """The scene file loads, or is refused in one line naming it, by the loader and by `implgen render` alike
+    (nothing written)."""
+    scene, message = outcome(load_frames, path)
+    if scene is None:
+        assert message.startswith(f"{path}: "), message
+        _refusal_through_cli(work, path)
+
+
 @fuzz_settings(250)
 @given(broken(scenes()))
 def test_scene_loader_broken_scenes(work, case):
     how, doc = case
     path = work / "scenes" / "scene.yaml"
     path.write_text(dump(doc), encoding="utf-8")
-    scene, message = outcome(load_frames, path)
-    if scene is None:
-        assert message.startswith(f"{path}: "), message
-        _refusal_through_cli(work, path)
+    _scene_loads_or_is_refused_cleanly(work, path)
 
 
 @fuzz_settings(60)
@@ -263,10 +269,7 @@ def test_scene_loader_deep_scenes(work, case, flow):
     block or flow style: loaded, or refused in one line naming the file; never a RecursionError."""
     path = work / "scenes" / "deep.yaml"
     path.write_text(dump(case, flow=flow or None), encoding="utf-8")
-    scene, message = outcome(load_frames, path)
-    if scene is None:
-        assert message.startswith(f"{path}: "), message
-        _refusal_through_cli(work, path)
+    _scene_loads_or_is_refused_cleanly(work, path)
 
 
 @fuzz_settings(150)
@@ -306,10 +309,7 @@ def test_mutated_example_scenes(work, case):
     path = work / "scenes" / name
     path.write_bytes(data)
     try:
-        scene, message = outcome(load_frames, path)
-        if scene is None:
-            assert message.startswith(f"{path}: "), message
-            _refusal_through_cli(work, path)
+        _scene_loads_or_is_refused_cleanly(work, path)
     finally:
         path.unlink()
 

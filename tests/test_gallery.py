@@ -13,7 +13,7 @@ from implgen.codegen.spec import MAX_DEGREE, parse_spec
 from implgen.codegen.speccache import parse_spec as cached_parse_spec
 from implgen.errors import UserError
 from implgen.resources import gallery_dir
-from implgen.scene.preview import BACKGROUND, preview_scene
+from implgen.scene.preview import BACKGROUND, frame, preview_scene
 from implgen.scene.render import render
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -74,6 +74,19 @@ def test_an_open_spec_is_framed_by_a_box_for_its_picture():
     barth = gallery.entry("barth6")
     assert barth.load().box() is None
     assert barth.load_framed().box() == [-2.0, -2.0, -2.0, 2.0, 2.0, 2.0]
+
+
+def test_a_preview_frames_the_box_and_refuses_a_spec_without_one():
+    """preview_scene frames the spec's box (Barth's sextic: the framed one, centre 0, radius sqrt(3) * 2); a spec
+    left open has nothing to frame and is a ValueError, not a picture of something else."""
+    barth = gallery.entry("barth6")
+    centre, radius = frame(barth.load_framed())
+    assert np.array_equal(centre, np.zeros(3)) and radius == pytest.approx(2.0 * np.sqrt(3.0), rel=1e-15)
+    scene = preview_scene(barth.load_framed(), 64, 48)
+    (leaf,) = scene.leaves()
+    assert leaf.spec.box() == [-2.0, -2.0, -2.0, 2.0, 2.0, 2.0]  # the shape itself, with no clip beside it
+    with pytest.raises(ValueError, match="barth6 has no whole box"):
+        preview_scene(barth.load(), 64, 48)
 
 
 SPEC = {"name": "s", "equation": "x^2 + y^2 + z^2 - a^2", "params": {"a": 1.0}}

@@ -70,15 +70,15 @@ def test_pov_matrix_is_transposed_for_row_vectors():
 
 def test_exact_verdict_hit_miss_and_tangent():
     scene = _sphere_scene()
-    judge = pc.ExactJudge(scene, 80, 60)
+    judge = pc.PixelJudge(scene, 80, 60)
     assert judge.hits(40, 30)  # through the centre
     assert not judge.hits(0, 0)  # a corner ray passes far from the ball
-    obj = judge.objects[0]
+    (obj,) = judge.exact.objects
     eye = np.array([0.0, 0.0, 5.0])
-    assert judge.ray_hits(obj, eye, np.array([0.0, 0.0, -1.0]))
-    assert not judge.ray_hits(obj, eye, np.array([0.0, 0.0, 1.0]))  # pointing away: roots t < 0
-    assert judge.ray_hits(obj, np.array([0.0, 1.0, 5.0]), np.array([0.0, 0.0, -1.0]))  # tangent: double root
-    assert not judge.ray_hits(obj, np.array([0.0, 1.0 + 2.0**-40, 5.0]), np.array([0.0, 0.0, -1.0]))
+    assert obj.meets(eye, np.array([0.0, 0.0, -1.0]))
+    assert not obj.meets(eye, np.array([0.0, 0.0, 1.0]))  # pointing away: roots t < 0
+    assert obj.meets(np.array([0.0, 1.0, 5.0]), np.array([0.0, 0.0, -1.0]))  # tangent: double root
+    assert not obj.meets(np.array([0.0, 1.0 + 2.0**-40, 5.0]), np.array([0.0, 0.0, -1.0]))
 
 
 def test_camera_ray_matches_the_tracer_convention():
@@ -129,15 +129,15 @@ def test_box_that_cuts_the_surface_is_exported_as_clipped_by():
 
 
 def test_exact_verdict_clips_to_the_box():
-    judge = pc.ExactJudge(_cut_ball_scene({"x": [-0.5, 0.5], "y": [-2, 2], "z": [-2, 2]}), 64, 48)
-    obj = judge.objects[0]
+    judge = pc.PixelJudge(_cut_ball_scene({"x": [-0.5, 0.5], "y": [-2, 2], "z": [-2, 2]}), 64, 48)
+    (obj,) = judge.exact.objects
     eye = np.array([0.0, 0.0, 5.0])
-    assert judge.ray_hits(obj, eye, np.array([0.0, 0.0, -1.0]))  # through the middle, inside the box
+    assert obj.meets(eye, np.array([0.0, 0.0, -1.0]))  # through the middle, inside the box
     # towards x = 0.8 on the sphere's front: outside the box's x range, so no hit (the whole ball would say yes)
     target = np.array([0.8, 0.0, 0.6])
-    assert not judge.ray_hits(obj, eye, target - eye)
-    full = pc.ExactJudge(_cut_ball_scene({"x": [-2, 2], "y": [-2, 2], "z": [-2, 2]}), 64, 48)
-    assert full.ray_hits(full.objects[0], eye, target - eye)
+    assert not obj.meets(eye, target - eye)
+    full = pc.PixelJudge(_cut_ball_scene({"x": [-2, 2], "y": [-2, 2], "z": [-2, 2]}), 64, 48)
+    assert full.exact.hits(eye, target - eye)
 
 
 @pytest.mark.needs_program("povray")
@@ -150,7 +150,7 @@ def test_povray_renders_the_clipped_ball_like_the_exact_verdict(tmp_path):
     png = tmp_path / "cut.png"
     pc.run_povray(shutil.which("povray"), pov, png, 64, 48, 1)
     mask = pc.pov_mask(png)
-    judge = pc.ExactJudge(scene, 64, 48)
+    judge = pc.PixelJudge(scene, 64, 48)
     hits = 0
     for py in range(4, 48, 6):
         for px in range(2, 64, 5):
@@ -159,32 +159,8 @@ def test_povray_renders_the_clipped_ball_like_the_exact_verdict(tmp_path):
     assert hits >= 5
     # pixel 43 of row 24 looks at the ball's front at x ~ 0.7 (the whole ball spans ~14 pixels either side)
     assert mask[24, 32] and not mask[24, 43] and not judge.hits(43, 24)
-    whole = pc.ExactJudge(_cut_ball_scene({"x": [-2, 2], "y": [-2, 2], "z": [-2, 2]}), 64, 48)
+    whole = pc.PixelJudge(_cut_ball_scene({"x": [-2, 2], "y": [-2, 2], "z": [-2, 2]}), 64, 48)
     assert whole.hits(43, 24)
-
-
-def test_integer_ray_polynomial_is_a_positive_multiple_of_the_exact_one():
-    """ExactJudge.ray_poly works on integers; SymPy's expansion of f(o' + t d') over Q is the reference."""
-    from fractions import Fraction
-
-    import sympy as sp
-
-    scene = load_scene(TORUS)
-    judge = pc.ExactJudge(scene, 80, 60)
-    obj = judge.objects[0]
-    leaf = next(lf for lf in scene.leaves() if lf.spec.degree == 4)
-    o, d = pc.camera_ray(scene, 41.5, 33.5, 80, 60)
-    oo, dd = judge.object_ray(obj, o, d)
-    t = sp.Symbol("t")
-    subs = {pc.param_symbol(k): sp.Rational(Fraction(float(v))) for k, v in leaf.params.items()}
-    f = leaf.spec.f.xreplace(subs)
-    names = {s.name: s for s in f.free_symbols}
-    assert set(names) == {"x", "y", "z"}
-    line = {names[n]: sp.Rational(oo[k]) + sp.Rational(dd[k]) * t for k, n in enumerate("xyz")}
-    want = [Fraction(int(c.p), int(c.q)) for c in reversed(sp.Poly(sp.expand(f.xreplace(line)), t).all_coeffs())]
-    got = judge.ray_poly(obj, o, d)
-    ratio = Fraction(got[-1]) / want[-1]
-    assert ratio > 0 and all(Fraction(g) == ratio * w for g, w in zip(got, want))
 
 
 def _timing(ours_wall: float, ours_render: float, pov_wall: float, pov_trace: float) -> dict:

@@ -109,3 +109,42 @@ def test_the_c_side_refuses_a_clip_it_cannot_honour() -> None:
         assert lib.rt_scene_set_clip(s, u, sphere, origin, 1.0) == -1  # not a leaf
     finally:
         lib.rt_scene_free(s)
+
+
+def _clipped_cone_hit(clips: list[tuple[str | None, float]]):
+    """A cone leaf given the clips in turn (the last one holds), committed, hit by the ray x = 0.5, y = 0.3 along
+    -z from z = 10: the cone's points there are z = +-sqrt(0.34) = +-0.583."""
+    import ctypes
+
+    import numpy as np
+
+    from implgen.compile import clib
+    from implgen.scene.model import Material
+    from implgen.scene.tracer import CLIPS, RtHit, bind, darr
+
+    sc = parse_scene(scene({"equation": CONE, "name": "cone"}), "clip.yaml")
+    lib = bind(clib.load(build.build_scene(sc).library))
+    s = lib.rt_scene_new()
+    try:
+        mat = lib.rt_scene_add_material(s, darr(Material().packed()))
+        leaf = lib.rt_scene_add_leaf(s, lib.rt_scene_shape(0), darr([]), 0, darr(np.eye(3, 4).reshape(-1)), mat)
+        for kind, size in clips:
+            assert lib.rt_scene_set_clip(s, leaf, CLIPS[kind] if kind else 0, darr([0, 0, 0]), size) == 0
+        assert lib.rt_scene_add_object(s, leaf) == 0 and lib.rt_scene_commit(s) == 0
+        hit = RtHit()
+        if lib.rt_scene_intersect(s, darr([0.5, 0.3, 10]), darr([0, 0, -1]), 0.0, math.inf, ctypes.byref(hit)):
+            return hit.t
+        return None
+    finally:
+        lib.rt_scene_free(s)
+
+
+@pytest.mark.parametrize("kind", ["box", "sphere"])
+def test_a_later_clip_replaces_an_earlier_one(kind) -> None:
+    """A second rt_scene_set_clip replaces the first, larger or smaller: the object's box is the spec's box cut
+    by the last clip, not by every clip ever given (the small clip alone hides both cone points)."""
+    near = 10 - math.sqrt(0.34)
+    assert _clipped_cone_hit([(kind, 0.2)]) is None
+    assert _clipped_cone_hit([(kind, 0.2), (kind, 2.0)]) == pytest.approx(near, abs=1e-9)
+    assert _clipped_cone_hit([(kind, 2.0), (kind, 0.2)]) is None
+    assert _clipped_cone_hit([(kind, 0.2), (None, 1.0)]) == pytest.approx(near, abs=1e-9)  # no clip: all of it

@@ -7,6 +7,11 @@
 
 The headers are small and read once, on first use. tests/test_abi.py compiles a probe against the same
 headers that prints sizeof, offsetof and the values the compiler sees, and compares them with this module.
+
+One shared fact is a figure in C code rather than a define: how much `ig_shape_prepare` (runtime_c/shape.c) grows
+a shape's box before it clips a ray to it. grown_box() is its one Python statement (the NumPy ray caster, the
+exact judge, the POV-Ray export's clip); tests/test_abi.py runs ig_shape_prepare on boxes and requires the same
+doubles, bit for bit.
 """
 
 from __future__ import annotations
@@ -14,6 +19,8 @@ from __future__ import annotations
 import ctypes
 import re
 from functools import cache, lru_cache
+
+import numpy as np
 
 from implgen.resources import runtime_dir
 
@@ -75,3 +82,15 @@ def material_fields() -> tuple[tuple[str, int], ...]:
     fields = struct_fields("rt_material")
     assert all(ctype == "double" for _, ctype, _ in fields), "rt_material travels as packed doubles"
     return tuple((name, count) for name, _, count in fields)
+
+
+BOX_GROWTH = 1e-9  # of a box's finite extent: a surface that touches its own box keeps the root there
+
+
+def grown_box(box) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi), each per axis, of a box {xmin, ymin, zmin, xmax, ymax, zmax} (a bound may be +-inf) grown as
+    ig_shape_prepare grows it: each side by BOX_GROWTH times the larger finite |bound| of its axis."""
+    box = np.asarray(box, dtype=float)
+    lo, hi = box[:3], box[3:]
+    scale = np.maximum(np.where(np.isfinite(lo), np.abs(lo), 0.0), np.where(np.isfinite(hi), np.abs(hi), 0.0))
+    return lo - BOX_GROWTH * scale, hi + BOX_GROWTH * scale

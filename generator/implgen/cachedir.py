@@ -270,7 +270,7 @@ def write_file(path: Path, data: bytes) -> None:
         _write_new(tmp, data)
         _replace(tmp, path)
     except BaseException:
-        _unlink_quietly(tmp)
+        unlink_quietly(tmp)
         raise
     used_here.add(Path(path))
 
@@ -303,11 +303,11 @@ def seal(tmp: Path, path: Path, key: str) -> None:
         os.fsync(fd)
     except BaseException:
         os.close(fd)
-        _unlink_quietly(tmp)
+        unlink_quietly(tmp)
         raise
     os.close(fd)
     if not data:  # None: it grew while being read
-        _unlink_quietly(tmp)
+        unlink_quietly(tmp)
         raise EmptyOutput(str(tmp))
     _replace(tmp, path)
     write_file(path.with_name(path.name + SEAL), _seal_text(key, len(data), hashlib.sha256(data).hexdigest()))
@@ -320,7 +320,7 @@ def write_entry(path: Path, data: bytes, key: str) -> None:
     try:
         _write_new(tmp, data)
     except BaseException:
-        _unlink_quietly(tmp)
+        unlink_quietly(tmp)
         raise
     seal(tmp, path, key)
 
@@ -331,10 +331,11 @@ def remove_entry(path: Path) -> None:
         if os.path.isdir(p) and not os.path.islink(p):
             shutil.rmtree(p, ignore_errors=True)
         else:
-            _unlink_quietly(p)
+            unlink_quietly(p)
 
 
-def _unlink_quietly(path: Path) -> None:
+def unlink_quietly(path: Path) -> None:
+    """Remove a file or a link (never what it points to); one already gone, or that cannot go, is left."""
     try:
         os.unlink(path)
     except OSError:

@@ -23,6 +23,7 @@
  */
 #define _POSIX_C_SOURCE 199309L /* clock_gettime */
 #include "embree_shape.h"
+#include "plane_y.h"
 #include "tracer.h"
 
 #include "blobs10.h"
@@ -44,24 +45,7 @@
 static const ig_shape *const SHAPES[] = {&blobs10_shape, &chmutov8_shape, &heart_shape,  &piriform_shape,
                                          &sphere_shape,  &torus_y_shape,  &torus_z_shape};
 
-/* the ground of the tracer: the plane y = 0, clipped to |x|, |z| <= params[0] */
-static void plane_coeffs(const double o[3], const double d[3], const double *p, double *c)
-{
-    (void)p;
-    c[0] = o[1];
-    c[1] = d[1];
-}
-static double plane_value(const double q[3], const double *p)
-{
-    (void)p;
-    return q[1];
-}
-static void plane_gradient(const double q[3], const double *p, double g[3])
-{
-    (void)q, (void)p;
-    g[0] = g[2] = 0.0;
-    g[1] = 1.0;
-}
+/* the ground of the tracer: the plane y = 0 (plane_y.h), clipped to |x|, |z| <= params[0] */
 static int plane_bounds(const double *p, double box[6])
 {
     box[0] = box[2] = -p[0];
@@ -70,7 +54,7 @@ static int plane_bounds(const double *p, double box[6])
     box[4] = 1.0;
     return 1;
 }
-static const ig_shape plane_shape = {"ground", 1, 1, plane_coeffs, plane_value, plane_gradient, plane_bounds};
+static const ig_shape plane_shape = {"ground", 1, 1, plane_y_coeffs, plane_y_value, plane_y_gradient, plane_bounds};
 
 typedef struct scene_in {
     double eye[3], look[3], up[3], fov, light[3], ground;

@@ -3,6 +3,7 @@
  * CSG boundaries, coloured shadows); the tracer's own shortcuts. Part of the tracer_rays test (tracer_rays.c
  * holds main). */
 #include "tracer_rays.h"
+#include "plane_y.h"
 
 /* ---------------------------------------------------------------- optics */
 void test_optics(void)
@@ -236,26 +237,7 @@ void test_glass(void)
 
 /* ---------------------------------------------------------------- the tracer's own shortcuts */
 
-/* The plane y = 0 as a hand-written unbounded shape of degree 1. */
-static void plane_coeffs(const double o[3], const double d[3], const double *p, double *c)
-{
-    (void)p;
-    c[0] = o[1];
-    c[1] = d[1];
-}
-static double plane_value(const double q[3], const double *p)
-{
-    (void)p;
-    return q[1];
-}
-static void plane_gradient(const double q[3], const double *p, double g[3])
-{
-    (void)p;
-    (void)q;
-    g[0] = 0.0;
-    g[1] = 1.0;
-    g[2] = 0.0;
-}
+/* The plane y = 0 (plane_y.h) as a hand-written unbounded shape of degree 1. */
 static int plane_bounds(const double *p, double box[6])
 {
     (void)p;
@@ -263,7 +245,7 @@ static int plane_bounds(const double *p, double box[6])
     box[3] = box[4] = box[5] = INFINITY;
     return 0;
 }
-static const ig_shape plane_y = {"plane_y", 1, 0, plane_coeffs, plane_value, plane_gradient, plane_bounds};
+static const ig_shape plane_y = {"plane_y", 1, 0, plane_y_coeffs, plane_y_value, plane_y_gradient, plane_bounds};
 
 void test_shortcuts(void)
 {

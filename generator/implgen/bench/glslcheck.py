@@ -19,6 +19,8 @@ import numpy as np
 from implgen.codegen.emit import generate
 from implgen.codegen.glslprogram import program
 from implgen.roots import exactray
+from implgen.scene.camera import camera_rays as scene_camera_rays
+from implgen.scene.model import Camera
 
 IG_HIT, IG_UNSURE, IG_EARLIER = 1, 2, 4
 
@@ -58,19 +60,12 @@ class Case:
 
 
 def camera_rays(eye, look_at, up, fov: float, size: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
-    """Pixel-centre rays as runtime_c/tracer_render.c builds them (double), (h, w, 3); row 0 is the top row."""
+    """Pixel-centre rays as runtime_c/tracer_render.c builds them (double, implgen.scene.camera), (h, w, 3);
+    row 0 is the top row."""
     w_px, h_px = size
-    eye = np.asarray(eye, float)
-    wv = eye - np.asarray(look_at, float)
-    wv /= np.linalg.norm(wv)
-    u = np.cross(np.asarray(up, float), wv)
-    u /= np.linalg.norm(u)
-    v = np.cross(wv, u)
-    tan_half = np.tan(0.5 * fov * np.pi / 180.0)
     ys, xs = np.mgrid[0:h_px, 0:w_px] + 0.5
-    px = (2.0 * xs / w_px - 1.0) * tan_half * (w_px / h_px)
-    py = (1.0 - 2.0 * ys / h_px) * tan_half
-    d = px[..., None] * u + py[..., None] * v - wv
+    cam = Camera(position=tuple(map(float, eye)), look_at=tuple(map(float, look_at)), up=tuple(map(float, up)), fov=fov)
+    eye, d = scene_camera_rays(cam, w_px, h_px, xs, ys)
     return np.broadcast_to(eye, d.shape).copy(), d
 
 
@@ -132,20 +127,11 @@ class Judge:
 
     def __init__(self, case: Case) -> None:
         self.case = case
-        self.terms = exactray.exact_terms(case.spec, case.params)
-        self.box = exactray.padded_box(case.spec.box(case.params))
+        self.shape = exactray.Placed.of(case.spec, case.params)
 
     def __call__(self, row: int, col: int) -> bool:
         c = self.case
-        return exactray.ray_hits(
-            self.terms,
-            c.spec.degree,
-            self.box,
-            c.origins[row, col],
-            c.dirs[row, col],
-            c.tmin[row, col],
-            c.tmax[row, col],
-        )
+        return self.shape.meets(c.origins[row, col], c.dirs[row, col], c.tmin[row, col], c.tmax[row, col])
 
 
 @dataclass

@@ -288,11 +288,7 @@ def parse_expression(
     max_param_degree: int = 64,
 ) -> Parsed:
     """Parse one side of an equation. `variables` count towards the degree; `params` do not."""
-    if not isinstance(text, str):
-        raise ParseError("expression must be text")
-    if len(text) > MAX_TEXT_LENGTH:
-        raise ParseError(f"expression longer than {MAX_TEXT_LENGTH} characters")
-    check_alphabet(text)
+    _check_text(text, "expression")
     if not text.strip():
         raise ParseError("expression is empty")
     if _LONG_NUMBER.search(text):
@@ -319,6 +315,15 @@ def parse_expression(
     return parsed
 
 
+def _check_text(text: object, what: str) -> None:
+    """Text, at most MAX_TEXT_LENGTH characters, of the allowed alphabet; `what` names it in the error."""
+    if not isinstance(text, str):
+        raise ParseError(f"{what} must be text")
+    if len(text) > MAX_TEXT_LENGTH:
+        raise ParseError(f"{what} longer than {MAX_TEXT_LENGTH} characters")
+    check_alphabet(text)
+
+
 def check_terms(terms: int) -> None:
     """Refuse what would expand to more than MAX_TERMS terms, before anything expands it."""
     if terms > MAX_TERMS:
@@ -328,11 +333,7 @@ def check_terms(terms: int) -> None:
 
 def split_equation(text: str) -> tuple[str, str]:
     """`lhs = rhs` -> (lhs, rhs); a bare `expr` means `expr = 0`."""
-    if not isinstance(text, str):
-        raise ParseError("equation must be text")
-    if len(text) > MAX_TEXT_LENGTH:
-        raise ParseError(f"equation longer than {MAX_TEXT_LENGTH} characters")
-    check_alphabet(text)
+    _check_text(text, "equation")
     parts = text.split("=")
     if len(parts) == 1:
         return parts[0], "0"

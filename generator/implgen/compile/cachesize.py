@@ -167,17 +167,10 @@ def clear(root: Path) -> tuple[list[Unit], list[Unit]]:
         path = root / sub
         st = _lstat(path)
         if st is not None and stat.S_ISLNK(st.st_mode):
-            _unlink(path)  # a link in place of a subfolder: the link goes, its target stays
+            cachedir.unlink_quietly(path)  # a link in place of a subfolder: the link goes, its target stays
         else:
             try:
                 os.rmdir(path)
             except OSError:
                 pass  # not empty (files implgen does not know) or absent
     return removed, failed
-
-
-def _unlink(path: Path) -> None:
-    try:
-        os.unlink(path)
-    except OSError:
-        pass

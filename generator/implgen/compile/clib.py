@@ -38,6 +38,14 @@ from implgen.errors import UserError
 # and what `implgen demo` says it compiled with.
 WARNING_FLAGS: tuple[str, ...] = ("-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic")
 BASE_FLAGS: tuple[str, ...] = (*WARNING_FLAGS, "-O3", "-fPIC")
+# AddressSanitizer and UndefinedBehaviorSanitizer, any report fatal: the tests' C drivers and the Embree checks
+SANITIZE_FLAGS: tuple[str, ...] = (
+    "-O1",
+    "-g",
+    "-fsanitize=address,undefined",
+    "-fno-sanitize-recover=all",
+    "-fno-omit-frame-pointer",
+)
 KEY_FORMAT = "clib-2"  # part of every key: entries of an earlier layout are never taken for these
 
 # The libraries this process holds loaded (a live ctypes handle): eviction leaves them alone. Weak, so a library
@@ -109,7 +117,7 @@ def _run(job: Job) -> Path:
     except OSError as err:
         raise UserError("CC", f"cannot run the C compiler {cmd[0]!r} on {job.what}: {err.strerror or err}") from None
     if proc.returncode != 0:
-        _remove(tmp)
+        cachedir.unlink_quietly(tmp)
         raise UserError(
             "CC", f"{cmd[0]} failed on {job.what} (exit status {proc.returncode}): {_first_error(proc.stderr)}"
         )
@@ -120,16 +128,9 @@ def _run(job: Job) -> Path:
             "CC", f"{cmd[0]} exited 0 on {job.what} but wrote nothing; is CC a C compiler? nothing was cached"
         ) from None
     except OSError as err:
-        _remove(tmp)
+        cachedir.unlink_quietly(tmp)
         raise UserError(cachedir.label(), f"cannot write {job.target.name}: {err.strerror or err}") from None
     return job.target
-
-
-def _remove(path: Path) -> None:
-    try:
-        os.unlink(path)
-    except OSError:
-        pass
 
 
 def _writable(folder: Path) -> None:

@@ -12,6 +12,7 @@ from fractions import Fraction
 
 import sympy
 
+from implgen.abi import grown_box
 from implgen.codegen.spec import Spec, exact_polynomial, param_symbol
 
 POVRAY_MAX_ORDER = 35  # POV-Ray 3.7's limit for `polynomial`
@@ -105,17 +106,14 @@ def _leaf_object(leaf, texture: str) -> str:
 
 def clip_text(box) -> str:
     """What cuts the surface to its spec box, as implgen's runtime does (it solves only inside the box, grown
-    by 1e-9 of its extent). POV-Ray's `bounded_by` alone does not cut: it only skips rays that miss the box,
+    by implgen.abi.grown_box). POV-Ray's `bounded_by` alone does not cut: it only skips rays that miss the box,
     and a surface that leaves the box would render whole. So: `clipped_by` the box (or, with some bounds
     infinite, the planes of the finite ones), and `bounded_by { clipped_by }` when the box is finite."""
     import numpy as np
 
     if box is None:
         return ""
-    box = np.asarray(box, dtype=float)
-    lo, hi = box[:3], box[3:]
-    scale = np.maximum(np.where(np.isfinite(lo), np.abs(lo), 0.0), np.where(np.isfinite(hi), np.abs(hi), 0.0))
-    lo, hi = lo - 1e-9 * scale, hi + 1e-9 * scale
+    lo, hi = grown_box(box)
     if np.all(np.isfinite(box)):
         return f"  clipped_by {{ box {{ {_vec(lo)}, {_vec(hi)} }} }}\n  bounded_by {{ clipped_by }}\n"
     planes = []

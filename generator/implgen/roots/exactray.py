@@ -3,18 +3,22 @@
 The ray's origin and direction (doubles or floats, taken exactly as the rationals they are) and the shape's
 params (doubles, likewise) give f(o + t d) over Q, scaled to integer coefficients; the box clip of the ray is
 computed exactly; Descartes' rule with bisection (implgen.roots.descartes) says whether a real root lies in
-the clipped interval, a tangent (even) root included. This is the judge of bench/povray_compare.py's disputed
-pixels and of the GLSL checks (implgen.bench.glslcheck, bench/glsl_compare.py).
+the clipped interval, a tangent (even) root included. A shape placed by a 3x4 matrix (Placed) takes the world ray
+into its own space in rationals; ExactJudge decides which of several placed shapes a ray meets first. This is the
+judge of bench/povray_compare.py's disputed pixels, of the Embree checks (bench/embree_scenes.py) and of the GLSL
+checks (implgen.bench.glslcheck, bench/glsl_compare.py).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
 
+from implgen.abi import grown_box
 from implgen.codegen.spec import exact_polynomial, param_symbol
 from implgen.roots.descartes import has_root
 
@@ -64,14 +68,11 @@ def integer_ray_poly(terms: Terms, deg: int, oo: Sequence[Fraction], dd: Sequenc
 
 
 def padded_box(box) -> list[tuple[Fraction | None, Fraction | None]] | None:
-    """The spec box grown by 1e-9 of its extent, in doubles as runtime_c/shape.c does (and the POV-Ray
-    exporter's clipped_by), as exact rationals; None bounds for infinite ones."""
+    """The spec box grown in doubles as runtime_c/shape.c grows it (implgen.abi.grown_box; the POV-Ray
+    exporter's clipped_by too), as exact rationals; None bounds for infinite ones."""
     if box is None:
         return None
-    box = np.asarray(box, dtype=float)
-    lo, hi = box[:3], box[3:]
-    scale = np.maximum(np.where(np.isfinite(lo), np.abs(lo), 0.0), np.where(np.isfinite(hi), np.abs(hi), 0.0))
-    lo, hi = lo - 1e-9 * scale, hi + 1e-9 * scale
+    lo, hi = grown_box(box)
     return [
         (Fraction(float(a)) if np.isfinite(a) else None, Fraction(float(b)) if np.isfinite(b) else None)
         for a, b in zip(lo, hi)
@@ -101,13 +102,80 @@ def box_span(
     return t0, t1
 
 
-def ray_hits(terms: Terms, deg: int, box, o, d, tmin: float = 0.0, tmax: float | None = None) -> bool:
-    """Does f(o + t d) = 0 have a real root with t in [tmin, tmax] inside `box` (padded_box's form, or None)?
-    o, d, tmin, tmax are floats (or doubles), each taken exactly."""
-    oo = [Fraction(float(v)) for v in o]
-    dd = [Fraction(float(v)) for v in d]
-    hi = None if tmax is None or not math.isfinite(tmax) else Fraction(float(tmax))
-    span = box_span(box, oo, dd, Fraction(float(tmin)), hi)
-    if span is None:
-        return False
-    return has_root(integer_ray_poly(terms, deg, oo, dd), *span)
+def _exact(v) -> Fraction:
+    return v if isinstance(v, Fraction) else Fraction(float(v))
+
+
+_IDENTITY = tuple(tuple(Fraction(int(i == j)) for j in range(3)) for i in range(3))
+_ZERO = (Fraction(0),) * 3
+
+
+@dataclass(frozen=True)
+class Placed:
+    """One shape placed in the world, exactly: f's monomials over Q, its degree, its box (padded_box's form, or
+    None) and the world -> object map x_obj = inv (x_world - shift), all in rationals."""
+
+    terms: Terms
+    degree: int
+    box: list[tuple[Fraction | None, Fraction | None]] | None
+    inv: tuple[tuple[Fraction, ...], ...] = _IDENTITY
+    shift: tuple[Fraction, ...] = _ZERO
+
+    @classmethod
+    def of(cls, spec, params: Mapping[str, float], matrix=None) -> Placed:
+        """`spec` with `params` (doubles), its box padded as the C runtime pads it, placed by the object -> world
+        3x4 `matrix` of doubles (None: where it stands), each double taken exactly."""
+        terms, box = exact_terms(spec, params), padded_box(spec.box(params))
+        if matrix is None:
+            return cls(terms, spec.degree, box)
+        import sympy
+
+        m = [Fraction(float(v)) for v in np.asarray(matrix, dtype=float).reshape(12)]
+        inv = sympy.Matrix(3, 3, [sympy.Rational(m[4 * i + j]) for i in range(3) for j in range(3)]).inv()
+        inv_f = tuple(tuple(Fraction(int(inv[i, j].p), int(inv[i, j].q)) for j in range(3)) for i in range(3))
+        shift = tuple(m[4 * i + 3] for i in range(3))
+        return cls(terms, spec.degree, box, inv_f, shift)
+
+    def object_ray(self, o, d) -> tuple[list[Fraction], list[Fraction]]:
+        """The world ray o + t d (numbers taken exactly) in the object's space, exactly: the same t."""
+        ow = [Fraction(float(v)) - self.shift[k] for k, v in enumerate(o)]
+        dw = [Fraction(float(v)) for v in d]
+        oo = [sum(self.inv[i][j] * ow[j] for j in range(3)) for i in range(3)]
+        dd = [sum(self.inv[i][j] * dw[j] for j in range(3)) for i in range(3)]
+        return oo, dd
+
+    def ray_poly(self, o, d) -> list[int]:
+        """Integer coefficients (lowest first) of a positive multiple of f along the world ray o + t d."""
+        return integer_ray_poly(self.terms, self.degree, *self.object_ray(o, d))
+
+    def meets(self, o, d, t0=0, t1=None) -> bool:
+        """Does f(o + t d) = 0 have a real root, a tangent (even) one included, with t in [t0, t1] (t1 None or
+        infinite: unbounded) and o + t d inside the box? Every number is taken exactly."""
+        oo, dd = self.object_ray(o, d)
+        hi = None if t1 is None or not math.isfinite(t1) else _exact(t1)
+        span = box_span(self.box, oo, dd, _exact(t0), hi)
+        return span is not None and has_root(integer_ray_poly(self.terms, self.degree, oo, dd), *span)
+
+
+class ExactJudge:
+    """Which of several placed shapes does a ray truly meet first? The judge of a ray's first hit where two
+    tracers disagree (bench/povray_compare.py, bench/embree_scenes.py)."""
+
+    def __init__(self, objects: Sequence[Placed]):
+        self.objects = list(objects)
+
+    def hits(self, o, d, t0=0, t1=None) -> bool:
+        """Does any object meet o + t d for t in [t0, t1]?"""
+        return any(obj.meets(o, d, t0, t1) for obj in self.objects)
+
+    def right(self, claim: tuple[int, float], other: tuple[int, float], o, d, rel: float = 1e-9) -> bool:
+        """Is the claim (object index, t; index -1: a miss) true where the other answer disagrees: its object
+        meets the ray within rel of t, and the other answer's object does not meet it before?"""
+        obj, t = claim
+        oobj, _ = other
+        if obj < 0:  # a miss: the other object is not met at all
+            return oobj < 0 or not self.objects[oobj].meets(o, d)
+        near = Fraction(t * (1 - rel))
+        if not self.objects[obj].meets(o, d, near, Fraction(t * (1 + rel))):
+            return False
+        return oobj < 0 or oobj == obj or not self.objects[oobj].meets(o, d, 0, near)

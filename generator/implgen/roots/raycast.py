@@ -13,6 +13,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
+from implgen.abi import grown_box
 from implgen.roots.solvers import first_root_batch, real_roots_batch
 
 CoeffsFn = Callable[[np.ndarray, np.ndarray], np.ndarray]
@@ -23,10 +24,7 @@ def _clip(box: np.ndarray | None, o: np.ndarray, d: np.ndarray, t0: np.ndarray, 
     valid = t0 <= t1
     if box is None:
         return t0, t1, valid
-    lo, hi = box[:3], box[3:]
-    # the box grows by 1e-9 of its finite extent, as in shape.c: a surface touching its box keeps that root
-    scale = np.maximum(np.where(np.isfinite(lo), np.abs(lo), 0.0), np.where(np.isfinite(hi), np.abs(hi), 0.0))
-    lo, hi = lo - 1e-9 * scale, hi + 1e-9 * scale
+    lo, hi = grown_box(box)  # as shape.c grows it: a surface touching its box keeps that root
     with np.errstate(divide="ignore", invalid="ignore"):
         inv = 1.0 / d
         ta = (lo - o) * inv
@@ -116,10 +114,7 @@ def nearest_hit(
     method: str = "auto",
 ) -> np.ndarray:
     """Nearest root t in [tmin, tmax] per ray (np.inf for a miss), shape = broadcast batch shape."""
-    batch, t, counts = _solve(coeffs_fn, box, o, d, tmin, tmax, method)
-    first = t[:, 0] if t.shape[1] else np.full(t.shape[0], np.nan)
-    out = np.where(counts > 0, first, np.inf)
-    return out.reshape(batch)
+    return _nearest(coeffs_fn, box, o, d, tmin, tmax, method, first=False)
 
 
 def first_hit(
@@ -133,8 +128,14 @@ def first_hit(
 ) -> np.ndarray:
     """nearest_hit through the first-root solver (`ig_first_root`: it stops at the smallest root instead of
     isolating all of them): nearest root t in [tmin, tmax] per ray, np.inf for a miss."""
-    batch, t, counts = _solve(coeffs_fn, box, o, d, tmin, tmax, method, first=True)
-    return np.where(counts > 0, t[:, 0], np.inf).reshape(batch)
+    return _nearest(coeffs_fn, box, o, d, tmin, tmax, method, first=True)
+
+
+def _nearest(coeffs_fn, box, o, d, tmin, tmax, method: str, first: bool) -> np.ndarray:
+    """The smallest root per ray, np.inf where there is none, in the broadcast batch shape."""
+    batch, t, counts = _solve(coeffs_fn, box, o, d, tmin, tmax, method, first=first)
+    near = t[:, 0] if t.shape[1] else np.full(t.shape[0], np.inf)  # degree 0: no root column
+    return np.where(counts > 0, near, np.inf).reshape(batch)
 
 
 def all_hits(

@@ -1,8 +1,8 @@
 """A picture of one shape spec on its own, framed: the gallery's contact sheet (bench/surfaces.py) and its tests.
 
 The camera looks at the spec's box from above and to the side, far enough for the box's bounding sphere to fill
-the view; two lights move with it. The outside (f > 0) is gold, the inside blue, as in the viewer. A spec
-without a whole box is shown inside a ball of radius UNBOUNDED_RADIUS (CSG intersection), which bounds its solve.
+the view; two lights move with it. The outside (f > 0) is gold, the inside blue, as in the viewer. The spec
+needs a whole, finite box: an open one is framed first (implgen.codegen.gallery's Entry.load_framed gives one).
 """
 
 from __future__ import annotations
@@ -11,28 +11,21 @@ import math
 
 import numpy as np
 
-from implgen.codegen.spec import parse_spec
 from implgen.codegen.specmodel import Spec
-from implgen.scene.model import Camera, Csg, Leaf, Light, Material, Node, Scene
+from implgen.scene.model import Camera, Leaf, Light, Material, Scene
 
-UNBOUNDED_RADIUS = 2.0
 OUTSIDE = (0.95, 0.75, 0.3)
 INSIDE = (0.35, 0.55, 0.95)
 BACKGROUND = (0.12, 0.12, 0.14)
 YAW, PITCH, FOV = 30.0, 25.0, 40.0  # degrees
 
 
-def _ball() -> Spec:
-    box = {a: ["-r", "r"] for a in "xyz"}
-    ball = {"name": "preview_ball", "equation": "x^2 + y^2 + z^2 - r^2", "params": {"r": 1.0}, "bounds": box}
-    return parse_spec(ball)
-
-
 def frame(spec: Spec, values: dict[str, float] | None = None) -> tuple[np.ndarray, float]:
-    """(centre, radius) of the sphere the picture shows: the box's bounding sphere, or the clip ball's."""
+    """(centre, radius) of the sphere the picture shows: the box's bounding sphere. A ValueError for a spec
+    without a whole box: there is nothing to frame."""
     box = spec.box(values)
     if box is None or not all(math.isfinite(v) for v in box):
-        return np.zeros(3), UNBOUNDED_RADIUS
+        raise ValueError(f"{spec.name} has no whole box to frame: frame it first (gallery Entry.load_framed)")
     lo, hi = np.array(box[:3]), np.array(box[3:])
     return 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
 
@@ -42,10 +35,7 @@ def preview_scene(spec: Spec, width: int, height: int, spp: int = 1, values: dic
     params = {**spec.params, **(values or {})}
     centre, radius = frame(spec, params)
     material = Material(color=OUTSIDE, inside=INSIDE, ambient=0.12, diffuse=0.75, specular=0.45, shininess=40.0)
-    node: Node = Leaf(spec=spec, params=params, matrix=np.eye(3, 4), material=material, where="shape")
-    if spec.box(params) is None or not all(math.isfinite(v) for v in spec.box(params)):
-        ball = Leaf(spec=_ball(), params={"r": UNBOUNDED_RADIUS}, matrix=np.eye(3, 4), material=None, where="clip")
-        node = Csg(op="intersection", left=node, right=ball, material=material, where="shape")
+    node = Leaf(spec=spec, params=params, matrix=np.eye(3, 4), material=material, where="shape")
     y, p = math.radians(YAW), math.radians(PITCH)
     back = np.array([math.cos(p) * math.sin(y), math.sin(p), math.cos(p) * math.cos(y)])
     distance = radius / math.sin(math.radians(FOV / 2)) * 1.05
