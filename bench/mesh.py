@@ -30,13 +30,13 @@ from implgen.bench.machine import load_average, write_results
 from implgen.codegen.emit import generate
 from implgen.codegen.speccache import load_spec
 from implgen.mesh.contour import contour
-from implgen.mesh.crossings import clip_values
+from implgen.mesh.crossings import boundary_value_gradient
 from implgen.mesh.pipeline import closed_and_euler
 from implgen.mesh.region import make_grid, parse_clip
 from implgen.mesh.shapelib import ShapeLib
 
 ROOT = Path(__file__).resolve().parents[1]
-GRIDS = (8, 12, 16, 24, 32, 48, 64, 96, 128)
+GRIDS = (4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128)
 # (label, spec, clip, Euler characteristic and where it comes from; None: not a manifold)
 SURFACES = (
     ("torus", "examples/shapes/torus_z.yaml", None, 0, "a torus"),
@@ -60,20 +60,14 @@ def python_module(spec, folder: Path):
 
 
 def boundary_distance(lib: ShapeLib, clips, verts: np.ndarray) -> np.ndarray:
-    f, g = lib.value_gradient(verts)
-    cv = clip_values(clips, verts)
-    if len(cv):
-        top = cv.argmax(axis=0)
-        use = cv.max(axis=0) > f
-        f = np.where(use, cv.max(axis=0), f)
-        for k, c in enumerate(clips):
-            sel = use & (top == k)
-            g[sel] = c.gradient(verts[sel])
+    f, g = boundary_value_gradient(lib, clips, verts)
     return np.abs(f) / np.maximum(np.linalg.norm(g, axis=1), 1e-300)
 
 
-def ours(lib, clips, grid):
+def ours(lib, clips, grid, stats=None):
     m = contour(lib, clips, grid)
+    if stats is not None:
+        stats.append(m.stats)
     return m.vertices, m.faces
 
 
@@ -111,12 +105,21 @@ def run_surface(label, path, clip_text, euler, runs, cells, folder):
     row = {"label": label, "degree": spec.degree}
     smallest = {"ours": None, "mc": None}
     right_at = {"ours": [], "mc": []}
+    row["grids"] = {}  # n: (ours' Euler, MC's, ours' edges with crossings their ends do not show)
     for n in GRIDS:
         grid, clips = make_grid(spec.box(), user, n, path)
+        seen = {}
         for name, fn, merge in (("ours", ours, False), ("mc", marching, True)):
-            args = (lib, clips, grid) if name == "ours" else (module, spec.params, clips, grid)
-            verts, faces = fn(*args)
+            stats = []
+            args = (lib, clips, grid, stats) if name == "ours" else (module, spec.params, clips, grid)
+            try:
+                verts, faces = fn(*args)
+            except ValueError:  # marching cubes: no grid vertex inside
+                verts, faces = np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
             closed, e = topology(verts, faces, merge)
+            seen[name] = e if closed else None
+            if stats:
+                seen["hidden"] = stats[0]["hidden_crossing_edges"]
             ok = closed and euler is not None and e == euler
             if ok:
                 right_at[name].append(n)
@@ -126,12 +129,14 @@ def run_surface(label, path, clip_text, euler, runs, cells, folder):
                 d = boundary_distance(lib, clips, verts)
                 row[name] = {"closed": closed, "euler": e, "max": float(d.max()), "median": float(np.median(d))}
                 row["size"] = grid.size
+        row["grids"][n] = (seen["ours"], seen["mc"], seen["hidden"])
     grid, clips = make_grid(spec.box(), user, cells, path)
-    t_ours, t_mc = [], []
+    t_ours, t_mc, stats = [], [], []
     for _ in range(runs):  # interleaved
-        t_ours.append(timed(ours, lib, clips, grid)[0])
+        t_ours.append(timed(ours, lib, clips, grid, stats)[0])
         t_mc.append(timed(marching, module, spec.params, clips, grid)[0])
     row["t_ours"], row["t_mc"] = statistics.median(t_ours), statistics.median(t_mc)
+    row["phases"] = {k: statistics.median(st["seconds"][k] for st in stats) for k in stats[0]["seconds"]}
     row["smallest"] = smallest
     row["right_at"] = right_at
     return row
@@ -156,6 +161,48 @@ def table(rows, cells: int) -> list[str]:
             f"| {o['max'] / s:.1e} / {m['max'] / s:.1e} | {o['median'] / s:.1e} / {m['median'] / s:.1e} "
             f"| {yn(o['closed'])} / {yn(m['closed'])} | {o['euler']} / {m['euler']} ({known}) | {small} |"
         )
+    return out
+
+
+def phase_table(rows, cells: int) -> list[str]:
+    """Where our time goes: each phase of contour() (its stats' seconds), median over the timed runs."""
+    names = list(rows[0]["phases"])
+    out = [
+        f"| surface | {' | '.join(names)} | total (s), N = {cells} |",
+        "|---|" + "---|" * (len(names) + 1),
+    ]
+    for r in rows:
+        ph = r["phases"]
+        out.append(f"| {r['label']} | " + " | ".join(f"{ph[k]:.3f}" for k in names) + f" | {sum(ph.values()):.3f} |")
+    return out
+
+
+def _euler(e) -> str:
+    return "not closed" if e is None else str(e)
+
+
+def coarse_table(rows) -> list[str]:
+    """Below the smallest right grid: what each method got, and how many grid edges held crossings that their
+    two ends did not show (ours; the detail both methods miss)."""
+    out = [
+        "| surface | grids where both are closed: with the same Euler characteristic | largest wrong grid below ours' "
+        "smallest right one | Euler there ours / MC (known) | edges with crossings their ends do not show there |",
+        "|---|---|---|---|---|",
+    ]
+    for r in rows:
+        if r["known"] is None:
+            continue
+        g = r["grids"]
+        both = [(o, m) for o, m, _ in g.values() if o is not None and m is not None]
+        agree = f"{len(both)} of {len(g)}: {sum(1 for o, m in both if o == m)}"
+        small = r["smallest"]["ours"]
+        below = [n for n in g if small is None or n < small]
+        if below:
+            n = max(below)
+            o, m, hidden = g[n]
+            out.append(f"| {r['label']} | {agree} | {n} | {_euler(o)} / {_euler(m)} ({r['known']}) | {hidden} |")
+        else:
+            out.append(f"| {r['label']} | {agree} | - (right at {small}) | | |")
     return out
 
 
@@ -214,6 +261,21 @@ def main() -> int:
         "the known Euler characteristic.",
         "",
         *table(rows, args.cells),
+        "",
+        "Where our time goes (seconds per phase of the contour, medians of the timed runs): signs -- f at every "
+        "grid vertex; crossings -- every root on every grid line (the certified solver) and the gradient at each "
+        "edge's crossing; sheets -- cells' corner patterns, ambiguous faces' centres, the sheet table; qef -- "
+        "each sheet's point (one C loop over the cells); projection -- Newton onto the surface (C for f alone); "
+        "faces -- quads into triangles.",
+        "",
+        *phase_table(rows, args.cells),
+        "",
+        "Why not coarser than marching cubes: both read the signs at the same grid vertices. Below the smallest "
+        "right grid, what each got and how many grid edges held two (or more) crossings with both ends on one "
+        "side -- a thin neck or handle between two grid vertices, which the exact crossings see and no sign "
+        "shows:",
+        "",
+        *coarse_table(rows),
         "",
         "Known Euler characteristics: " + "; ".join(f"{r['label']}: {r['why']}" for r in rows) + ".",
         "Barth's sextic has no Euler characteristic to check against: its 50 nodes make it not a manifold, and a mesh "

@@ -218,3 +218,30 @@ def test_the_piriform_cusp():
         assert through == (cells == 48) and result.mesh.stats["snapped_to_singular"] == (cells == 48)
         tm = trimesh.Trimesh(result.mesh.vertices, result.mesh.faces, process=False)
         assert tm.is_watertight and tm.euler_number == 2
+
+
+def test_clip_values_along_grid_lines():
+    """A clip's value at points on grid lines (Clip.along, which skips building the points for a plane) equals
+    its value at those points, for a ball and every side of a box, lines along each axis."""
+    rng = np.random.default_rng(7)
+    clips = parse_clip("sphere:1.3") + parse_clip("box:0.9")
+    starts = rng.uniform(-2.0, 2.0, size=(40, 3))
+    line = rng.integers(0, len(starts), size=200)
+    t = rng.uniform(0.0, 4.0, size=200)
+    for axis in range(3):
+        p = starts[line].copy()
+        p[:, axis] += t
+        for c in clips:
+            assert np.array_equal(c.along(axis, starts, line, t), c.value(p))
+
+
+def test_closed_and_euler_on_small_complexes():
+    """A tetrahedron (closed, V - E + F = 4 - 6 + 4 = 2), with unused vertices around it; without a face (open);
+    with a face twice (edges in three faces) or turned over (an edge twice the same way); two tetrahedra (4)."""
+    tet = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]])
+    assert closed_and_euler(tet, 4) == (True, 2)
+    assert closed_and_euler(tet + 3, 10) == (True, 2)
+    assert closed_and_euler(tet[1:], 4) == (False, 4 - 6 + 3)
+    assert not closed_and_euler(np.concatenate([tet, tet[:1]]), 4)[0]
+    assert not closed_and_euler(np.concatenate([tet[:1, ::-1], tet[1:]]), 4)[0]
+    assert closed_and_euler(np.concatenate([tet, tet + 4]), 8) == (True, 4)

@@ -77,6 +77,7 @@ def test_scene_object_placed_by_its_transform(tmp_path):
         (["-o", "{d}/x.stl", "--clip", "sphere:-1"], "--clip"),
         (["-o", "{d}/x.stl", "--param", "q=1"], "--param"),
         (["-o", "{d}/x.stl", "--param", "r=abc"], "--param"),
+        (["-o", "{d}/x.stl", "--param", "r=0.1", "--param", "r=0.2"], "given twice"),
         (["-o", "{d}/x.stl", "--report", "{d}/r.txt"], "--report"),
         (["-o", "{d}/x.stl", "--object", "torus"], "--object"),
         (["-o", "{d}/no/such/x.stl"], "-o"),
@@ -91,4 +92,13 @@ def test_bad_options(tmp_path, args, names):
 def test_unbounded_needs_a_clip(tmp_path):
     ran = implgen("mesh", ROOT / "examples/shapes/cone.yaml", "-o", tmp_path / "c.stl")
     assert ran.code == 2 and "--clip" in ran.err and ran.err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_grid_that_misses_the_solid_says_so(tmp_path):
+    """At 4 cells no grid vertex of the torus_z grid lies in the tube (its lines cross it, between vertices): one
+    line naming --cells and the crossings seen, nothing written."""
+    ran = implgen("mesh", TORUS, "-o", tmp_path / "t.stl", "--cells", "4", "--no-singular")
+    assert ran.code == 2 and ran.err.count("\n") == 1 and "--cells 4" in ran.err and "empty" in ran.err
+    assert "grid edges hold crossings" in ran.err and "Traceback" not in ran.err
     assert list(tmp_path.iterdir()) == []

@@ -134,3 +134,21 @@ def check(
                 source,
                 f"{key}: with these params the bounds of shape {name!r} are empty along {axis} (from {lo:g} to {hi:g})",
             )
+
+
+def named_items(option: str, items: Sequence[str], shape: str, params: Mapping[str, float]) -> dict[str, str]:
+    """NAME=TEXT command-line items (`--param a=1`, `--range a=0:2`) naming params of the shape, each at most
+    once: {name: text}. The text is not read here."""
+    out: dict[str, str] = {}
+    for item in items:
+        name, eq, text = item.partition("=")
+        label = f"{option} {item[:60]}"
+        if not eq or not name:
+            raise UserError(label, "expected NAME=VALUE" if option == "--param" else "expected NAME=LOW:HIGH")
+        if name not in params:
+            known = ", ".join(params) or "none"
+            raise UserError(label, f"shape {shape!r} has no param {validate.describe(name)} (params: {known})")
+        if name in out:
+            raise UserError(label, f"{name} is given twice")
+        out[name] = text
+    return out

@@ -18,6 +18,9 @@ from functools import cache
 
 import numpy as np
 
+# corner c's offsets along the three axes (the numbering above)
+CORNER_OFFSETS = np.array([[c & 1, c >> 1 & 1, c >> 2 & 1] for c in range(8)], dtype=np.int64)
+
 
 def other_axes(a: int) -> tuple[int, int]:
     return tuple(b for b in range(3) if b != a)  # type: ignore[return-value]
@@ -99,7 +102,11 @@ def components(key: int) -> tuple[int, ...]:
 
 
 def cell_table(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """For an array of cell keys: (row of each key in the table, table (K, 12) of sheet ids, sheets per key)."""
-    uniq, row = np.unique(keys, return_inverse=True)
-    table = np.array([components(int(k)) for k in uniq], dtype=np.int64).reshape(-1, 12)
+    """For an array of cell keys: (row of each key in the table, table (K, 12) of sheet ids (int8), sheets per
+    key)."""
+    seen = np.zeros(1 << 14, dtype=bool)  # keys are 8 corner bits and 6 face bits: a table, not a sort
+    seen[keys] = True
+    uniq = np.flatnonzero(seen)
+    row = np.cumsum(seen)[keys] - 1
+    table = np.array([components(int(k)) for k in uniq], dtype=np.int8).reshape(-1, 12)
     return row, table, table.max(axis=1) + 1

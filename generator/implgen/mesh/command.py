@@ -16,6 +16,7 @@ import numpy as np
 
 from implgen import validate
 from implgen.args import ArgumentParser
+from implgen.codegen.paramvalues import named_items
 from implgen.errors import UserError
 from implgen.mesh.pipeline import Result, closed_and_euler, mesh_spec, signed_volume, singular_in_solid
 from implgen.mesh.region import parse_clip
@@ -56,13 +57,12 @@ def _parser() -> ArgumentParser:
 
 
 def _params(spec, pairs: Sequence[str]) -> dict[str, float]:
-    out: dict[str, float] = {}
-    for text in pairs:
-        name, eq, value = text.partition("=")
-        if not eq or name not in spec.params:
-            known = ", ".join(spec.params) or "none"
-            raise UserError(f"--param {text}", f"expected NAME=VALUE with NAME a param of the shape ({known})")
-        out[name] = validate.number("--param", name, value.strip(), text_ok=True)
+    """--param NAME=VALUE items: named as `implgen share` names them (codegen.paramvalues.named_items), each a
+    number or a constant's name, then checked against the shape."""
+    out = {
+        k: validate.number("--param", k, v.strip(), text_ok=True)
+        for k, v in named_items("--param", pairs, spec.name, spec.params).items()
+    }
     spec.check_values(out, "--param", "--param")
     return out
 
@@ -123,6 +123,12 @@ def main(argv: Sequence[str]) -> int:
     values.update(_params(spec, args.param))
     result = mesh_spec(spec, values, args.cells, clips, singular=not args.no_singular, what=args.file)
     verts, faces = result.mesh.vertices, result.mesh.faces
+    if not len(faces):
+        hidden = result.mesh.stats["hidden_crossing_edges"]
+        raise UserError(
+            f"--cells {args.cells}",
+            f"no grid vertex lies in the solid, so the mesh is empty ({hidden} grid edges hold crossings): raise it",
+        )
     normals = vertex_normals(result.lib, result.clips, verts)
     if matrix is not None:  # object -> world; normals by the inverse transpose; a mirror turns the faces
         lin = matrix[:, :3]

@@ -11,7 +11,7 @@ import numpy as np
 
 from implgen.mesh import cells
 from implgen.mesh.crossings import Crossings, axis_crossings, grid_flags, inside_flags
-from implgen.mesh.dual import outside_pieces, piece_mask, project, qef_points
+from implgen.mesh.dual import CREASE, DROP, outside_pieces, project
 from implgen.mesh.faces import Quads, triangulate
 from implgen.mesh.region import Clip, Grid
 from implgen.mesh.shapelib import ShapeLib
@@ -28,10 +28,6 @@ class Mesh:
     grid: Grid
     stats: dict = field(default_factory=dict)
     cell: np.ndarray | None = None  # per vertex, the flat index of its cell's lower corner (-1: added by faces.py)
-
-
-def _corner_offsets(strides: np.ndarray) -> np.ndarray:
-    return np.array([((c & 1) * strides[0] + (c >> 1 & 1) * strides[1] + (c >> 2 & 1) * strides[2]) for c in range(8)])
 
 
 def _face_bits(lib, clips, grid: Grid, cell_idx: np.ndarray, config: np.ndarray) -> np.ndarray:
@@ -68,39 +64,29 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     ins = inside.view(np.uint8)
     n0, n1, n2 = grid.n
     config = np.zeros((n0, n1, n2), dtype=np.uint8)
-    for c in range(8):
-        dx, dy, dz = c & 1, c >> 1 & 1, c >> 2 & 1
+    for c, (dx, dy, dz) in enumerate(cells.CORNER_OFFSETS):
         config |= ins[dx : dx + n0, dy : dy + n1, dz : dz + n2] << np.uint8(c)
-    cidx = np.argwhere((config != 0) & (config != 255))
-    conf = config[tuple(cidx.T)].astype(np.int64)
-    cflat = np.ravel_multi_index(tuple(cidx.T), shape)
+    cflat = np.flatnonzero((config != 0) & (config != 255))  # in the cells' own (n0, n1, n2) numbering
+    cidx = np.stack(np.unravel_index(cflat, grid.n), axis=1)
+    conf = config.reshape(-1)[cflat].astype(np.int64)
+    cflat = cidx @ strides  # now the flat index of each cell's lower corner among the grid's vertices
     key = conf | _face_bits(lib, clips, grid, cidx, conf) << 8
     row, table, nsheets = cells.cell_table(key)
-    sheets = table[row]  # (C, 12)
+    sheets = table[row]  # (C, 12) int8: the sheet of each edge in its cell, -1 where not active
     count = nsheets[row]
-    base = np.concatenate([[0], np.cumsum(count)[:-1]])
-    cellvert = np.where(sheets >= 0, base[:, None] + sheets, -1)
+    base = np.cumsum(count) - count  # each cell's first vertex
     nverts = int(count.sum())
 
     clock.append(time.perf_counter())
-    # every sheet's crossings -> QEF point -> onto the surface
-    corner = _corner_offsets(strides)
-    vids, cps, cns, cpieces = [], [], [], []
-    for e in range(12):
-        has = np.nonzero(cellvert[:, e] >= 0)[0]
-        a = e // 4
-        start, _ = cells.edge_corners(e)
-        edge = cflat[has] + corner[start]
-        k = np.searchsorted(cross[a].edges, edge)
-        vids.append(cellvert[has, e])
-        cps.append(cross[a].points[k])
-        cns.append(cross[a].normals[k])
-        cpieces.append(cross[a].piece[k])
-    vid, cp, cn, cpiece = (np.concatenate(x) for x in (vids, cps, cns, cpieces))
-    cell_of_vertex = np.repeat(np.arange(len(cidx)), count)
-    lower = grid.origin + grid.h * cidx[cell_of_vertex]
-    qef = qef_points(vid, cp, cn, nverts, lower, grid.h)
-    mask = piece_mask(vid, cpiece, nverts)
+    # every sheet's crossings -> QEF point (one C loop over the cells) -> onto the surface
+    nv = int(np.prod(shape))
+    keys = np.concatenate([a * nv + c.edges for a, c in enumerate(cross)])
+    cp = np.concatenate([c.points for c in cross])
+    cn = np.concatenate([c.normals for c in cross])
+    cpiece = np.concatenate([c.piece for c in cross])
+    qef, mask, nearest = lib.sheet_points(
+        cflat, sheets, base, strides, nv, keys, cp, cn, cpiece, grid.origin, grid.h, CREASE, DROP, nverts
+    )
     clock.append(time.perf_counter())
     verts, projected = project(lib, clips, qef, mask, grid.h, grid.size)
     extra = outside_pieces(lib, clips, verts, mask, grid.size)
@@ -110,10 +96,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         verts[redo], projected[redo] = project(lib, clips, verts[redo], mask[redo], grid.h, grid.size)
     failed = ~projected
     if failed.any():  # Newton strayed (near a node, a thin neck): the sheet's crossing nearest the QEF point,
-        d = np.linalg.norm(cp - qef[vid], axis=1)  # which lies on the surface exactly
-        order = np.lexsort((d, vid))
-        first = order[np.unique(vid[order], return_index=True)[1]]
-        verts[failed] = cp[first][failed]
+        verts[failed] = cp[nearest[failed]]  # which lies on the surface exactly
 
     clock.append(time.perf_counter())
     # one quad per active edge, from the sheets of its four cells
@@ -128,12 +111,12 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         for q, (db, dc) in enumerate(AROUND):
             r = rowof[edges - db * strides[b] - dc * strides[c]]
             u, v = (db, dc) if lo_ax == b else (dc, db)  # the edge's offsets inside that cell
-            quad[:, q] = cellvert[r, 4 * a + u + 2 * v]
+            quad[:, q] = base[r] + sheets[r, 4 * a + u + 2 * v]
         flip = ~inside.reshape(-1)[edges]  # outside below: the outside is toward -a
         parts.append((quad, np.full(edges.size, a), edges, flip, cross[a].points, cross[a].piece))
     quads = Quads(*(np.concatenate([p[i] for p in parts]) for i in range(6)))
     near_amb = np.repeat(cells.AMBIGUOUS[conf] != 0, count)  # sheets of cells with an ambiguous face
-    verts, faces, split = triangulate(quads, verts, near_amb, inside, grid, lib, clips, AROUND)
+    verts, faces, split = triangulate(quads, verts, near_amb, inside, grid, lib, clips, AROUND, rowof, key)
     clock.append(time.perf_counter())
     phases = ("signs", "crossings", "sheets", "qef", "projection", "faces")
     stats = {
@@ -147,5 +130,5 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         "split_sides": split,
     }
     cell = np.full(len(verts), -1, dtype=np.int64)
-    cell[:nverts] = cflat[cell_of_vertex]
+    cell[:nverts] = np.repeat(cflat, count)
     return Mesh(vertices=verts, faces=faces, grid=grid, stats=stats, cell=cell)

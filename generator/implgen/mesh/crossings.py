@@ -55,6 +55,27 @@ def grid_flags(lib: ShapeLib, clips: list[Clip], grid: Grid) -> tuple[np.ndarray
     return g < 0, g
 
 
+def piece_value_gradient(lib: ShapeLib, clips: list[Clip], j: int, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(value, gradient) at points p of piece j: 0 for f, j >= 1 for clips[j - 1]."""
+    if j == 0:
+        return lib.value_gradient(p)
+    return clips[j - 1].value(p), clips[j - 1].gradient(p)
+
+
+def boundary_value_gradient(lib: ShapeLib, clips: list[Clip], p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """g = max(f, clips) at points p (n, 3), and the gradient of the piece that attains it."""
+    f, g = lib.value_gradient(p)
+    if clips:
+        cv = clip_values(clips, p)
+        top = cv.argmax(axis=0)
+        use = cv.max(axis=0) > f
+        f = np.where(use, cv.max(axis=0), f)
+        for k, c in enumerate(clips):
+            sel = use & (top == k)
+            g[sel] = c.gradient(p[sel])
+    return f, g
+
+
 def unit(v: np.ndarray) -> np.ndarray:
     n = np.linalg.norm(v, axis=-1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -62,14 +83,16 @@ def unit(v: np.ndarray) -> np.ndarray:
     return u
 
 
-def _candidates(lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, starts: np.ndarray):
+def line_points(lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, starts: np.ndarray):
     """Every boundary point of the solid on the lines along `axis` starting at `starts` (L, 3): (line, t,
-    piece), t measured from the line's start."""
+    piece), t measured from the line's start, in order of line and, without clips, of t along it."""
     length = grid.n[axis] * grid.h
     d = np.zeros(3)
     d[axis] = 1.0
     roots, counts = lib.roots(starts, d, 0.0, length)
     lines, cols = np.nonzero(np.arange(roots.shape[1])[None, :] < counts[:, None])
+    if not clips:
+        return lines, roots[lines, cols], np.zeros(lines.size, dtype=np.int32)
     ts = [roots[lines, cols]]
     ls = [lines]
     pieces = [np.zeros(lines.size, dtype=np.int32)]
@@ -84,20 +107,19 @@ def _candidates(lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, starts:
     line = np.concatenate(ls)
     t = np.concatenate(ts)
     piece = np.concatenate(pieces)
-    p = starts[line].copy()
-    p[:, axis] += t
     # the piece bounds the solid there only where every other piece is <= 0
-    fvals, fgrad = lib.value_gradient(p)
-    cvals = clip_values(clips, p)
-    others = np.where(piece == 0, -np.inf, fvals)
-    for k in range(len(clips)):
-        others = np.maximum(others, np.where(piece == k + 1, -np.inf, cvals[k]))
-    keep = others <= 0
-    normals = fgrad.copy()
+    others = np.full(len(t), -np.inf)
+    on_clip = np.flatnonzero(piece != 0)
+    p = starts[line[on_clip]]
+    p[:, axis] += t[on_clip]
+    others[on_clip] = lib.value(p)
     for k, c in enumerate(clips):
-        sel = piece == k + 1
-        normals[sel] = c.gradient(p[sel])
-    return line[keep], t[keep], piece[keep], p[keep], unit(normals[keep])
+        others = np.maximum(others, np.where(piece == k + 1, -np.inf, c.along(axis, starts, line, t)))
+    keep = others <= 0
+    if not keep[lines.size :].any():  # no clip bounds the solid on these lines: f's roots, already in order
+        return lines[keep[: lines.size]], t[: lines.size][keep[: lines.size]], piece[: lines.size][keep[: lines.size]]
+    order = np.lexsort((t[keep], line[keep]))
+    return line[keep][order], t[keep][order], piece[keep][order]
 
 
 def axis_crossings(
@@ -114,24 +136,25 @@ def axis_crossings(
     base_idx = np.indices(tuple(1 if a == axis else s for a, s in enumerate(shape))).reshape(3, -1)
     base = np.ravel_multi_index(tuple(base_idx), shape)
     starts = grid.point(base)
-    line, t, piece, p, nrm = _candidates(lib, clips, grid, axis, starts)
+    line, t, piece = line_points(lib, clips, grid, axis, starts)
     step = np.clip(np.floor(t / grid.h).astype(np.int64), 0, shape[axis] - 2)
     key = base[line] + step * strides[axis]
     at = np.minimum(np.searchsorted(active, key), max(active.size - 1, 0))
     on = (active[at] == key) if active.size else np.zeros(key.size, dtype=bool)
-    hidden = int(np.unique(key[~on]).size)
-    key, t, piece, p, nrm = key[on], t[on], piece[on], p[on], nrm[on]
-    order = np.lexsort((t, key))
-    key, piece, p, nrm = key[order], piece[order], p[order], nrm[order]
-    uniq, first, count = np.unique(key, return_index=True, return_counts=True)
-    pick = first + count // 2
+    # in order of line and t, one edge's points are consecutive: runs of one key
+    run = np.flatnonzero(np.concatenate([[True], key[1:] != key[:-1]])) if key.size else np.zeros(0, dtype=np.int64)
+    count = np.diff(np.append(run, key.size))
+    hidden = int((~on[run]).sum())  # edges whose ends agree but that hold points
+    run, count = run[on[run]], count[on[run]]
+    pick = run + count // 2  # an edge with several points: the middle one
+    slot = at[run]
+    found = np.zeros(active.size, dtype=bool)
+    found[slot] = True
     points = np.empty((active.size, 3))
-    normals = np.zeros((active.size, 3))
     pieces = np.zeros(active.size, dtype=np.int32)
-    pos = np.searchsorted(uniq, active)
-    found = (pos < uniq.size) & (uniq[np.minimum(pos, uniq.size - 1)] == active)
-    src = pick[pos[found]]
-    points[found], normals[found], pieces[found] = p[src], nrm[src], piece[src]
+    points[slot] = starts[line[pick]]
+    points[slot, axis] += t[pick]
+    pieces[slot] = piece[pick]
     miss = np.nonzero(~found)[0]
     if miss.size:  # an end within rounding of the surface: the end nearer it
         lo_v = active[miss]
@@ -139,6 +162,10 @@ def axis_crossings(
         gf = g.reshape(-1)
         end = np.where(np.abs(gf[lo_v]) <= np.abs(gf[hi_v]), lo_v, hi_v)
         points[miss] = grid.point(end)
-        _, grad = lib.value_gradient(points[miss])
-        normals[miss] = unit(grad)
-    return Crossings(edges=active, points=points, normals=normals, piece=pieces, fallback=int(miss.size), hidden=hidden)
+    _, grad = lib.value_gradient(points)  # then the clips' own where they bound the solid
+    for j in np.unique(pieces[pieces != 0]):
+        sel = np.flatnonzero(pieces == j)
+        grad[sel] = piece_value_gradient(lib, clips, int(j), points[sel])[1]
+    return Crossings(
+        edges=active, points=points, normals=unit(grad), piece=pieces, fallback=int(miss.size), hidden=hidden
+    )

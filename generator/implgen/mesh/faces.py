@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from implgen.mesh.crossings import inside_flags
 from implgen.mesh.dual import piece_mask, project
 from implgen.mesh.region import Clip, Grid
 from implgen.mesh.shapelib import ShapeLib
@@ -38,16 +37,6 @@ class Quads:
 SIDE_NORMAL = (1, 2, 1, 2)
 
 
-def _simple(q: np.ndarray, verts: np.ndarray, flip: np.ndarray) -> np.ndarray:
-    q = np.where(flip[:, None], q[:, ::-1], q)
-    d02 = np.linalg.norm(verts[q[:, 0]] - verts[q[:, 2]], axis=1)
-    d13 = np.linalg.norm(verts[q[:, 1]] - verts[q[:, 3]], axis=1)
-    alt = (d13 < d02)[:, None]
-    t1 = np.where(alt, q[:, [1, 2, 3]], q[:, [0, 1, 2]])
-    t2 = np.where(alt, q[:, [1, 3, 0]], q[:, [0, 2, 3]])
-    return np.concatenate([t1, t2])
-
-
 def triangulate(
     quads: Quads,
     verts: np.ndarray,
@@ -57,41 +46,43 @@ def triangulate(
     lib: ShapeLib,
     clips: list[Clip],
     around,
+    rowof: np.ndarray,
+    cell_key: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """(vertices with any added, triangles, how many quad sides were split). near_amb: per vertex, whether its
-    cell has an ambiguous face (only a quad with all its sides' cells so can hold a doubled side)."""
+    cell has an ambiguous face (only a quad with all its sides' cells so can hold a doubled side); rowof: the
+    row of each cell (by the flat index of its lower corner) in cell_key, the cells' keys (cells.components)."""
     q = quads.verts
     dup = np.zeros((len(q), 4), dtype=bool)
-    sides = np.stack([np.sort(np.stack([q[:, k], q[:, (k + 1) % 4]], axis=1), axis=1) for k in range(4)], axis=1)
     cand = np.nonzero(near_amb[q].any(axis=1))[0]
-    if cand.size:
-        key = sides[cand, :, 0] * len(verts) + sides[cand, :, 1]
-        _, inv, cnt = np.unique(key.reshape(-1), return_inverse=True, return_counts=True)
-        dup[cand] = (cnt[inv.reshape(-1)] > 2).reshape(-1, 4)
+    if cand.size == 0:
+        return verts, lib.split_quads(q, quads.flip, verts), 0
+    qc = q[cand]
+    sides = np.sort(np.stack([qc, np.roll(qc, -1, axis=1)], axis=2), axis=2)  # (cand, 4, 2): side k's two ends
+    key = sides[:, :, 0] * len(verts) + sides[:, :, 1]
+    _, inv, cnt = np.unique(key.reshape(-1), return_inverse=True, return_counts=True)
+    dup[cand] = (cnt[inv.reshape(-1)] > 2).reshape(-1, 4)
     hit = dup.any(axis=1)
     if not hit.any():
-        return verts, _simple(q, verts, quads.flip), 0
+        return verts, lib.split_quads(q, quads.flip, verts), 0
     shape = inside.shape
     qi, ks = np.nonzero(dup)
     a = quads.axis[qi]
     normal = (a + np.array(SIDE_NORMAL)[ks]) % 3
-    third = 3 - a - normal
-    e_idx = np.stack(np.unravel_index(quads.edge[qi], shape), axis=1)
-    # the face between the two cells of this side: its centre, computed from global indices
+    # the face between the two cells of this side is ambiguous: whether its centre is inside is bit 8 + f of
+    # the key of the cell AROUND[k] (contour._face_bits), f its face there: across `normal`, on the edge's side
     around = np.array(around)
     off_b, off_c = around[ks, 0], around[ks, 1]
-    b_axis = (a + 1) % 3
-    d_third = np.where(third == b_axis, off_b, off_c)
-    centre = e_idx.astype(np.float64)
-    rows = np.arange(len(qi))
-    centre[rows, a] += 0.5
-    centre[rows, third] += 0.5 - d_third
-    c_in, _ = inside_flags(lib, clips, grid.origin + grid.h * centre)
+    b_axis, c_axis = (a + 1) % 3, (a + 2) % 3
+    strides = np.array([shape[1] * shape[2], shape[2], 1])
+    cell = quads.edge[qi] - off_b * strides[b_axis] - off_c * strides[c_axis]
+    face = 2 * normal + np.where(normal == b_axis, off_b, off_c)
+    c_in = ((cell_key[rowof[cell]] >> (8 + face)) & 1).astype(bool)
     # the corner the side's curve cuts off: the edge's end whose flag differs from the centre's
     lo_in = inside.reshape(-1)[quads.edge[qi]]
-    strides = np.array([shape[1] * shape[2], shape[2], 1])
     corner = np.where(lo_in != c_in, quads.edge[qi], quads.edge[qi] + strides[a])
-    key = np.stack([sides[qi, ks, 0], sides[qi, ks, 1], corner, normal], axis=1)
+    side = sides[np.searchsorted(cand, qi), ks]
+    key = np.stack([side[:, 0], side[:, 1], corner, normal], axis=1)
     ukey, mid_of = np.unique(key, axis=0, return_inverse=True)
     mid_of = mid_of.reshape(-1)
     nmid = len(ukey)
@@ -116,5 +107,5 @@ def triangulate(
             tris.append(t[::-1] if quads.flip[qn] else t)
     out_verts = np.concatenate([verts, mids, quads.point[fan]])
     keep = ~hit
-    faces = np.concatenate([_simple(q[keep], verts, quads.flip[keep]), np.array(tris, dtype=np.int64)])
+    faces = np.concatenate([lib.split_quads(q[keep], quads.flip[keep], verts), np.array(tris, dtype=np.int64)])
     return out_verts, faces, nmid

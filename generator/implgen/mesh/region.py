@@ -45,6 +45,12 @@ class Sphere:
         r = np.sqrt(np.where(disc > 0, disc, np.nan))
         return np.stack([-r, r], axis=1)
 
+    def along(self, axis: int, starts: np.ndarray, line: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """The value at starts[line] + t along `axis` (points on grid lines)."""
+        p = starts[line].copy()
+        p[:, axis] += t
+        return self.value(p)
+
     def box(self) -> tuple[np.ndarray, np.ndarray]:
         return np.full(3, -self.radius), np.full(3, self.radius)
 
@@ -68,6 +74,12 @@ class HalfSpace:
         g = np.zeros(p.shape)
         g[..., self.axis] = self.sign
         return g
+
+    def along(self, axis: int, starts: np.ndarray, line: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """The value at starts[line] + t along `axis`: constant on a line across the plane's axis."""
+        if axis == self.axis:
+            return self.sign * ((starts[line, axis] + t) - self.at)
+        return (self.sign * (starts[:, self.axis] - self.at))[line]
 
     def crossings(self, axis: int, others: np.ndarray) -> np.ndarray:
         if axis != self.axis:

@@ -20,6 +20,7 @@ AUTO = abi.value("IG_ROOTS_AUTO")
 _DP = ctypes.POINTER(ctypes.c_double)
 _IP = ctypes.POINTER(ctypes.c_int)
 _VP = ctypes.c_void_p
+_LONG = np.dtype(f"i{ctypes.sizeof(ctypes.c_long)}")  # C's long, as NumPy holds it
 
 
 def _ptr(a: np.ndarray):
@@ -40,6 +41,15 @@ class ShapeLib:
         lib.ig_shape_eval_many.argtypes = [_VP, _DP, ctypes.c_long, _DP, _DP, _DP]
         lib.ig_shape_values_grid.restype = None
         lib.ig_shape_values_grid.argtypes = [_VP, _DP, _DP, ctypes.c_long, _DP, ctypes.c_long, _DP, ctypes.c_long, _DP]
+        lib.ig_shape_project_many.restype = None
+        lib.ig_shape_project_many.argtypes = [_VP, _DP, ctypes.c_long, _DP, ctypes.c_int, ctypes.c_double,
+                                              ctypes.c_double, ctypes.c_double, _VP]  # fmt: skip
+        lib.ig_mesh_sheet_points.restype = None
+        lib.ig_mesh_sheet_points.argtypes = [ctypes.c_long, _VP, _VP, _VP, _VP, ctypes.c_long, ctypes.c_long, _VP,
+                                             _DP, _DP, _VP, _DP, ctypes.c_double, ctypes.c_double, ctypes.c_double,
+                                             ctypes.c_long, _DP, _VP, _VP]  # fmt: skip
+        lib.ig_mesh_split_quads.restype = None
+        lib.ig_mesh_split_quads.argtypes = [ctypes.c_long, _VP, _VP, _DP, _VP]
         self._lib = lib
         self._shape = lib.rt_scene_shape(0)
         self._params = np.ascontiguousarray(np.asarray(list(params) or [0.0], dtype=np.float64))
@@ -84,3 +94,52 @@ class ShapeLib:
             self._shape, _ptr(self._params), _ptr(x), x.size, _ptr(y), y.size, _ptr(z), z.size, _ptr(f)
         )
         return f
+
+    def project(
+        self, p: np.ndarray, steps: int, tol: float, noise: float, reach: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Each point moved onto f = 0 by at most `steps` Newton steps of least norm: (points, converged flags);
+        converged: a step at most `tol`, or at most `noise` and no longer halving (f's rounding), or a last step
+        at most `noise`, and moved at most `reach` along each axis (ig_shape_project_many)."""
+        out = np.array(p, dtype=np.float64, order="C").reshape(-1, 3)
+        ok = np.zeros(len(out), dtype=np.uint8)
+        self._lib.ig_shape_project_many(
+            self._shape, _ptr(self._params), len(out), _ptr(out), steps, tol, noise, reach, ok.ctypes.data
+        )
+        return out, ok.astype(bool)
+
+    def sheet_points(self, corner, sheets, first, strides, nvertices: int, keys, points, normals, piece, origin,
+                     h: float, crease: float, drop: float, nverts: int):  # fmt: skip
+        """The dual vertex of every sheet of every active cell (ig_mesh_sheet_points, runtime_c/shape_batch.h):
+        (points (nverts, 3), piece masks, index of the nearest crossing). Not f's: the shape's library holds it."""
+
+        def longs(a):
+            return np.ascontiguousarray(a, dtype=_LONG)
+
+        corner, first, strides, keys = longs(corner), longs(first), longs(strides), longs(keys)
+        sheets = np.ascontiguousarray(sheets, dtype=np.int8)
+        points, normals, origin = (np.ascontiguousarray(a, dtype=np.float64) for a in (points, normals, origin))
+        piece = np.ascontiguousarray(piece, dtype=np.intc)
+        if not (len(sheets) == len(corner) == len(first) and len(keys) == len(points) == len(normals) == len(piece)):
+            raise ValueError("sheet_points: array lengths disagree")
+        out = np.zeros((nverts, 3))
+        mask = np.zeros(nverts, dtype=_LONG)
+        nearest = np.full(nverts, -1, dtype=_LONG)
+        self._lib.ig_mesh_sheet_points(
+            len(corner), corner.ctypes.data, sheets.ctypes.data, first.ctypes.data, strides.ctypes.data, nvertices,
+            len(keys), keys.ctypes.data, _ptr(points), _ptr(normals), piece.ctypes.data, _ptr(origin), h, crease,
+            drop, nverts, _ptr(out), mask.ctypes.data, nearest.ctypes.data,
+        )  # fmt: skip
+        return out, mask.astype(np.int64), nearest.astype(np.int64)
+
+    def split_quads(self, quads: np.ndarray, flip: np.ndarray, verts: np.ndarray) -> np.ndarray:
+        """Quads (m, 4) into triangles (2 m, 3) on their shorter diagonals, reversed where flip
+        (ig_mesh_split_quads)."""
+        quads = np.ascontiguousarray(quads, dtype=_LONG).reshape(-1, 4)
+        flip = np.ascontiguousarray(flip, dtype=np.uint8)
+        verts = np.ascontiguousarray(verts, dtype=np.float64)
+        if len(flip) != len(quads) or (quads.size and not 0 <= quads.min() <= quads.max() < len(verts)):
+            raise ValueError("split_quads: quads and flags disagree, or a vertex id is out of range")
+        tris = np.empty((2 * len(quads), 3), dtype=_LONG)
+        self._lib.ig_mesh_split_quads(len(quads), quads.ctypes.data, flip.ctypes.data, _ptr(verts), tris.ctypes.data)
+        return tris.astype(np.int64, copy=False)

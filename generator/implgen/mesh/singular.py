@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from implgen.mesh.cells import CORNER_OFFSETS
 from implgen.mesh.shapelib import ShapeLib
 
 START = 16  # cells along the longest side at the first level
@@ -53,8 +54,8 @@ def _keep(vals: np.ndarray, widen: float, h: float) -> np.ndarray:
 def _corners(lib: ShapeLib, lo: np.ndarray, h: float) -> np.ndarray:
     """f and grad f at the 8 corners and the centre of each cell: (9, cells, 4). The centre catches a component
     that touches zero without changing sign midway between corners where it is equal (a cusp's)."""
-    offs = [[c & 1, c >> 1 & 1, c >> 2 & 1] for c in range(8)] + [[0.5, 0.5, 0.5]]
-    p = lo[None, :, :] + (np.array(offs, dtype=np.float64) * h)[:, None, :]  # (9, cells, 3): sample first
+    offs = np.concatenate([CORNER_OFFSETS, [[0.5, 0.5, 0.5]]])
+    p = lo[None, :, :] + (offs * h)[:, None, :]  # (9, cells, 3): sample first
     f, g = lib.value_gradient(p)
     return np.concatenate([f[..., None], g], axis=-1)
 

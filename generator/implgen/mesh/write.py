@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from implgen.mesh.crossings import clip_values, unit
+from implgen.mesh.crossings import boundary_value_gradient, unit
 from implgen.mesh.region import Clip
 from implgen.mesh.shapelib import ShapeLib
 from implgen.outputs import atomic_write
@@ -18,14 +18,7 @@ FORMATS = {".stl": "stl", ".obj": "obj", ".ply": "ply", ".glb": "glb"}
 
 def vertex_normals(lib: ShapeLib, clips: list[Clip], verts: np.ndarray) -> np.ndarray:
     """Unit normals toward f > 0 (zero where the bounding piece's gradient vanishes)."""
-    f, g = lib.value_gradient(verts)
-    if clips:
-        cv = clip_values(clips, verts)
-        top = cv.argmax(axis=0)
-        use_clip = cv.max(axis=0) > f
-        for k, c in enumerate(clips):
-            sel = use_clip & (top == k)
-            g[sel] = c.gradient(verts[sel])
+    _, g = boundary_value_gradient(lib, clips, verts)
     return unit(g)
 
 
@@ -34,9 +27,10 @@ def to_trimesh(verts: np.ndarray, faces: np.ndarray, normals: np.ndarray | None 
 
     mesh = trimesh.Trimesh(vertices=verts, faces=faces, process=False, validate=False)
     if normals is not None:
-        fallback = np.asarray(mesh.vertex_normals)  # area-weighted face normals
         bad = np.linalg.norm(normals, axis=1) == 0
-        mesh.vertex_normals = np.where(bad[:, None], fallback, normals)
+        if bad.any():  # the faces' area-weighted normals there (trimesh computes them for the whole mesh)
+            normals = np.where(bad[:, None], np.asarray(mesh.vertex_normals), normals)
+        mesh.vertex_normals = normals
     return mesh
 
 

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from implgen import validate
 from implgen.args import ArgumentParser
+from implgen.codegen.paramvalues import named_items
 from implgen.codegen.spec import parse_spec
 from implgen.codegen.specmodel import Spec
 from implgen.errors import UserError
@@ -37,20 +38,7 @@ EXAMPLES = (
 
 
 def _pairs(option: str, items: list[str], spec: Spec) -> dict[str, str]:
-    """NAME=TEXT items naming the spec's params, each at most once."""
-    out: dict[str, str] = {}
-    for item in items:
-        name, eq, text = item.partition("=")
-        label = f"{option} {item[:60]}"
-        if not eq or not name:
-            raise UserError(label, "expected NAME=VALUE" if option == "--param" else "expected NAME=LOW:HIGH")
-        if name not in spec.params:
-            known = ", ".join(spec.params) or "none"
-            raise UserError(label, f"shape {spec.name!r} has no param {validate.describe(name)} (params: {known})")
-        if name in out:
-            raise UserError(label, f"{name} is given twice")
-        out[name] = text
-    return out
+    return named_items(option, items, spec.name, spec.params)
 
 
 def _num(label: str, text: str) -> float:
