@@ -1,6 +1,8 @@
 """One shape compiled with the runtime (compile/library.py, cached), and its batch entry points
 (runtime_c/shape_batch.c) bound with ctypes: every root of f along many rays at once, and f with its gradient
-at many points at once. Each call is one C loop; Python never loops per ray or per point."""
+at many points at once. Each call is one C loop; Python never loops per ray or per point. With a `budget`
+(budget.py) the C loop runs in slices (ROWS rays, POINTS points, a slab of about POINTS grid vertices) and the
+budget is checked before each: a mesh stops within one slice of its deadline, or of its stop."""
 
 from __future__ import annotations
 
@@ -13,6 +15,7 @@ from implgen import abi
 from implgen.codegen.specmodel import Spec
 from implgen.compile import clib
 from implgen.compile.library import ShapeEntry, build_library
+from implgen.mesh.budget import Budget
 
 MAX_DEGREE = abi.value("IG_MAX_DEGREE")
 AUTO = abi.value("IG_ROOTS_AUTO")
@@ -20,6 +23,8 @@ AUTO = abi.value("IG_ROOTS_AUTO")
 _DP = ctypes.POINTER(ctypes.c_double)
 _IP = ctypes.POINTER(ctypes.c_int)
 _VP = ctypes.c_void_p
+ROWS = 4096  # rays a slice (a degree-20 line costs about 20 us: 0.1 s)
+POINTS = 1 << 18  # points, or grid vertices, a slice
 
 
 def _ptr(a: np.ndarray):
@@ -43,6 +48,17 @@ class ShapeLib:
         self._lib = lib
         self._shape = lib.rt_scene_shape(0)
         self._params = np.ascontiguousarray(np.asarray(list(params) or [0.0], dtype=np.float64))
+        self.budget: Budget | None = None  # checked before each slice of a batch call
+
+    def _slices(self, n: int, size: int):
+        """[(start, stop)] covering range(n): one slice without a budget, else slices of `size`, the budget
+        checked before each."""
+        if self.budget is None:
+            yield 0, n
+            return
+        for start in range(0, n, max(1, size)):
+            self.budget.check()
+            yield start, min(n, start + size)
 
     def roots(self, o: np.ndarray, d: np.ndarray, tmin: np.ndarray, tmax: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """All distinct roots in [tmin, tmax] of each ray o + t d: (roots (n, IG_MAX_DEGREE), NaN past each
@@ -54,10 +70,11 @@ class ShapeLib:
         t1 = np.ascontiguousarray(np.broadcast_to(np.asarray(tmax, dtype=np.float64), (n,)))
         out = np.full((n, MAX_DEGREE), np.nan)
         counts = np.zeros(n, dtype=np.intc)
-        self._lib.ig_shape_roots_many(
-            self._shape, _ptr(self._params), n, _ptr(o), _ptr(d), _ptr(t0), _ptr(t1), AUTO, _ptr(out),
-            counts.ctypes.data_as(_IP),
-        )  # fmt: skip
+        for a, b in self._slices(n, ROWS):  # rows of C-ordered arrays: each slice is contiguous
+            self._lib.ig_shape_roots_many(
+                self._shape, _ptr(self._params), b - a, _ptr(o[a:b]), _ptr(d[a:b]), _ptr(t0[a:b]), _ptr(t1[a:b]),
+                AUTO, _ptr(out[a:b]), counts[a:b].ctypes.data_as(_IP),
+            )  # fmt: skip
         out[np.arange(MAX_DEGREE)[None, :] >= counts[:, None]] = np.nan
         return out, counts
 
@@ -65,7 +82,9 @@ class ShapeLib:
         """f at each point (p: (..., 3)), shape p.shape[:-1]."""
         p = np.ascontiguousarray(p, dtype=np.float64)
         f = np.empty(p.shape[:-1])
-        self._lib.ig_shape_eval_many(self._shape, _ptr(self._params), f.size, _ptr(p), _ptr(f), None)
+        pf, ff = p.reshape(-1, 3), f.reshape(-1)
+        for a, b in self._slices(ff.size, POINTS):
+            self._lib.ig_shape_eval_many(self._shape, _ptr(self._params), b - a, _ptr(pf[a:b]), _ptr(ff[a:b]), None)
         return f
 
     def value_gradient(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -73,14 +92,19 @@ class ShapeLib:
         p = np.ascontiguousarray(p, dtype=np.float64)
         f = np.empty(p.shape[:-1])
         g = np.empty(p.shape)
-        self._lib.ig_shape_eval_many(self._shape, _ptr(self._params), f.size, _ptr(p), _ptr(f), _ptr(g))
+        pf, ff, gf = p.reshape(-1, 3), f.reshape(-1), g.reshape(-1, 3)
+        for a, b in self._slices(ff.size, POINTS):
+            self._lib.ig_shape_eval_many(
+                self._shape, _ptr(self._params), b - a, _ptr(pf[a:b]), _ptr(ff[a:b]), _ptr(gf[a:b])
+            )
         return f, g
 
     def values_grid(self, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
         """f at every (x[i], y[j], z[k]), shape (len(x), len(y), len(z))."""
         x, y, z = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, y, z))
         f = np.empty((x.size, y.size, z.size))
-        self._lib.ig_shape_values_grid(
-            self._shape, _ptr(self._params), _ptr(x), x.size, _ptr(y), y.size, _ptr(z), z.size, _ptr(f)
-        )
+        for a, b in self._slices(x.size, POINTS // max(1, y.size * z.size)):  # slabs of x: contiguous in f
+            self._lib.ig_shape_values_grid(
+                self._shape, _ptr(self._params), _ptr(x[a:b]), b - a, _ptr(y), y.size, _ptr(z), z.size, _ptr(f[a:b])
+            )
         return f
