@@ -28,8 +28,10 @@ from implgen.errors import UserError
 from implgen.mesh.region import Clip, Grid, HalfSpace, Sphere, make_grid
 
 MIN_CELLS, MAX_CELLS = 4, 256
-GRID_BYTES = 64  # a grid vertex (measured at most 40: bench/results/mesh_memory.md)
-EDGE_BYTES = 1800  # an active edge, the STL included (measured at most 1500: bench/results/mesh_memory.md)
+# fitted over 18 runs by bench/mesh_memory.py: 19 bytes a grid vertex and 1244 an active edge; with these, every
+# run's peak is at most 0.91 of GRID_BYTES V + EDGE_BYTES E (bench/results/mesh_memory.md)
+GRID_BYTES = 40
+EDGE_BYTES = 1400
 
 
 class OverBudget(UserError):

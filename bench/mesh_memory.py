@@ -1,0 +1,113 @@
+"""The memory of a mesh as the viewer's Save mesh makes it (mesh pipeline without the singular search, vertex
+normals, binary STL bytes) against the upper estimate the viewer reserves before it starts (mesh/budget.py).
+
+    nice .venv/bin/python bench/mesh_memory.py [--cells 32 64 128] [-o bench/results/mesh_memory.md]
+
+Per surface and grid: the grid's vertices V, its active edges E (known only once meshed), the bound on E the
+estimate uses (lines x crossings per line), the peak of NumPy's memory traced by tracemalloc, and the estimate.
+Then the least-squares fit peak = a V + b E over every run: what a grid vertex and an active edge cost, which
+budget.GRID_BYTES and budget.EDGE_BYTES must exceed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+
+from implgen.bench.machine import describe as machine
+from implgen.bench.machine import load_average, write_results
+from implgen.codegen.speccache import load_spec
+from implgen.mesh import budget
+from implgen.mesh.pipeline import mesh_spec
+from implgen.mesh.region import make_grid, parse_clip
+from implgen.mesh.write import mesh_bytes, vertex_normals
+
+ROOT = Path(__file__).resolve().parents[1]
+SURFACES = (
+    ("torus", "examples/shapes/torus_z.yaml", None),
+    ("heart", "examples/shapes/heart.yaml", None),
+    ("Barth sextic in a ball of 1.8", "examples/shapes/barth6.yaml", "sphere:1.8"),
+    ("Chmutov 8", "examples/shapes/chmutov8.yaml", None),
+    ("tanglecube", "examples/mesh/tanglecube.yaml", None),
+    ("Chmutov 20", "examples/mesh/chmutov20.yaml", None),
+)
+
+
+def measure(spec, clips: list, cells: int) -> tuple[int, int, int, int, float]:
+    """(V, E, bound on E, peak bytes, seconds) of one Save-mesh-like run."""
+    tracemalloc.start()
+    t0 = time.perf_counter()
+    result = mesh_spec(spec, {}, cells, clips, singular=False)
+    normals = vertex_normals(result.lib, result.clips, result.mesh.vertices)
+    mesh_bytes("stl", result.mesh.vertices, result.mesh.faces, normals)
+    seconds = time.perf_counter() - t0
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    grid, all_clips = make_grid(spec.box({}), clips, cells, "bench")
+    n = grid.n
+    verts = (n[0] + 1) * (n[1] + 1) * (n[2] + 1)
+    bound = (budget.grid_bytes(grid, all_clips, spec.degree) - budget.GRID_BYTES * verts) // budget.EDGE_BYTES
+    return verts, result.mesh.stats["active_edges"], bound, peak, seconds
+
+
+def main(argv: list[str]) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--cells", type=int, nargs="+", default=[32, 64, 128])
+    ap.add_argument("-o", "--output", default=str(ROOT / "bench" / "results" / "mesh_memory.md"))
+    args = ap.parse_args(argv)
+    rows, runs, ratios = [], [], []
+    for label, path, clip in SURFACES:
+        spec = load_spec(ROOT / path)
+        clips = parse_clip(clip) if clip else []
+        measure(spec, clips, 8)  # the library built, trimesh imported, the caches filled: not measured
+        for cells in args.cells:
+            verts, edges, bound, peak, seconds = measure(spec, clips, cells)
+            est = budget.estimate_bytes(spec.box({}), spec.degree, clips, cells, "bench")
+            runs.append((verts, edges, peak))
+            ratios.append(est / peak)
+            row = (
+                f"| {label} | {cells} | {verts} | {edges} | {bound} | {peak / 2**20:.1f} | {est / 2**20:.1f} | "
+                f"{peak / est:.2f} | {seconds:.2f} |"
+            )
+            print(row, flush=True)
+            rows.append(row)
+    a = np.array([[v, e] for v, e, _ in runs], dtype=np.float64)
+    y = np.array([p for _, _, p in runs], dtype=np.float64)
+    (per_vertex, per_edge), *_ = np.linalg.lstsq(a, y, rcond=None)
+    worst = max(p / (budget.GRID_BYTES * v + budget.EDGE_BYTES * e) for v, e, p in runs)
+    fit = (
+        f"Fit over the {len(runs)} runs: peak = {per_vertex:.1f} bytes a grid vertex + {per_edge:.0f} bytes an active "
+        f"edge. budget.GRID_BYTES = {budget.GRID_BYTES}, budget.EDGE_BYTES = {budget.EDGE_BYTES}: the largest peak "
+        f"over (GRID_BYTES V + EDGE_BYTES E) with the true E is {worst:.2f}; the estimate (with the bound on E) "
+        f"is {min(ratios):.2f} to {max(ratios):.1f} times the peak."
+    )
+    print(fit)
+    text = "\n".join(
+        [
+            "# Save mesh: memory against the estimate",
+            "",
+            f"Machine: {machine()}; load average {load_average()}.",
+            f"Written by `bench/mesh_memory.py --cells {' '.join(map(str, args.cells))}`: each run is the mesh "
+            "pipeline without the singular search, the vertex normals and the binary STL's bytes, as the viewer's "
+            "Save mesh makes them; its peak is NumPy's memory as tracemalloc traces it.",
+            "",
+            "| surface | cells | grid vertices V | active edges E | bound on E | peak MB | estimate MB "
+            "| peak / estimate | seconds |",
+            "|---|---|---|---|---|---|---|---|---|",
+            *rows,
+            "",
+            fit,
+            "",
+        ]
+    )
+    write_results(Path(args.output), text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
