@@ -7,7 +7,7 @@ and looks at the budget between them, so a mesh stops within one slice of its de
 raises `OverBudget`, a UserError in one line ("mesh: over its time budget of 2 s at 192 cells ...; try fewer
 cells"); a stopped one raises `Stopped`.
 
-The memory estimate bounds the pipeline's peak (NumPy's arrays, traced by tracemalloc; bench/mesh_memory.py
+The memory estimate bounds the pipeline's peak (NumPy's arrays, traced by tracemalloc; bench/mesh_budget.py
 measures it) by two terms:
   - per grid vertex, the values of f and the clips, the sign flags, the cell configurations and the cell rows:
     GRID_BYTES;
@@ -28,8 +28,8 @@ from implgen.errors import UserError
 from implgen.mesh.region import Clip, Grid, HalfSpace, Sphere, make_grid
 
 MIN_CELLS, MAX_CELLS = 4, 256
-# fitted over 18 runs by bench/mesh_memory.py: 19 bytes a grid vertex and 1244 an active edge; with these, every
-# run's peak is at most 0.91 of GRID_BYTES V + EDGE_BYTES E (bench/results/mesh_memory.md)
+# fitted over 18 runs by bench/mesh_budget.py: 19 bytes a grid vertex and 1244 an active edge; with these, every
+# run's peak is at most 0.91 of GRID_BYTES V + EDGE_BYTES E (bench/results/mesh_budget.md)
 GRID_BYTES = 40
 EDGE_BYTES = 1400
 

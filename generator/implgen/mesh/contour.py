@@ -63,6 +63,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         raise AssertionError("the grid's outer layer must lie outside every clip")
     cross: list[Crossings] = [axis_crossings(lib, clips, grid, a, inside, g) for a in range(3)]
     clock.append(time.perf_counter())
+    lib.check()  # the budget, between phases (budget.py)
 
     # cells: corner flags -> config; active ones get their sheets
     ins = inside.view(np.uint8)
@@ -83,6 +84,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     nverts = int(count.sum())
 
     clock.append(time.perf_counter())
+    lib.check()  # the budget, between phases (budget.py)
     # every sheet's crossings -> QEF point -> onto the surface
     corner = _corner_offsets(strides)
     vids, cps, cns, cpieces = [], [], [], []
@@ -102,6 +104,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     qef = qef_points(vid, cp, cn, nverts, lower, grid.h)
     mask = piece_mask(vid, cpiece, nverts)
     clock.append(time.perf_counter())
+    lib.check()  # the budget, between phases (budget.py)
     verts, projected = project(lib, clips, qef, mask, grid.h, grid.size)
     extra = outside_pieces(lib, clips, verts, mask, grid.size)
     if extra.any():  # on one piece but outside another (a cap vertex past the rim): onto both
@@ -116,6 +119,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         verts[failed] = cp[first][failed]
 
     clock.append(time.perf_counter())
+    lib.check()  # the budget, between phases (budget.py)
     # one quad per active edge, from the sheets of its four cells
     rowof = np.full(int(np.prod(shape)), -1, dtype=np.int64)
     rowof[cflat] = np.arange(len(cflat))

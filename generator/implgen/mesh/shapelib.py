@@ -50,6 +50,11 @@ class ShapeLib:
         self._params = np.ascontiguousarray(np.asarray(list(params) or [0.0], dtype=np.float64))
         self.budget: Budget | None = None  # checked before each slice of a batch call
 
+    def check(self) -> None:
+        """The budget's check, when there is one (between the phases of the contour)."""
+        if self.budget is not None:
+            self.budget.check()
+
     def _slices(self, n: int, size: int):
         """[(start, stop)] covering range(n): one slice without a budget, else slices of `size`, the budget
         checked before each."""
