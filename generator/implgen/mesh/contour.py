@@ -73,6 +73,8 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         dx, dy, dz = c & 1, c >> 1 & 1, c >> 2 & 1
         config |= ins[dx : dx + n0, dy : dy + n1, dz : dz + n2] << np.uint8(c)
     cidx = np.argwhere((config != 0) & (config != 255))
+    if len(cidx) == 0:  # no boundary in the grid: nothing to mesh (pipeline.py says so)
+        return Mesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64), grid, {"cells": list(grid.n)})
     conf = config[tuple(cidx.T)].astype(np.int64)
     cflat = np.ravel_multi_index(tuple(cidx.T), shape)
     key = conf | _face_bits(lib, clips, grid, cidx, conf) << 8

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from implgen.codegen.specmodel import Spec
+from implgen.errors import UserError
 from implgen.mesh.budget import Budget, check_cells
 from implgen.mesh.contour import Mesh, contour
 from implgen.mesh.crossings import clip_values
@@ -64,10 +65,12 @@ def mesh_spec(
     lib = ShapeLib(spec, [full[k] for k in spec.params])
     t1 = time.perf_counter()
     grid, clips = make_grid(spec.box(dict(values)), user_clips, cells, what or spec.source)
-    budget.phase = "meshing"
     budget.check()
+    budget.phase = "meshing"
     lib.budget = budget
     mesh = contour(lib, clips, grid)
+    if len(mesh.faces) == 0:
+        raise UserError(what or spec.source, "no real points of the surface in the region meshed: nothing to mesh")
     t2 = time.perf_counter()
     sing = None
     if singular:

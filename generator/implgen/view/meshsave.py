@@ -94,10 +94,9 @@ def run(job: MeshJob, seconds: float, stop: threading.Event, started: Callable[[
     """On the save pool: the STL's bytes and a line saying what they hold. The budget starts now."""
     started()
     t0 = time.monotonic()
-    result = mesh_spec(job.spec, job.values, job.cells, job.clips, singular=False, deadline=t0 + seconds, cancel=stop)
+    deadline = t0 + seconds
+    result = mesh_spec(job.spec, job.values, job.cells, job.clips, False, SOURCE, deadline, stop)
     verts, faces = result.mesh.vertices, result.mesh.faces
-    if len(faces) == 0:
-        raise UserError(SOURCE, "no real points of the surface in the clip: nothing to mesh")
     normals = vertex_normals(result.lib, result.clips, verts)
     if job.matrix is not None:
         verts, faces, normals = place(job.matrix, verts, faces, normals)
