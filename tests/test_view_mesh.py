@@ -208,6 +208,40 @@ def test_one_mesh_a_page_stop_and_a_closed_page_stop_it(heavy_built, monkeypatch
         assert ended == ["stopped", "stopped"]
 
 
+def test_ctrl_c_stops_a_mesh_in_progress(heavy_built) -> None:
+    """Work.shutdown (Ctrl-C) sets every mesh's stop, as it cancels every render."""
+    import asyncio
+    import threading
+
+    from implgen.view.work import Work
+
+    spec = load_spec(HEAVY)
+    ended: list[str] = []
+
+    def mesh(stop: threading.Event) -> None:
+        try:
+            mesh_spec(spec, {}, 128, [], singular=False, cancel=stop)
+            ended.append("finished")
+        except Stopped:
+            ended.append("stopped")
+
+    async def main() -> None:
+        work = Work()
+        stop = threading.Event()
+        task = asyncio.get_running_loop().create_task(work.stoppable(work.save, stop, mesh, stop))
+        await asyncio.sleep(0.3)
+        work.shutdown()
+        assert stop.is_set()
+        await asyncio.wait([task], timeout=GUARD)
+
+    asyncio.run(main())
+    deadline = time.monotonic() + GUARD
+    while not ended:
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    assert ended == ["stopped"]
+
+
 # ------------------------------------------------------------------------------------- in Chromium
 
 browser = pytest.mark.needs_program("chromium", "chromedriver")
