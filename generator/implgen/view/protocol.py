@@ -44,18 +44,8 @@ MAX_FRAME = (2048, 2048)  # the largest interactive frame
 MAX_SAVE = (8192, 8192)  # the largest saved picture
 MAX_SAVE_PIXELS = 8192 * 4608  # 8K at 16:9
 MAX_SAVE_SPP = 64
-TYPES = (
-    "shape",
-    "render",
-    "save_png",
-    "save_yaml",
-    "show_c",
-    "pick",
-    "object",
-    "export_page",
-    "save_mesh",
-    "stop_mesh",
-)
+MESH_TYPES = ("save_mesh", "stop_mesh")  # meshsave.py
+TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object", "export_page", *MESH_TYPES)
 PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
 
 _parsed: OrderedDict[str, Spec | UserError] = OrderedDict()
