@@ -23,9 +23,9 @@ from implgen.mesh.write import mesh_bytes, vertex_normals
 from implgen_proc import implgen
 
 ROOT = Path(__file__).resolve().parent.parent
-HEAVY = ROOT / "examples/mesh/chmutov20.yaml"  # degree 20: about 10 s at 192 cells on this machine, unbudgeted
+HEAVY = ROOT / "examples/mesh/chmutov20.yaml"  # degree 20: the costliest of bench/results/mesh_budget.md
 TORUS = ROOT / "examples/shapes/torus_z.yaml"
-# How far past its deadline a mesh may stop: a slice of a C batch call or one phase's NumPy work (at most 1.6 s in
+# How far past its deadline a mesh may stop: a slice of a C batch call or one phase's NumPy work (at most 4.2 s in
 # bench/results/mesh_budget.md), with room for a loaded 2-core machine. Far below the unbudgeted run.
 LATE = 6.0
 

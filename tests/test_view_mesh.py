@@ -31,7 +31,7 @@ from implgen.view.session import HEADER
 from implgen.view.work import Limits
 from view_fixtures import view_process
 
-HEAVY = ROOT / "examples/mesh/chmutov20.yaml"  # degree 20: about 10 s at 192 cells unbudgeted on 2 cores
+HEAVY = ROOT / "examples/mesh/chmutov20.yaml"  # degree 20: the costliest of bench/results/mesh_budget.md
 TORUS_VOLUME = 2 * math.pi**2 * 1.0 * 0.35**2  # the starter torus: 2 pi^2 R r^2, R = a = 1, r = b = 0.35
 GUARD = 60  # seconds: a hang guard, not a timing
 
