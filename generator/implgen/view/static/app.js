@@ -372,6 +372,7 @@
     ws.binaryType = "arraybuffer";
     ws.addEventListener("message", onMessage);
     ws.addEventListener("close", (e) => {
+      implgenMesh.reset(); // Save mesh (mesh.js)
       const why = e.reason ? `: ${e.reason}` : " (reload to reconnect)";
       // the error the server closed after stays in view (a scene file that no longer reads, too many pages)
       const text = e.code === 1013 && lastError ? lastError

@@ -1,7 +1,8 @@
 // implgen view: Save mesh. Asks the server for a closed STL of the shape the page shows (its param values and its
 // clip, read from the page as a render request reads them), says how it goes beside the button, and hands the
-// file to the browser. The server checks everything (view/meshsave.py). app.js calls attach() once, message() for
-// each {"type": "mesh"} message and received() with the STL's bytes. Plain JS, no build step.
+// file to the browser. The server checks everything (view/meshsave.py). app.js calls attach() once, message()
+// for each {"type": "mesh"} message, received() with the STL's bytes, and reset() when the socket closes.
+// Plain JS, no build step.
 "use strict";
 
 window.implgenMesh = (() => {
@@ -52,6 +53,10 @@ window.implgenMesh = (() => {
     else api.showMessage(String(msg.text), false); // done: what the file holds; stopped: said so
   }
 
+  function reset() { // the socket closed: no mesh is coming
+    if (running) setRunning(false);
+  }
+
   function received(bytes) {
     api.download(new Blob([bytes], { type: "model/stl" }), name);
   }
@@ -61,5 +66,5 @@ window.implgenMesh = (() => {
     $("save-mesh").addEventListener("click", click);
   }
 
-  return { attach, message, received };
+  return { attach, message, received, reset };
 })();
