@@ -12,6 +12,7 @@ import base64
 import io
 import json
 import math
+import multiprocessing
 import time
 
 import numpy as np
@@ -70,6 +71,11 @@ def mesh_replies(ws, until=("done", "failed", "stopped")) -> tuple[list[dict], b
 
 def save_mesh(ws, hello: dict, cells: int, **options) -> dict:
     return {"type": "save_mesh", "cells": cells, "values": hello["values"], "options": {**hello["options"], **options}}
+
+
+def mesh_processes() -> list:
+    """The meshes' child processes still alive (the test client runs the server in this process)."""
+    return [p for p in multiprocessing.active_children() if p.name == "implgen-view-mesh"]
 
 
 @pytest.fixture(scope="module")
@@ -198,14 +204,14 @@ def test_one_mesh_a_page_stop_and_a_closed_page_stop_it(heavy_built, monkeypatch
             ws.send_text(json.dumps({"type": "stop_mesh"}))
             said, data = mesh_replies(ws)
             assert said[-1] == {"type": "mesh", "state": "stopped", "text": "meshing stopped"} and data is None
-            assert ended == ["stopped"]
+            assert ended == ["stopped"] and not mesh_processes()  # killed, not left running
             ws.send_text(json.dumps(save_mesh(ws, hello, 128)))  # again, then the page closes
             mesh_replies(ws, until=("running",))
         deadline = time.monotonic() + GUARD
         while len(ended) < 2:
             assert time.monotonic() < deadline, "the closed page's mesh went on"
             time.sleep(0.05)
-        assert ended == ["stopped", "stopped"]
+        assert ended == ["stopped", "stopped"] and not mesh_processes()
 
 
 def test_ctrl_c_stops_a_mesh_in_progress(heavy_built) -> None:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import math
+import multiprocessing
 import threading
 import time
 from collections.abc import Awaitable, Callable
@@ -29,7 +30,7 @@ import numpy as np
 
 from implgen.codegen.spec import Spec
 from implgen.errors import UserError
-from implgen.mesh.budget import Stopped, estimate_bytes
+from implgen.mesh.budget import OverBudget, Stopped, estimate_bytes
 from implgen.mesh.pipeline import closed_and_euler, mesh_spec
 from implgen.mesh.region import Clip, Sphere, box_clips
 from implgen.mesh.write import mesh_bytes, place, vertex_normals
@@ -38,6 +39,8 @@ from implgen.view.document import Document, Options
 from implgen.view.work import Work
 
 SOURCE = "save_mesh"
+GRACE = 10.0  # seconds a mesh's process may run past its budget (its start, one uncut phase) before it is killed
+POLL = 0.05  # seconds between looks at the stop
 
 log = logging.getLogger("implgen.view")
 Send = Callable[[dict | bytes], Awaitable[None]]
@@ -91,17 +94,60 @@ def estimate(job: MeshJob) -> int:
 
 
 def run(job: MeshJob, seconds: float, stop: threading.Event, started: Callable[[], None]) -> tuple[bytes, str]:
-    """On the save pool: the STL's bytes and a line saying what they hold. The budget starts now."""
+    """On the save pool: the STL's bytes and a line saying what they hold, made in a child process (`make`). The
+    budget starts now; the child stops itself at it (OverBudget, with its phase) and is killed at once on `stop`,
+    or GRACE seconds past the budget when its work is not cut soon enough."""
     started()
+    ctx = multiprocessing.get_context("spawn")  # a fresh interpreter: never a fork of the threaded server
+    receive, send = ctx.Pipe(duplex=False)
+    child = ctx.Process(target=_child, args=(job, seconds, send), name="implgen-view-mesh", daemon=True)
+    hard = time.monotonic() + seconds + GRACE
+    child.start()
+    send.close()
+    try:
+        while not receive.poll(POLL):
+            if stop.is_set():
+                raise Stopped
+            if time.monotonic() > hard:
+                raise OverBudget(seconds, job.cells, "killed")
+            if not child.is_alive() and not receive.poll(0):
+                raise UserError(SOURCE, f"the mesh's process ended with exit code {child.exitcode}: try fewer cells")
+        try:
+            kind, *what = receive.recv()
+        except EOFError:
+            raise UserError(SOURCE, f"the mesh's process ended with exit code {child.exitcode}") from None
+    finally:
+        if child.is_alive():
+            child.kill()
+        child.join(GRACE)
+        receive.close()
+    if kind == "ok":
+        return what[0], what[1]
+    if kind == "user":
+        raise UserError(what[0], what[1])
+    raise RuntimeError(f"in the mesh's process: {what[0]}")
+
+
+def _child(job: MeshJob, seconds: float, send) -> None:
+    """The child process: make the mesh, send ("ok", bytes, line), ("user", source, message) or ("bug", text)."""
+    try:
+        reply = ("ok", *make(job, time.monotonic() + seconds))
+    except UserError as err:
+        reply = ("user", err.source, err.message)
+    except Exception as err:  # a bug: its kind and text to the server's log
+        reply = ("bug", f"{type(err).__name__}: {err}")
+    send.send(reply)
+    send.close()
+
+
+def make(job: MeshJob, deadline: float) -> tuple[bytes, str]:
+    """The STL's bytes and a line saying what they hold (in the child process)."""
     t0 = time.monotonic()
-    deadline = t0 + seconds
-    result = mesh_spec(job.spec, job.values, job.cells, job.clips, False, SOURCE, deadline, stop)
+    result = mesh_spec(job.spec, job.values, job.cells, job.clips, False, SOURCE, deadline)
     verts, faces = result.mesh.vertices, result.mesh.faces
     normals = vertex_normals(result.lib, result.clips, verts)
     if job.matrix is not None:
         verts, faces, normals = place(job.matrix, verts, faces, normals)
-    if stop.is_set():
-        raise Stopped
     closed, euler = closed_and_euler(faces, len(verts))
     data = mesh_bytes("stl", verts, faces, normals)
     shape = "closed" if closed else "NOT closed"
