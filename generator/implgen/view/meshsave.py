@@ -7,8 +7,11 @@ is the picked object alone, cut by its own clip (if the file gives it one) and p
 
 Each mesh has bounds, checked before any work: cells in [MIN_CELLS, MAX_CELLS]; an upper estimate of its memory
 (mesh/budget.py) reserved from the saves' memory (work.py); a time budget (Limits.mesh_budget, counted from when
-the save pool starts it) and a stop, both checked by the pipeline as it goes. A page meshes one shape at a time;
-closing it, or Stop, stops its mesh. The singular-point search of `implgen mesh` is skipped: its time and memory
+the save pool starts it). The mesh is NumPy work in Python, so it runs in a child process (spawned, never forked
+from the threaded server): in the server's own process it held the GIL long enough to cost the other pages
+half their frames (bench/view_mesh.py). The child stops itself at its budget, saying in which phase; a save pool
+thread waits for it and kills it at once on Stop, when its page closes or at Ctrl-C, or GRACE seconds past its
+budget. A page meshes one shape at a time. The singular-point search of `implgen mesh` is skipped: its time and memory
 do not depend on the cells (tens of seconds and hundreds of MB on a degree-20 surface); nodes are closed around.
 
 The page hears, as `{"type": "mesh", "state": ..., "text": ...}`: `running` (with the file's name), then the
