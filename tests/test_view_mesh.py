@@ -14,6 +14,7 @@ import json
 import math
 import multiprocessing
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -214,19 +215,20 @@ def test_one_mesh_a_page_stop_and_a_closed_page_stop_it(heavy_built, monkeypatch
         assert ended == ["stopped", "stopped"] and not mesh_processes()
 
 
-def test_ctrl_c_stops_a_mesh_in_progress(heavy_built) -> None:
-    """Work.shutdown (Ctrl-C) sets every mesh's stop, as it cancels every render."""
+def test_ctrl_c_kills_a_mesh_in_progress(heavy_built) -> None:
+    """Work.shutdown (Ctrl-C) sets every mesh's stop, as it cancels every render: the mesh's process is killed."""
     import asyncio
     import threading
 
     from implgen.view.work import Work
 
-    spec = load_spec(HEAVY)
+    doc = document_factory(HEAVY)()
+    job = meshsave.job_for(doc, 128, doc.values, doc.options)
     ended: list[str] = []
 
     def mesh(stop: threading.Event) -> None:
         try:
-            mesh_spec(spec, {}, 128, [], singular=False, cancel=stop)
+            meshsave.run(job, 100.0, stop, lambda: None)
             ended.append("finished")
         except Stopped:
             ended.append("stopped")
@@ -235,7 +237,10 @@ def test_ctrl_c_stops_a_mesh_in_progress(heavy_built) -> None:
         work = Work()
         stop = threading.Event()
         task = asyncio.get_running_loop().create_task(work.stoppable(work.save, stop, mesh, stop))
-        await asyncio.sleep(0.3)
+        deadline = time.monotonic() + GUARD
+        while not mesh_processes():  # the child is meshing
+            assert time.monotonic() < deadline
+            await asyncio.sleep(0.05)
         work.shutdown()
         assert stop.is_set()
         await asyncio.wait([task], timeout=GUARD)
@@ -245,7 +250,58 @@ def test_ctrl_c_stops_a_mesh_in_progress(heavy_built) -> None:
     while not ended:
         assert time.monotonic() < deadline
         time.sleep(0.05)
-    assert ended == ["stopped"]
+    assert ended == ["stopped"] and not mesh_processes()
+
+
+def _mesh_children(pid: int) -> list[int]:
+    """The processes `pid` spawned for meshes (multiprocessing's spawn_main), from /proc."""
+    out = []
+    for d in Path("/proc").iterdir():
+        try:
+            ppid = int((d / "stat").read_text().rsplit(")", 1)[1].split()[1]) if d.name.isdigit() else -1
+            cmd = (d / "cmdline").read_bytes() if ppid == pid else b""
+        except OSError:
+            continue
+        if b"spawn_main" in cmd:
+            out.append(int(d.name))
+    return out
+
+
+def test_ctrl_c_on_the_real_server_leaves_no_mesh_process(heavy_built) -> None:
+    """`implgen view` meshing in a child process, then Ctrl-C: the server ends within 2 s and so does the child."""
+    import signal
+    import subprocess
+    import sys
+
+    from websockets.sync.client import connect
+
+    cmd = [sys.executable, "-m", "implgen.cli", "view", str(HEAVY), "--no-browser", "--port", "0"]
+    srv = subprocess.Popen(
+        cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )  # fmt: skip
+    try:
+        url = "ws://" + srv.stdout.readline().split("http://", 1)[1].split("/", 1)[0] + "/ws"
+        with connect(url, max_size=2**26) as ws:
+            hello = json.loads(ws.recv())
+            ws.send(json.dumps(save_mesh(ws, hello, 128)))
+            deadline = time.monotonic() + GUARD
+            while not (kids := _mesh_children(srv.pid)):
+                assert time.monotonic() < deadline, "no mesh process"
+                time.sleep(0.05)
+            t0 = time.monotonic()
+            srv.send_signal(signal.SIGINT)
+            srv.wait(GUARD)
+        assert time.monotonic() - t0 < 2 and srv.returncode == 130
+        assert srv.stderr.read() == "implgen: interrupted\n"  # one line, no traceback
+        deadline = time.monotonic() + 5
+        while any(Path(f"/proc/{k}").exists() for k in kids):
+            assert time.monotonic() < deadline, "the mesh process outlived the server"
+            time.sleep(0.05)
+    finally:
+        if srv.poll() is None:
+            srv.kill()
+            srv.wait(30)
 
 
 # ------------------------------------------------------------------------------------- in Chromium

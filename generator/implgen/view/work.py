@@ -277,6 +277,7 @@ class Work:
                 raise asyncio.CancelledError
             self._stops.add(stop)
         fut = asyncio.wrap_future(pool.submit(fn, *args))
+        fut.add_done_callback(lambda f: f.cancelled() or f.exception())  # heard even when no one waits (Ctrl-C)
         try:
             return await asyncio.shield(fut)
         except asyncio.CancelledError:
