@@ -5,9 +5,11 @@ holds the GIL part of the time) take frames from the other pages?
 
 Starts `implgen view --no-browser --port 0` in its own process (the starter torus). One page orbits, each render
 request sent when the previous coarse frame has arrived, for --seconds; in the `meshing` rounds a second page
-meshes Chmutov's octic at MESH_CELLS cells again and again meanwhile; `quiet` rounds have no second page. Rounds
-interleave (quiet, meshing, quiet, ...). Per round: the orbiting page's coarse frames a second and its longest
-wait for a frame; the medians over rounds; the meshes finished and their median time.
+meshes Chmutov's octic at MESH_CELLS cells again and again meanwhile; in the `apart` rounds the same meshes are
+made by `implgen mesh` in a process of its own (the same work on the CPU, no share of the server's GIL); `quiet`
+rounds have neither. Rounds interleave (quiet, meshing, apart, quiet, ...). Per round: the orbiting page's
+coarse frames a second and its longest wait for a frame; the medians over rounds; the meshes finished and
+their median time.
 """
 
 from __future__ import annotations
@@ -15,9 +17,11 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import statistics
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from pathlib import Path
@@ -68,13 +72,25 @@ def mesher(url: str, stop: threading.Event, times: list[float], ready: threading
         page.ws.close()
 
 
-def orbit(url: str, seconds: float, meshing: bool) -> dict[str, float]:
+def apart(stop: threading.Event, times: list[float], ready: threading.Event, folder: Path) -> None:
+    """The same meshes by `implgen mesh` in its own process, again and again until `stop`."""
+    cmd = [sys.executable, "-m", "implgen.cli", "mesh", str(OCTIC), "--cells", str(MESH_CELLS), "--no-singular"]
+    ready.set()
+    while not stop.is_set():
+        t0 = time.perf_counter()
+        subprocess.run([*cmd, "-o", str(folder / "octic.stl")], check=True, capture_output=True)
+        times.append(time.perf_counter() - t0)
+
+
+def orbit(url: str, seconds: float, kind: str, folder: Path) -> dict[str, float]:
     good = Page(url)
     good.frame(good.render(False), KIND_COARSE)  # built before the measure
     stop, ready, times = threading.Event(), threading.Event(), []
     other = None
-    if meshing:
-        other = threading.Thread(target=mesher, args=(url, stop, times, ready), daemon=True)
+    if kind != "quiet":
+        work = mesher if kind == "meshing" else apart
+        args = (url, stop, times, ready) if kind == "meshing" else (stop, times, ready, folder)
+        other = threading.Thread(target=work, args=args, daemon=True)
         other.start()
         ready.wait(120)
         time.sleep(0.5)  # its first mesh under way
@@ -102,18 +118,20 @@ def main() -> int:
     args = ap.parse_args()
     load_before = load_average()
     server, url = start_server()
-    runs: dict[str, list[dict]] = {"quiet": [], "meshing": []}
+    runs: dict[str, list[dict]] = {"quiet": [], "meshing": [], "apart": []}
+    folder = Path(tempfile.mkdtemp(prefix="implgen-bench-view-mesh-"))
     try:
-        orbit(url, 1.0, False)  # the starter built
+        orbit(url, 1.0, "quiet", folder)  # the starter built
         for r in range(args.rounds):
-            for kind in ("quiet", "meshing"):
-                got = orbit(url, args.seconds, kind == "meshing")
+            for kind in runs:
+                got = orbit(url, args.seconds, kind, folder)
                 runs[kind].append(got)
                 print(f"round {r + 1} {kind}: {got['fps']:.1f} frames/s, longest wait {got['longest']:.3f} s, "
                       f"{got['meshes']} meshes", flush=True)  # fmt: skip
     finally:
         server.kill()
         server.wait(30)
+        shutil.rmtree(folder, ignore_errors=True)
     rows = []
     for kind, got in runs.items():
         fps = statistics.median(g["fps"] for g in got)
@@ -122,7 +140,8 @@ def main() -> int:
         times = [t for g in got for t in g["mesh_seconds"]]
         mesh = f"{len(times)}, median {statistics.median(times):.2f} s" if times else "none"
         rows.append(f"| {kind} | {fps:.1f} | {longest:.3f} | {worst:.3f} | {mesh} |")
-    ratio = statistics.median(g["fps"] for g in runs["meshing"]) / statistics.median(g["fps"] for g in runs["quiet"])
+    quiet = statistics.median(g["fps"] for g in runs["quiet"])
+    ratios = {k: statistics.median(g["fps"] for g in runs[k]) / quiet for k in ("meshing", "apart")}
     text = "\n".join(
         [
             "# `implgen view`: a page's frames while another page saves a mesh",
@@ -130,15 +149,17 @@ def main() -> int:
             f"Machine: {machine()}; load average {load_before} before the run, {load_average()} after.",
             f"Written by `bench/view_mesh.py --rounds {args.rounds} --seconds {args.seconds:g}`: one page orbits the "
             f"starter torus (coarse frames, each request sent when the previous frame has arrived) while, in the "
-            f"`meshing` rounds, a second page saves Chmutov's octic at {MESH_CELLS} cells again and again; rounds "
-            "interleaved.",
+            f"`meshing` rounds, a second page saves Chmutov's octic at {MESH_CELLS} cells again and again, and in the "
+            "`apart` rounds `implgen mesh --no-singular` makes the same mesh again and again in its own process; "
+            "rounds interleaved.",
             "",
             "| rounds | coarse frames/s (median) | longest wait for a frame (median) | longest wait (worst round) "
             "| meshes finished |",
             "|---|---|---|---|---|",
             *rows,
             "",
-            f"Frames a second while meshing over quiet: {ratio:.2f}.",
+            f"Frames a second over quiet: {ratios['meshing']:.2f} while the server meshes, {ratios['apart']:.2f} while "
+            "a process of its own makes the same meshes.",
             "",
         ]
     )
