@@ -1,6 +1,6 @@
 """`implgen mesh` as the user runs it: all four formats written and read back by trimesh, binary STL by default,
 the JSON report and the one stderr line, a shape of a scene placed by its transform, and bad options refused
-with one line, exit status 2 and nothing written."""
+with one line, exit status 2 and nothing written; a shape with no real points in its box is one line too."""
 
 from __future__ import annotations
 
@@ -102,3 +102,13 @@ def test_a_grid_that_misses_the_solid_says_so(tmp_path):
     assert ran.code == 2 and ran.err.count("\n") == 1 and "--cells 4" in ran.err and "empty" in ran.err
     assert "grid edges hold crossings" in ran.err and "Traceback" not in ran.err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_no_real_points_is_one_line_not_an_empty_file(tmp_path):
+    """x^2 + y^2 + z^2 + 1 > 0 everywhere: no solid to mesh (it was a NumPy traceback)."""
+    spec = tmp_path / "none.yaml"
+    spec.write_text("name: none\nequation: x^2 + y^2 + z^2 + 1\nbounds: {x: [-1, 1], y: [-1, 1], z: [-1, 1]}\n")
+    ran = implgen("mesh", spec, "-o", tmp_path / "n.stl")
+    assert ran.code == 2 and ran.err.count("\n") == 1 and "Traceback" not in ran.err
+    assert ran.err == f"implgen: error: {spec}: no real points of the surface in the region meshed: nothing to mesh\n"
+    assert list(tmp_path.iterdir()) == [spec]

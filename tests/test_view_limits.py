@@ -296,8 +296,9 @@ def test_parses_are_cached_by_text_and_params(monkeypatch) -> None:
 
     asyncio.run(two_pages())
     # (a first build of the runtime in this cache also sends its progress: status lines, not answers)
-    assert [r["type"] for r in replies if r["type"] != "status"] == ["shape", "error"] * 2
-    assert replies[1] == replies[3]  # the cached refusal says the same
+    answers = [r for r in replies if r["type"] != "status"]
+    assert [r["type"] for r in answers] == ["shape", "error"] * 2
+    assert answers[1] == answers[3]  # the cached refusal says the same
     assert len(calls) == 2, calls
 
 

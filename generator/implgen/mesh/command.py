@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import sys
+import time
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -18,13 +19,15 @@ from implgen import validate
 from implgen.args import ArgumentParser
 from implgen.codegen.paramvalues import named_items
 from implgen.errors import UserError
+from implgen.mesh.budget import MAX_CELLS, MIN_CELLS
 from implgen.mesh.pipeline import Result, closed_and_euler, mesh_spec, signed_volume, singular_in_solid
 from implgen.mesh.region import parse_clip
-from implgen.mesh.write import FORMATS, vertex_normals, write_mesh
+from implgen.mesh.write import FORMATS, place, vertex_normals, write_mesh
 from implgen.outputs import atomic_write, check_output_file
 from implgen.yamlfile import read_yaml
 
-MIN_CELLS, MAX_CELLS, DEFAULT_CELLS = 4, 256, 64
+DEFAULT_CELLS = 64
+MAX_TIME_LIMIT = 1e6  # seconds
 EXAMPLES = (
     ("a torus as binary STL", "implgen mesh examples/shapes/torus_z.yaml -o torus.stl"),
     (
@@ -53,6 +56,8 @@ def _parser() -> ArgumentParser:
     ap.add_argument("--object", help="in a scene: the shape to mesh, by its name")
     ap.add_argument("--report", help="a JSON report: sizes, checks, singular points, timings")
     ap.add_argument("--no-singular", action="store_true", help="skip the search for singular points")
+    limit_help = "stop, writing nothing, when meshing takes longer (reading the file not counted; default: none)"
+    ap.add_argument("--time-limit", metavar="SECONDS", help=limit_help)
     return ap
 
 
@@ -118,25 +123,20 @@ def main(argv: Sequence[str]) -> int:
     if args.report is not None:
         check_output_file(Path(args.report), "--report", (".json",))
     validate.whole("--cells", "", args.cells, MIN_CELLS, MAX_CELLS)
+    limit = None
+    if args.time_limit is not None:
+        limit = validate.number("--time-limit", "", args.time_limit, 0.0, MAX_TIME_LIMIT, lo_open=True, text_ok=True)
     clips = parse_clip(args.clip) if args.clip is not None else []
     spec, values, matrix = _shape(Path(args.file), args.object)
     values.update(_params(spec, args.param))
-    result = mesh_spec(spec, values, args.cells, clips, singular=not args.no_singular, what=args.file)
+    deadline = None if limit is None else time.monotonic() + limit  # counted from here: the file is read
+    result = mesh_spec(
+        spec, values, args.cells, clips, singular=not args.no_singular, what=args.file, deadline=deadline
+    )
     verts, faces = result.mesh.vertices, result.mesh.faces
-    if not len(faces):
-        hidden = result.mesh.stats["hidden_crossing_edges"]
-        raise UserError(
-            f"--cells {args.cells}",
-            f"no grid vertex lies in the solid, so the mesh is empty ({hidden} grid edges hold crossings): raise it",
-        )
     normals = vertex_normals(result.lib, result.clips, verts)
-    if matrix is not None:  # object -> world; normals by the inverse transpose; a mirror turns the faces
-        lin = matrix[:, :3]
-        verts = verts @ lin.T + matrix[:, 3]
-        normals = normals @ np.linalg.inv(lin)
-        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
-        if np.linalg.det(lin) < 0:
-            faces = faces[:, ::-1]
+    if matrix is not None:
+        verts, faces, normals = place(matrix, verts, faces, normals)
     rep = report(result, spec.name, {**spec.params, **values}, verts, faces)
     write_mesh(out, verts, faces, normals)
     if args.report is not None:

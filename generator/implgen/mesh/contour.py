@@ -59,6 +59,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         raise AssertionError("the grid's outer layer must lie outside every clip")
     cross: list[Crossings] = [axis_crossings(lib, clips, grid, a, inside, g) for a in range(3)]
     clock.append(time.perf_counter())
+    lib.check()  # the budget, between phases (budget.py)
 
     # cells: corner flags -> config; active ones get their sheets
     ins = inside.view(np.uint8)
@@ -78,6 +79,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     nverts = int(count.sum())
 
     clock.append(time.perf_counter())
+    lib.check()  # the budget, between phases (budget.py)
     # every sheet's crossings -> QEF point (one C loop over the cells) -> onto the surface
     nv = int(np.prod(shape))
     keys = np.concatenate([a * nv + c.edges for a, c in enumerate(cross)])
@@ -88,6 +90,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         cflat, sheets, base, strides, nv, keys, cp, cn, cpiece, grid.origin, grid.h, CREASE, DROP, nverts
     )
     clock.append(time.perf_counter())
+    lib.check()  # the budget, between phases (budget.py)
     verts, projected = project(lib, clips, qef, mask, grid.h, grid.size)
     extra = outside_pieces(lib, clips, verts, mask, grid.size)
     if extra.any():  # on one piece but outside another (a cap vertex past the rim): onto both
@@ -99,6 +102,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         verts[failed] = cp[nearest[failed]]  # which lies on the surface exactly
 
     clock.append(time.perf_counter())
+    lib.check()  # the budget, between phases (budget.py)
     # one quad per active edge, from the sheets of its four cells
     rowof = np.full(int(np.prod(shape)), -1, dtype=np.int64)
     rowof[cflat] = np.arange(len(cflat))

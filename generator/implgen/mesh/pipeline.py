@@ -1,8 +1,11 @@
 """One shape → a mesh and what is known of it: the library, the region, the contour, the singular points, the
-mesh's own checks (edges each shared by two faces, Euler characteristic, volume), timings."""
+mesh's own checks (edges each shared by two faces, Euler characteristic, volume), timings. The cells are checked
+before any work; a `deadline` and a `cancel` event are checked between the phases and inside their long loops
+(budget.py)."""
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -10,6 +13,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from implgen.codegen.specmodel import Spec
+from implgen.errors import UserError
+from implgen.mesh.budget import Budget, check_cells
 from implgen.mesh.contour import Mesh, contour
 from implgen.mesh.crossings import clip_values
 from implgen.mesh.region import Clip, make_grid
@@ -54,21 +59,43 @@ def mesh_spec(
     user_clips: list[Clip],
     singular: bool = True,
     what: str = "",
+    deadline: float | None = None,
+    cancel: threading.Event | None = None,
+    cells_name: str = "--cells",
 ) -> Result:
-    """Mesh the solid f < 0 (∩ the spec's box, ∩ the user's clip) of `spec` with these param values."""
+    """Mesh the solid f < 0 (∩ the spec's box, ∩ the user's clip) of `spec` with these param values. Past
+    `deadline` (a time.monotonic() value) it raises budget.OverBudget, once `cancel` is set budget.Stopped.
+    A mesh with no faces is a UserError: no real points in the region, or (crossings on the grid lines but no
+    grid vertex in the solid) too few cells, the option named by `cells_name`."""
+    budget = Budget(deadline, cancel, check_cells(cells, "cells"), "building the shape")
+    budget.check()
     t0 = time.perf_counter()
     full = {**spec.params, **values}
     lib = ShapeLib(spec, [full[k] for k in spec.params])
     t1 = time.perf_counter()
     grid, clips = make_grid(spec.box(dict(values)), user_clips, cells, what or spec.source)
+    budget.check()
+    budget.phase = "meshing"
+    lib.budget = budget
     mesh = contour(lib, clips, grid)
+    if len(mesh.faces) == 0:
+        hidden = mesh.stats["hidden_crossing_edges"]
+        if not hidden:
+            raise UserError(what or spec.source, "no real points of the surface in the region meshed: nothing to mesh")
+        raise UserError(
+            f"{cells_name} {cells}",
+            f"no grid vertex lies in the solid, so the mesh is empty ({hidden} grid edges hold crossings): raise it",
+        )
     t2 = time.perf_counter()
     sing = None
     if singular:
+        budget.phase = "finding singular points"
+        budget.check()
         hi = grid.origin + grid.h * np.array(grid.n)
         sing = find_singular(lib, grid.origin, hi)
         if sing.complete:  # isolated points (a curve's sample would only crumple the mesh along it)
             snap_to_singular(mesh, sing.points, clips)
+    lib.budget = None  # the caller's own uses (normals) are not timed
     t3 = time.perf_counter()
     return Result(mesh, lib, clips, sing, {"build": t1 - t0, "mesh": t2 - t1, "singular": t3 - t2})
 

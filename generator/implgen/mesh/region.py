@@ -23,27 +23,30 @@ SHIFT = (math.sqrt(2) - 1) / 7  # of a cell, per axis times (1, 1.37, 1.71): irr
 
 @dataclass(frozen=True)
 class Sphere:
-    """The ball |p| < radius."""
+    """The ball |p - center| < radius (a scene's clip may have its centre off the origin)."""
 
     radius: float
+    center: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def value(self, p: np.ndarray) -> np.ndarray:
-        return np.einsum("...i,...i->...", p, p) - self.radius**2
+        q = p - np.asarray(self.center)
+        return np.einsum("...i,...i->...", q, q) - self.radius**2
 
     def gradient(self, p: np.ndarray) -> np.ndarray:
-        return 2.0 * p
+        return 2.0 * (p - np.asarray(self.center))
 
     def on_grid(self, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
         """The value at every (x[i], y[j], z[k]), by broadcasting."""
+        x, y, z = x - self.center[0], y - self.center[1], z - self.center[2]
         return (x * x)[:, None, None] + (y * y)[None, :, None] + (z * z)[None, None, :] - self.radius**2
 
     def crossings(self, axis: int, others: np.ndarray) -> np.ndarray:
         """Where lines along `axis` (through the points `others`, (n, 3), the axis' own column ignored) meet
         the sphere: (n, 2) coordinates along the axis, NaN where they miss."""
-        q = np.delete(others, axis, axis=1)
+        q = np.delete(others - np.asarray(self.center), axis, axis=1)
         disc = self.radius**2 - (q * q).sum(axis=1)
         r = np.sqrt(np.where(disc > 0, disc, np.nan))
-        return np.stack([-r, r], axis=1)
+        return np.stack([-r, r], axis=1) + self.center[axis]
 
     def along(self, axis: int, starts: np.ndarray, line: np.ndarray, t: np.ndarray) -> np.ndarray:
         """The value at starts[line] + t along `axis` (points on grid lines)."""
@@ -52,7 +55,7 @@ class Sphere:
         return self.value(p)
 
     def box(self) -> tuple[np.ndarray, np.ndarray]:
-        return np.full(3, -self.radius), np.full(3, self.radius)
+        return np.asarray(self.center) - self.radius, np.asarray(self.center) + self.radius
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,8 @@
 """One shape compiled with the runtime (compile/library.py, cached), and its batch entry points
 (runtime_c/shape_batch.c) bound with ctypes: every root of f along many rays at once, and f with its gradient
-at many points at once. Each call is one C loop; Python never loops per ray or per point."""
+at many points at once. Each call is one C loop; Python never loops per ray or per point. With a `budget`
+(budget.py) the C loop runs in slices (ROWS rays, POINTS points, a slab of about POINTS grid vertices) and the
+budget is checked before each: a mesh stops within one slice of its deadline, or of its stop."""
 
 from __future__ import annotations
 
@@ -13,6 +15,7 @@ from implgen import abi
 from implgen.codegen.specmodel import Spec
 from implgen.compile import clib
 from implgen.compile.library import ShapeEntry, build_library
+from implgen.mesh.budget import Budget
 
 MAX_DEGREE = abi.value("IG_MAX_DEGREE")
 AUTO = abi.value("IG_ROOTS_AUTO")
@@ -21,6 +24,8 @@ _DP = ctypes.POINTER(ctypes.c_double)
 _IP = ctypes.POINTER(ctypes.c_int)
 _VP = ctypes.c_void_p
 _LONG = np.dtype(f"i{ctypes.sizeof(ctypes.c_long)}")  # C's long, as NumPy holds it
+ROWS = 4096  # rays a slice
+POINTS = 1 << 18  # points, grid vertices, cells or quads a slice
 
 
 def _ptr(a: np.ndarray):
@@ -53,6 +58,22 @@ class ShapeLib:
         self._lib = lib
         self._shape = lib.rt_scene_shape(0)
         self._params = np.ascontiguousarray(np.asarray(list(params) or [0.0], dtype=np.float64))
+        self.budget: Budget | None = None  # checked before each slice of a batch call
+
+    def check(self) -> None:
+        """The budget's check, when there is one (between the phases of the contour)."""
+        if self.budget is not None:
+            self.budget.check()
+
+    def _slices(self, n: int, size: int):
+        """[(start, stop)] covering range(n): one slice without a budget, else slices of `size`, the budget
+        checked before each."""
+        if self.budget is None:
+            yield 0, n
+            return
+        for start in range(0, n, max(1, size)):
+            self.budget.check()
+            yield start, min(n, start + size)
 
     def roots(self, o: np.ndarray, d: np.ndarray, tmin: np.ndarray, tmax: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """All distinct roots in [tmin, tmax] of each ray o + t d: (roots (n, IG_MAX_DEGREE), NaN past each
@@ -64,10 +85,11 @@ class ShapeLib:
         t1 = np.ascontiguousarray(np.broadcast_to(np.asarray(tmax, dtype=np.float64), (n,)))
         out = np.full((n, MAX_DEGREE), np.nan)
         counts = np.zeros(n, dtype=np.intc)
-        self._lib.ig_shape_roots_many(
-            self._shape, _ptr(self._params), n, _ptr(o), _ptr(d), _ptr(t0), _ptr(t1), AUTO, _ptr(out),
-            counts.ctypes.data_as(_IP),
-        )  # fmt: skip
+        for a, b in self._slices(n, ROWS):  # rows of C-ordered arrays: each slice is contiguous
+            self._lib.ig_shape_roots_many(
+                self._shape, _ptr(self._params), b - a, _ptr(o[a:b]), _ptr(d[a:b]), _ptr(t0[a:b]), _ptr(t1[a:b]),
+                AUTO, _ptr(out[a:b]), counts[a:b].ctypes.data_as(_IP),
+            )  # fmt: skip
         out[np.arange(MAX_DEGREE)[None, :] >= counts[:, None]] = np.nan
         return out, counts
 
@@ -75,7 +97,9 @@ class ShapeLib:
         """f at each point (p: (..., 3)), shape p.shape[:-1]."""
         p = np.ascontiguousarray(p, dtype=np.float64)
         f = np.empty(p.shape[:-1])
-        self._lib.ig_shape_eval_many(self._shape, _ptr(self._params), f.size, _ptr(p), _ptr(f), None)
+        pf, ff = p.reshape(-1, 3), f.reshape(-1)
+        for a, b in self._slices(ff.size, POINTS):
+            self._lib.ig_shape_eval_many(self._shape, _ptr(self._params), b - a, _ptr(pf[a:b]), _ptr(ff[a:b]), None)
         return f
 
     def value_gradient(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -83,16 +107,21 @@ class ShapeLib:
         p = np.ascontiguousarray(p, dtype=np.float64)
         f = np.empty(p.shape[:-1])
         g = np.empty(p.shape)
-        self._lib.ig_shape_eval_many(self._shape, _ptr(self._params), f.size, _ptr(p), _ptr(f), _ptr(g))
+        pf, ff, gf = p.reshape(-1, 3), f.reshape(-1), g.reshape(-1, 3)
+        for a, b in self._slices(ff.size, POINTS):
+            self._lib.ig_shape_eval_many(
+                self._shape, _ptr(self._params), b - a, _ptr(pf[a:b]), _ptr(ff[a:b]), _ptr(gf[a:b])
+            )
         return f, g
 
     def values_grid(self, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
         """f at every (x[i], y[j], z[k]), shape (len(x), len(y), len(z))."""
         x, y, z = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, y, z))
         f = np.empty((x.size, y.size, z.size))
-        self._lib.ig_shape_values_grid(
-            self._shape, _ptr(self._params), _ptr(x), x.size, _ptr(y), y.size, _ptr(z), z.size, _ptr(f)
-        )
+        for a, b in self._slices(x.size, POINTS // max(1, y.size * z.size)):  # slabs of x: contiguous in f
+            self._lib.ig_shape_values_grid(
+                self._shape, _ptr(self._params), _ptr(x[a:b]), b - a, _ptr(y), y.size, _ptr(z), z.size, _ptr(f[a:b])
+            )
         return f
 
     def project(
@@ -103,9 +132,10 @@ class ShapeLib:
         at most `noise`, and moved at most `reach` along each axis (ig_shape_project_many)."""
         out = np.array(p, dtype=np.float64, order="C").reshape(-1, 3)
         ok = np.zeros(len(out), dtype=np.uint8)
-        self._lib.ig_shape_project_many(
-            self._shape, _ptr(self._params), len(out), _ptr(out), steps, tol, noise, reach, ok.ctypes.data
-        )
+        for a, b in self._slices(len(out), POINTS):
+            self._lib.ig_shape_project_many(
+                self._shape, _ptr(self._params), b - a, _ptr(out[a:b]), steps, tol, noise, reach, ok[a:b].ctypes.data
+            )
         return out, ok.astype(bool)
 
     def sheet_points(self, corner, sheets, first, strides, nvertices: int, keys, points, normals, piece, origin,
@@ -125,11 +155,12 @@ class ShapeLib:
         out = np.zeros((nverts, 3))
         mask = np.zeros(nverts, dtype=_LONG)
         nearest = np.full(nverts, -1, dtype=_LONG)
-        self._lib.ig_mesh_sheet_points(
-            len(corner), corner.ctypes.data, sheets.ctypes.data, first.ctypes.data, strides.ctypes.data, nvertices,
-            len(keys), keys.ctypes.data, _ptr(points), _ptr(normals), piece.ctypes.data, _ptr(origin), h, crease,
-            drop, nverts, _ptr(out), mask.ctypes.data, nearest.ctypes.data,
-        )  # fmt: skip
+        for a, b in self._slices(len(corner), POINTS):  # each cell writes its own vertices (first[c] + sheet)
+            self._lib.ig_mesh_sheet_points(
+                b - a, corner[a:b].ctypes.data, sheets[a:b].ctypes.data, first[a:b].ctypes.data, strides.ctypes.data,
+                nvertices, len(keys), keys.ctypes.data, _ptr(points), _ptr(normals), piece.ctypes.data,
+                _ptr(origin), h, crease, drop, nverts, _ptr(out), mask.ctypes.data, nearest.ctypes.data,
+            )  # fmt: skip
         return out, mask.astype(np.int64), nearest.astype(np.int64)
 
     def split_quads(self, quads: np.ndarray, flip: np.ndarray, verts: np.ndarray) -> np.ndarray:
@@ -140,6 +171,13 @@ class ShapeLib:
         verts = np.ascontiguousarray(verts, dtype=np.float64)
         if len(flip) != len(quads) or (quads.size and not 0 <= quads.min() <= quads.max() < len(verts)):
             raise ValueError("split_quads: quads and flags disagree, or a vertex id is out of range")
-        tris = np.empty((2 * len(quads), 3), dtype=_LONG)
-        self._lib.ig_mesh_split_quads(len(quads), quads.ctypes.data, flip.ctypes.data, _ptr(verts), tris.ctypes.data)
+        m = len(quads)
+        tris = np.empty((2 * m, 3), dtype=_LONG)
+        for a, b in self._slices(m, POINTS):  # a slice's first triangles, then its second: placed as in one call
+            part = tris if b - a == m else np.empty((2 * (b - a), 3), dtype=_LONG)
+            self._lib.ig_mesh_split_quads(
+                b - a, quads[a:b].ctypes.data, flip[a:b].ctypes.data, _ptr(verts), part.ctypes.data
+            )
+            if part is not tris:
+                tris[a:b], tris[m + a : m + b] = part[: b - a], part[b - a :]
         return tris.astype(np.int64, copy=False)

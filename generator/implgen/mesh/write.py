@@ -34,15 +34,31 @@ def to_trimesh(verts: np.ndarray, faces: np.ndarray, normals: np.ndarray | None 
     return mesh
 
 
+def place(matrix: np.ndarray, verts: np.ndarray, faces: np.ndarray, normals: np.ndarray):
+    """(verts, faces, normals) moved object -> world by a 3x4 matrix: normals by the inverse transpose, the faces
+    turned by a mirror so they still face f > 0."""
+    lin = matrix[:, :3]
+    verts = verts @ lin.T + matrix[:, 3]
+    normals = normals @ np.linalg.inv(lin)
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
+    if np.linalg.det(lin) < 0:
+        faces = faces[:, ::-1]
+    return verts, faces, normals
+
+
 def write_mesh(path: Path, verts: np.ndarray, faces: np.ndarray, normals: np.ndarray | None) -> None:
     """Write in the format the suffix names (FORMATS); STL is binary."""
+    blob = mesh_bytes(FORMATS[path.suffix.lower()], verts, faces, normals)
+    atomic_write(path, lambda fh: fh.write(blob))  # type: ignore[attr-defined]
+
+
+def mesh_bytes(kind: str, verts: np.ndarray, faces: np.ndarray, normals: np.ndarray | None) -> bytes:
+    """The file's bytes, `kind` one of FORMATS' values."""
     mesh = to_trimesh(verts, faces, normals)
-    kind = FORMATS[path.suffix.lower()]
     if kind == "obj":  # 17 significant digits: the doubles exactly (trimesh's default keeps 8 decimals)
         data = mesh.export(file_type=kind, include_normals=True, digits=17)
     elif kind == "ply":
         data = mesh.export(file_type=kind, vertex_normal=True)
     else:  # binary STL (float32, as the format holds), glTF binary (float32)
         data = mesh.export(file_type=kind)
-    blob = data.encode("utf-8") if isinstance(data, str) else bytes(data)
-    atomic_write(path, lambda fh: fh.write(blob))  # type: ignore[attr-defined]
+    return data.encode("utf-8") if isinstance(data, str) else bytes(data)

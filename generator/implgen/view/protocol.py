@@ -8,6 +8,9 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
      "values": {"a": 1.2}, "orbit": {...}, "options": {...}}          the view to show (the newest wins)
     {"type": "save_png", "width": 1920, "height": 1080, "spp": 16}    the current view through render()
     {"type": "save_yaml", "width": 640, "height": 480}               the view as a scene file (its full frame)
+    {"type": "save_mesh", "cells": 128, "values": {...},
+     "options": {...}}                                                the shape as a closed STL (meshsave.py)
+    {"type": "stop_mesh"}                                             stop the mesh in progress
     {"type": "show_c"}                                                the generated C
     {"type": "export_page"}                                           the view as `implgen share`'s page
     {"type": "pick", "x": 120, "y": 80, "width": 640, "height": 480}  a scene file: edit the object at a pixel
@@ -33,6 +36,7 @@ from implgen import validate
 from implgen.codegen.grammar import format_expression
 from implgen.codegen.spec import Spec, param_symbol, parse_spec
 from implgen.errors import UserError
+from implgen.mesh.budget import MAX_CELLS, MIN_CELLS
 from implgen.view.document import CLIPS, LIGHTS, Options, Orbit
 
 MAX_MESSAGE = 64 * 1024  # bytes of one message from the page
@@ -40,7 +44,8 @@ MAX_FRAME = (2048, 2048)  # the largest interactive frame
 MAX_SAVE = (8192, 8192)  # the largest saved picture
 MAX_SAVE_PIXELS = 8192 * 4608  # 8K at 16:9
 MAX_SAVE_SPP = 64
-TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object", "export_page")
+MESH_TYPES = ("save_mesh", "stop_mesh")  # meshsave.py
+TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object", "export_page", *MESH_TYPES)
 PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
 
 _parsed: OrderedDict[str, Spec | UserError] = OrderedDict()
@@ -241,3 +246,9 @@ def parse_save(data: dict) -> tuple[int, int, int]:
         raise UserError("save_png", f"more than {MAX_SAVE_PIXELS} pixels")
     spp = validate.whole("save_png", "spp", data.get("spp", 16), 1, MAX_SAVE_SPP)
     return w, h, spp
+
+
+def parse_save_mesh(data: dict, spec: Spec) -> tuple[int, dict[str, float], Options]:
+    """Save mesh: (cells along the longest side, the param values, the options: their clip) as the page shows them."""
+    cells = validate.whole("save_mesh", "cells", data.get("cells", 128), MIN_CELLS, MAX_CELLS)
+    return cells, parse_values(data.get("values"), spec), parse_options(data.get("options", {}))

@@ -44,6 +44,7 @@ STATIC = {
     "/favicon.ico": ("favicon.ico", "image/x-icon"),
     "/app.js": ("app.js", "text/javascript; charset=utf-8"),
     "/share.js": ("share.js", "text/javascript; charset=utf-8"),
+    "/mesh.js": ("mesh.js", "text/javascript; charset=utf-8"),
     "/style.css": ("style.css", "text/css; charset=utf-8"),
 }
 HEADERS = {

@@ -39,12 +39,14 @@ from implgen.scene.renderjob import RenderJob
 from implgen.scene.tracer import CScene
 from implgen.view import dump, fit, pick, protocol, sharepage
 from implgen.view.document import Document
+from implgen.view.meshsave import MeshSaver
 from implgen.view.pace import CUT, Pace
 from implgen.view.work import Ticket, Work
 
 FULL_SPP = 4
 MAX_RENDERS_PER_SECOND = 60  # per page: requests beyond this wait (and are overtaken by newer ones)
 KIND_COARSE, KIND_FULL, KIND_SAVE, KIND_ONE = 0, 1, 2, 3  # KIND_ONE: full size at 1 sample, before KIND_FULL
+KIND_MESH = 4  # Save mesh's STL (meshsave.py)
 BUILD_QUIET, BUILD_POLL = 0.2, 0.4  # seconds: a build says nothing before the first, then repeats its progress
 REFINE_TARGET = 0.4  # seconds: a refined frame expected to take longer is first sent at 1 sample (KIND_ONE)
 HEADER = struct.Struct(">IBBxxHH")  # seq, kind, flags, width, height; the image bytes follow
@@ -133,6 +135,7 @@ class Session:
         self._task: asyncio.Task | None = None
         self._saving: asyncio.Task | None = None
         self.frames = 0  # frames sent (for tests)
+        self.meshes = MeshSaver(self.work, send, lambda stl: send(HEADER.pack(0, KIND_MESH, 0, 0, 0) + stl))
 
     # ------------------------------------------------------------------ messages
 
@@ -171,6 +174,10 @@ class Session:
                 # its own task: the page stays interactive while a large picture renders
                 self._saving = asyncio.get_running_loop().create_task(self._save_png(width, height, spp))
                 self._saving.add_done_callback(lambda _: release())
+            elif kind == "save_mesh":
+                await self.meshes.start(self.doc, data)
+            elif kind == "stop_mesh":
+                self.meshes.stop()
             elif kind == "save_yaml":
                 width, height = protocol.parse_size(data, "save_yaml")
                 text = await self.work.call(self.work.parse, dump.yaml_text, replace(self.doc), width, height, FULL_SPP)
@@ -386,3 +393,4 @@ class Session:
         for t in tasks:
             t.cancel()
         await asyncio.gather(*tasks, return_exceptions=True)  # work.trace waits for the C threads to stop
+        await self.meshes.close()

@@ -5,8 +5,8 @@ C render, one memory bound for all saves.
             thread, so heavy equations queue up there and never stop the event loop; the libraries built are
             kept for every page that shows the same shapes
     render  the pages' live frames, each encoded on the same thread: a few at once
-    save    Save PNG: one at a time; the memory of every save asked for, running or waiting, is reserved when it
-            is asked for and refused beyond the bound
+    save    Save PNG and Save mesh: one at a time; the memory of every save asked for, running or waiting, is
+            reserved when it is asked for and refused beyond the bound
 
 A C render (a live frame or a save) runs under a `Ticket`: the page cancels it when a newer request comes or when
 it closes, and a timer on the event loop cancels it when its time budget is spent (rt_render_cancel: the C threads
@@ -15,6 +15,9 @@ effect between rows only, so a render whose single row would outlast its budget 
 the page's previous render, times the row's samples) is refused before it starts. The threads are daemons and
 `Work.shutdown` cancels every render, so Ctrl-C never waits for one: a parse or a build still running ends with
 the process.
+
+A mesh (meshsave.py) is not a C render: it runs `stoppable`, its own time budget and stop checked by the mesh
+pipeline between slices of its work (implgen.mesh.budget); a cancelled caller, or `shutdown`, sets the stop.
 
 `Limits` holds every number; `implgen view` reads them from IMPLGEN_VIEW_* environment variables
 (docs/viewer.md#limits), which the tests set small.
@@ -50,6 +53,7 @@ class Limits:
     max_pages: int = 8  # pages connected at once, each counted until its last piece of work has ended
     render_budget: float = 20.0  # seconds of one live frame's C render
     save_budget: float = 300.0  # seconds of one save's C render
+    mesh_budget: float = 120.0  # seconds of one Save mesh
     save_memory: float = 2048.0  # MB reserved by all saves, running or waiting
     idle: float = 600.0  # seconds a page may send nothing before it is closed
     ping: float = 20.0  # seconds between WebSocket pings, and for the answer: a vanished peer is closed
@@ -214,6 +218,7 @@ class Work:
         self.save = Pool("save", self.limits.save_threads)
         self._lock = threading.Lock()
         self._tickets: set[Ticket] = set()
+        self._stops: set[threading.Event] = set()  # the meshes running or waiting (stoppable)
         self._save_bytes = 0
         self._libraries: OrderedDict[tuple, tuple[Any, list]] = OrderedDict()  # loop only
         self._waiting: set[asyncio.Future] = set()  # `call`s waiting for a parse or a build (loop only)
@@ -264,20 +269,44 @@ class Work:
             with self._lock:
                 self._tickets.discard(ticket)
 
+    async def stoppable(self, pool: Pool, stop: threading.Event, fn: Callable, *args) -> Any:
+        """fn(*args) on the pool, fn looking at `stop` as it goes (a mesh): a cancelled caller sets it and waits for
+        fn to end (its page is counted until then); shutdown sets it too."""
+        with self._lock:
+            if self.closed:
+                raise asyncio.CancelledError
+            self._stops.add(stop)
+        fut = asyncio.wrap_future(pool.submit(fn, *args))
+        fut.add_done_callback(lambda f: f.cancelled() or f.exception())  # heard even when no one waits (Ctrl-C)
+        try:
+            return await asyncio.shield(fut)
+        except asyncio.CancelledError:
+            stop.set()
+            if not self.closed:
+                await asyncio.wait([fut])
+            raise
+        finally:
+            with self._lock:
+                self._stops.discard(stop)
+
     def reserve_save(self, pixels: int) -> Callable[[], None]:
-        """Reserve a save's memory, or refuse it in one line; returns the release (call it once, any thread)."""
-        need = pixels * SAVE_BYTES_PER_PIXEL
+        """Reserve a picture's memory, or refuse it in one line; returns the release (call it once, any thread)."""
+        return self.reserve(pixels * SAVE_BYTES_PER_PIXEL, "save_png", f"a picture of {pixels} pixels")
+
+    def reserve(self, need: int, source: str, what: str, hint: str = "") -> Callable[[], None]:
+        """Reserve `need` bytes of the saves' memory for `what`, or refuse it in one line naming `source` (and
+        ending with `hint`); returns the release (call it once, any thread)."""
         bound = self.limits.save_memory * MB
         if need > bound:
             raise UserError(
-                "save_png",
-                f"a picture of {pixels} pixels needs about {need / MB:.0f} MB; saves may use at most "
-                f"{self.limits.save_memory:g} MB together",
+                source,
+                f"{what} needs about {need / MB:.0f} MB; saves may use at most {self.limits.save_memory:g} MB "
+                f"together{hint}",
             )
         with self._lock:
             if self._save_bytes + need > bound:
                 raise UserError(
-                    "save_png",
+                    source,
                     f"the saves in progress use {self._save_bytes / MB:.0f} MB of the {self.limits.save_memory:g} MB "
                     f"allowed and this one needs {need / MB:.0f} MB: try again when they are done",
                 )
@@ -298,8 +327,11 @@ class Work:
         with self._lock:
             self.closed = True
             tickets = list(self._tickets)
+            stops = list(self._stops)
         for t in tickets:
             t.cancel()
+        for stop in stops:
+            stop.set()
         for fut in list(self._waiting):
             try:
                 fut.cancel()

@@ -7,7 +7,7 @@
   const canvas = $("view");
   const ctx2d = canvas.getContext("2d");
   const HEADER = 12; // seq (u32), kind (u8), flags (u8), 2 spare bytes, width (u16), height (u16)
-  const KIND_COARSE = 0, KIND_FULL = 1, KIND_SAVE = 2, KIND_ONE = 3;
+  const KIND_COARSE = 0, KIND_FULL = 1, KIND_SAVE = 2, KIND_ONE = 3, KIND_MESH = 4;
   const RANK = { [KIND_COARSE]: 0, [KIND_ONE]: 1, [KIND_FULL]: 2 }; // a newer frame of the same request wins
   const KIND_NAME = { [KIND_COARSE]: "coarse", [KIND_ONE]: "full, 1 sample", [KIND_FULL]: "full" };
   const FLAG_EMPTY = 1; // the frame shows nothing but the background
@@ -264,6 +264,7 @@
     const w = view.getUint16(8), h = view.getUint16(10);
     const bytes = new Uint8Array(buf, HEADER);
     lastError = "";
+    if (kind === KIND_MESH) { implgenMesh.received(bytes); return; } // Save mesh (mesh.js)
     if (kind === KIND_SAVE) {
       download(new Blob([bytes], { type: "image/png" }), "implgen-view.png");
       showMessage(`saved ${w} x ${h} PNG`, false);
@@ -350,6 +351,8 @@
       } else {
         showMessage(msg.message, true);
       }
+    } else if (msg.type === "mesh") {
+      implgenMesh.message(msg);
     } else if (msg.type === "yaml") {
       download(new Blob([msg.text], { type: "application/yaml" }), `${$("shape-name").value.replace(/[^A-Za-z0-9_]/g, "") || "scene"}.yaml`);
     } else if (msg.type === "page") {
@@ -369,6 +372,7 @@
     ws.binaryType = "arraybuffer";
     ws.addEventListener("message", onMessage);
     ws.addEventListener("close", (e) => {
+      implgenMesh.reset(); // Save mesh (mesh.js)
       const why = e.reason ? `: ${e.reason}` : " (reload to reconnect)";
       // the error the server closed after stays in view (a scene file that no longer reads, too many pages)
       const text = e.code === 1013 && lastError ? lastError
@@ -525,5 +529,6 @@
   window.implgenState = () => JSON.parse(JSON.stringify({ orbit: state.orbit, options: readOptions(),
     values: state.values }));
 
+  implgenMesh.attach({ send, showMessage, download }); // Save mesh (mesh.js)
   connect();
 })();
