@@ -25,8 +25,9 @@ from implgen_proc import implgen
 ROOT = Path(__file__).resolve().parent.parent
 HEAVY = ROOT / "examples/mesh/chmutov20.yaml"  # degree 20: the costliest of bench/results/mesh_budget.md
 TORUS = ROOT / "examples/shapes/torus_z.yaml"
-# How far past its deadline a mesh may stop: a slice of a C batch call or one phase's NumPy work (at most 0.13 s in
-# bench/results/mesh_budget.md, 4.2 s before the contour's phases moved into C), with room for a loaded 2-core machine. Far below the unbudgeted run.
+# How far past its deadline a mesh may stop: a slice of a C batch call or one phase's NumPy work (at most 0.13 s
+# in bench/results/mesh_budget.md; 4.2 s before the contour's phases moved into C), with room for a loaded 2-core
+# machine. Far below the unbudgeted run.
 LATE = 6.0
 
 
