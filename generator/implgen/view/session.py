@@ -37,7 +37,7 @@ from implgen.scene.model import Scene
 from implgen.scene.render import usable_cores
 from implgen.scene.renderjob import RenderJob
 from implgen.scene.tracer import CScene
-from implgen.view import dump, fit, pick, protocol, sharepage
+from implgen.view import dump, fit, gpu, pick, protocol, sharepage
 from implgen.view.document import Document
 from implgen.view.pace import CUT, Pace
 from implgen.view.work import Ticket, Work
@@ -133,13 +133,15 @@ class Session:
         self._task: asyncio.Task | None = None
         self._saving: asyncio.Task | None = None
         self.frames = 0  # frames sent (for tests)
+        self._shape_id = 0  # numbers the shapes sent to the page (hello, shape replies), for the GPU preview
 
     # ------------------------------------------------------------------ messages
 
     def hello(self) -> dict:
         """The state the page starts from."""
         limits = {"frame": protocol.MAX_FRAME, "save": protocol.MAX_SAVE, "save_spp": protocol.MAX_SAVE_SPP}
-        return {"type": "hello", **self.doc.state(), "limits": limits}
+        hello = {"type": "hello", **self.doc.state(), "limits": limits}
+        return {**hello, "gpu": gpu.hello_part(), "shape_id": self._shape_id}
 
     def _shape_reply(self, **extra) -> dict:
         """The page's new shape: its name, equation, params and their values (and what `extra` adds)."""
@@ -151,6 +153,7 @@ class Session:
             "params": spec.params,
             "values": self.doc.values,
             "degree": spec.degree,
+            "shape_id": self._shape_id,
             **extra,
         }
 
@@ -180,6 +183,9 @@ class Session:
             elif kind == "export_page":
                 name, html = await self.work.call(self.work.parse, sharepage.page_text, replace(self.doc))
                 await self.send({"type": "page", "name": name, "text": html})
+            elif kind == "glsl":  # the page's GPU preview asks for the current shape's GLSL
+                msg = await self.work.call(self.work.parse, gpu.program_message, replace(self.doc))
+                await self.send({**msg, "shape_id": self._shape_id})
             elif kind == "show_c":
                 await self.send(
                     {"type": "c", "text": await self.work.call(self.work.parse, dump.c_text, self.doc.spec)}
@@ -203,6 +209,7 @@ class Session:
         self.doc.select(index)
         self._cost = None
         self.pace.new_shape()
+        self._shape_id += 1
         await self.send(self._shape_reply(fit=None, object=index, objects=self.doc.objects()))
 
     def _mode(self) -> str:
@@ -221,6 +228,7 @@ class Session:
         self._shown = None  # an accepted shape is drawn coarse first, even the same one again
         self._cost = None  # measured anew by the new shape's first render
         self.pace.new_shape()
+        self._shape_id += 1
         await self.send(self._shape_reply(fit=fitted, objects=self.doc.objects()))
 
     # ------------------------------------------------------------------ rendering
@@ -289,7 +297,9 @@ class Session:
 
     async def _frames(self, req: protocol.RenderRequest) -> None:
         view = (req.width, req.height, req.values, req.orbit, req.options, id(self.doc.spec))
-        while not (req.refine and view == self._shown):
+        if req.gpu and not req.refine:
+            return  # the page draws the live picture itself: the view is noted (and a refinement cancelled)
+        while not (req.refine and (view == self._shown or req.gpu)):
             cw, ch = self.pace.size(req.width, req.height)
             smallest = self.pace.smallest(req.width, req.height, cw)
             data, ticket = await self._render(cw, ch, 1, _live_jpeg, full=False, cut=not smallest)
