@@ -171,6 +171,7 @@ def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
             "params": {"r": 1.5},
             "values": {"r": 1.5},
             "degree": 2,
+            "shape_id": 1,  # the first shape accepted since the hello (the GPU preview's GLSL names it)
             "fit": None,  # not asked for
             "objects": [],  # a scene file's, to pick from
         }
@@ -577,7 +578,7 @@ def test_export_page_is_the_shared_page_of_this_view(client) -> None:
     start = html.index('<script type="application/json" id="ig-data">')
     data = json.loads(html[html.index(">", start) + 1 : html.index("</script>", start)])
     assert data["orbit"] == {**orbit, "target": list(orbit["target"])}
-    assert data["clip"] == {"kind": "box", "size": 2.5}
+    assert data["clip"] == {"kind": "box", "size": 2.5, "cut": False}
     assert {p["name"]: p["value"] for p in data["params"]} == pytest.approx(values)
     for p in data["params"]:
         assert p["min"] <= p["value"] <= p["max"]
