@@ -64,7 +64,7 @@ def server_only(doc: Document) -> str | None:
         parts.append(f"{len(doc.base.leaves())} shapes")
     parts += sorted(found)
     what = ", ".join(parts) if parts else "its own lights, materials and transforms"
-    return f"a scene file ({what}): the server draws every frame"
+    return f"a scene file ({what}): the GLSL page draws one shape alone"
 
 
 def program_message(doc: Document) -> dict:
@@ -75,10 +75,10 @@ def program_message(doc: Document) -> dict:
         try:
             shape = generate(spec, ("glsl",))[f"{spec.name}.glsl"]
         except UserError as err:
-            reason = f"the GLSL target cannot draw this shape ({err.message}): the server draws every frame"
+            reason = f"the GLSL target cannot draw this shape: {err.message}"
         except Exception:  # a bug in the GLSL backend: the server's path still draws; the log says why
             log.exception("GLSL generation failed")
-            reason = "the GLSL target failed on this shape: the server draws every frame"
+            reason = "the GLSL target failed on this shape"
         else:
             return {"type": "glsl", "name": spec.name, "shape": shape, "params": list(spec.params)}
     return {"type": "glsl", "name": spec.name, "reason": reason}

@@ -198,6 +198,7 @@ const ImplgenGpu = (() => {
       overlay.getContext("2d").putImageData(out, 0, 0);
       overlay.hidden = false;
       g.compared = { width: w, height: h, differ, unsure, unflagged };
+      overlay.dataset.seq = view.dataset.seq;
       overlay.dataset.differ = differ;
       overlay.dataset.unsure = unsure;
       const pc = (n) => `${((100 * n) / (w * h)).toFixed(2)} %`;
@@ -218,7 +219,9 @@ const ImplgenGpu = (() => {
       say();
     });
     say();
-    return { hello, shape, program, active, draw, serverFrame, state: g, renderer: () => g.renderer };
+    const api = { hello, shape, program, active, draw, serverFrame, state: g, renderer: () => g.renderer };
+    window.implgenGpu = api; // for tests and for the curious, in the browser's console
+    return api;
   }
 
   return { create, DIFF_LEVELS };
