@@ -198,6 +198,44 @@ void main()
     return HEADER + runtime + "\n" + shape + "\n" + main;
   }
 
+  /** VERTEX and a fragment shader compiled and linked, the vertex attribute `p` at location 0: the program, or
+   * an Error carrying the compiler's (or the linker's) log. Also the GLSL test harness's (implgen.bench.webgl). */
+  function compileProgram(gl, fragment) {
+    const shaders = [];
+    const compile = (type, text) => {
+      const s = gl.createShader(type);
+      gl.shaderSource(s, text);
+      gl.compileShader(s);
+      shaders.push(s);
+      if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s) || "the shader did not compile");
+      return s;
+    };
+    const prog = gl.createProgram();
+    try {
+      gl.attachShader(prog, compile(gl.VERTEX_SHADER, VERTEX));
+      gl.attachShader(prog, compile(gl.FRAGMENT_SHADER, fragment));
+      gl.bindAttribLocation(prog, 0, "p");
+      gl.linkProgram(prog);
+      if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog) || "the program did not link");
+    } catch (err) {
+      gl.deleteProgram(prog);
+      throw err;
+    } finally {
+      for (const s of shaders) gl.deleteShader(s); // the program keeps what it linked
+    }
+    return prog;
+  }
+
+  /** The one triangle that covers the viewport, bound to attribute 0; returns its buffer. */
+  function fullScreenTriangle(gl) {
+    const vbo = gl.createBuffer();
+    gl.bindBuffer(gl.ARRAY_BUFFER, vbo);
+    gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-1, -1, 3, -1, -1, 3]), gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(0);
+    gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 0, 0);
+    return vbo;
+  }
+
   const finite3 = (v, what) => {
     if (!Array.isArray(v) || v.length !== 3 || !v.every(Number.isFinite)) throw new Error(`${what}: three numbers`);
     return v.map(Number);
@@ -224,11 +262,7 @@ void main()
       this.width = canvas.width;
       this.height = canvas.height;
       this.coarse = null; // {fbo, rb, w, h}: the target of scaled-down draws
-      const vbo = gl.createBuffer();
-      gl.bindBuffer(gl.ARRAY_BUFFER, vbo);
-      gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-1, -1, 3, -1, -1, 3]), gl.STATIC_DRAW);
-      gl.enableVertexAttribArray(0);
-      gl.vertexAttribPointer(0, 2, gl.FLOAT, false, 0, 0);
+      fullScreenTriangle(gl);
     }
 
     /** Which WebGL2 this is: [version, renderer]. */
@@ -248,28 +282,8 @@ void main()
       } catch (err) {
         return String(err.message || err);
       }
-      const compile = (type, text) => {
-        const s = gl.createShader(type);
-        gl.shaderSource(s, text);
-        gl.compileShader(s);
-        if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) {
-          const log = gl.getShaderInfoLog(s) || "the shader did not compile";
-          gl.deleteShader(s);
-          throw new Error(log);
-        }
-        return s;
-      };
       try {
-        const prog = gl.createProgram();
-        gl.attachShader(prog, compile(gl.VERTEX_SHADER, VERTEX));
-        gl.attachShader(prog, compile(gl.FRAGMENT_SHADER, src));
-        gl.bindAttribLocation(prog, 0, "p");
-        gl.linkProgram(prog);
-        if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) {
-          const log = gl.getProgramInfoLog(prog) || "the program did not link";
-          gl.deleteProgram(prog);
-          throw new Error(log);
-        }
+        const prog = compileProgram(gl, src);
         if (this.prog) gl.deleteProgram(this.prog);
         this.prog = prog;
       } catch (err) {
@@ -592,7 +606,7 @@ void main()
     }
   }
 
-  return { Renderer, Progressive, fragmentSource, CLIPS, LIGHT, MAX_LIGHTS };
+  return { Renderer, Progressive, fragmentSource, compileProgram, fullScreenTriangle, CLIPS, LIGHT, MAX_LIGHTS };
 })();
 
 if (typeof window !== "undefined") window.IgSurface = IgSurface;

@@ -77,6 +77,7 @@ const ImplgenGpu = (() => {
     function shape(msg) {
       g.shapeId = msg.shape_id;
       g.shape = null;
+      g.view = null;
       g.reason = "";
       stop();
       ask();
@@ -137,7 +138,14 @@ const ImplgenGpu = (() => {
     function draw(v, moving) {
       if (!active()) return false;
       const key = JSON.stringify(v);
-      apply(v);
+      try {
+        apply(v);
+      } catch (err) { // a view the renderer refuses (it should not happen): the server draws, and says so
+        g.reason = `GPU preview off: ${err.message || err}`;
+        stop();
+        say();
+        return false;
+      }
       g.view = v;
       glCanvas.hidden = false;
       overlay.hidden = true;
@@ -211,7 +219,11 @@ const ImplgenGpu = (() => {
       if (toggle.checked && g.programId !== g.shapeId && !g.reason) ask();
       say();
     });
-    compare.addEventListener("change", () => { if (!compare.checked) overlay.hidden = true; });
+    compare.addEventListener("change", () => {
+      if (!compare.checked) { overlay.hidden = true; say(); return; }
+      // ticked while the server's picture is shown: compare it now, not at the next one
+      if (active() && g.view && view.dataset.shown === "server") runCompare(view.getContext("2d"));
+    });
     glCanvas.addEventListener("webglcontextlost", (e) => {
       e.preventDefault();
       g.failure = "GPU preview off: the browser took the GPU away (WebGL context lost)";
