@@ -41,6 +41,13 @@ WebGL2RenderingContext.prototype.getShaderParameter = function (shader, what) {
 };
 WebGL2RenderingContext.prototype.getShaderInfoLog = function () { return "ERROR: 0:1: refused by the test"; };
 """
+A_GPU = """
+const original = WebGL2RenderingContext.prototype.getParameter;
+WebGL2RenderingContext.prototype.getParameter = function (what) {
+  const e = this.getExtension("WEBGL_debug_renderer_info");
+  return e && what === e.UNMASKED_RENDERER_WEBGL ? "ANGLE (a hardware GPU, said the test)" : original.call(this, what);
+};
+"""
 CSG_SCENE = {
     "image": {"width": 64, "height": 48},
     "camera": {"position": [0, 1, 5], "look_at": [0, 0, 0], "fov": 40},
@@ -324,6 +331,18 @@ def test_without_webgl2_or_a_shader_the_server_draws_as_before(torus_server, dri
     assert [k for k in kinds if k["kind"] == "coarse"], "no coarse server frames while dragging"
     assert all(k["gl_hidden"] and k["gl_frames"] == 0 for k in kinds)
     until(d, lambda d: view_state(d)["kind"] == "full" and view_state(d)["seq"] > before["seq"], "no refined frame")
+
+
+def test_with_a_hardware_gpu_the_preview_is_on_from_the_start(torus_server, driver) -> None:
+    """The renderer's name is not a software one: the box is ticked and the first drag is the GPU's."""
+    d = driver
+    before = open_page(d, torus_server, script=A_GPU, gpu=False)
+    assert js(d, "return document.getElementById('gpu').checked")
+    until(d, lambda d: view_state(d)["path"] == "gpu", "the GPU preview did not start")
+    assert "a hardware GPU, said the test" in view_state(d)["note"]
+    moving = drag(d, steps=3, during=lambda d: view_state(d))
+    assert all(s["shown"] == "gpu" for s in moving) and moving[-1]["gl_frames"] > 0
+    until(d, lambda d: view_state(d)["shown"] == "server" and view_state(d)["seq"] > before["seq"], "no server frame")
 
 
 def test_a_csg_scene_is_the_server_s(tmp_path, driver) -> None:
