@@ -13,7 +13,7 @@
   const FLAG_EMPTY = 1; // the frame shows nothing but the background
   // the GPU preview (gpu.js): draws the live picture in this browser where it can, else null or inactive
   const gpu = window.ImplgenGpu ? ImplgenGpu.create({ stage: $("stage"), view: canvas, note: $("gpu-note"),
-    toggle: $("gpu"), compare: $("compare") }) : null;
+    toggle: $("gpu"), compare: $("compare"), status: $("status") }) : null;
 
   const state = {
     params: {}, // name -> default (as the server parsed it)

@@ -13,7 +13,7 @@ const ImplgenGpu = (() => {
   const UNSURE = [0, 230, 255, 255]; // cyan where the GLSL could not decide, yellow where both
   const BOTH = [255, 230, 0, 255];
 
-  function create({ stage, view, note, toggle, compare }) {
+  function create({ stage, view, note, toggle, compare, status = null }) {
     const glCanvas = document.createElement("canvas");
     glCanvas.id = "gpu-view";
     glCanvas.hidden = true;
@@ -102,7 +102,15 @@ const ImplgenGpu = (() => {
           g.shape = msg;
           g.programId = msg.shape_id;
           g.progressive = g.progressive || new IgSurface.Progressive(g.renderer, {
-            onStep: () => { g.frames += 1; glCanvas.dataset.frames = g.frames; },
+            onStep: (p) => {
+              g.frames += 1;
+              glCanvas.dataset.frames = g.frames;
+              if (status && view.dataset.shown === "gpu") { // the status line: what the GPU draws now
+                const r = g.renderer;
+                const done = p.moving ? "while moving" : p.row >= r.height ? "done" : `${Math.round((100 * p.row) / r.height)} %`;
+                status.textContent = `GPU ${r.width} x ${r.height}, ${done}`;
+              }
+            },
           });
         }
       }
