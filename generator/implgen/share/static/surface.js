@@ -108,6 +108,14 @@ bool ig_page_blocked(vec3 o, vec3 d, float tmax, inout int status)
     return (s & IG_HIT) != 0;
 }
 
+// Whether f's sign at the point q is certain in float (its coordinates' rounding counted): a shadow ray that
+// starts there does not start inside the surface's rounding noise.
+bool ig_page_certain(vec3 q)
+{
+    vec3 e = IG_ULP * abs(q) * (1.0 + IG_UP_REL) + IG_TINY;
+    return ig_raa_sign(SHAPE_raa(ig_raa_var(q.x, 0.0, e.x), ig_raa_var(q.y, 0.0, e.y), ig_raa_var(q.z, 0.0, e.z))) != 0;
+}
+
 // Two-sided shading as the C tracer's (runtime_c/tracer_shade.c): ambient, then for each light that faces the
 // side seen, Lambert and a Blinn-Phong highlight times the light's colour (0 in shadow).
 vec3 ig_page_shade(vec3 front, vec3 back, vec3 n, vec3 d, vec3 p, IgCamera cam, inout int status)
@@ -117,8 +125,14 @@ vec3 ig_page_shade(vec3 front, vec3 back, vec3 n, vec3 d, vec3 p, IgCamera cam, 
     vec3 nf = behind ? -n : n;
     vec3 base = behind ? back : front;
     vec3 colour = ig_page_material.x * base;
-    // shadow rays leave a little off the surface: the float hit point is only that accurate
-    vec3 start = p + nf * (4.0e-4 * (length(p) + length(p - cam.eye)) + 1.0e-6);
+    // shadow rays leave a little off the surface (the float hit point is only that accurate), and further, up to
+    // 64 times, until f's sign is certain there (a high degree's rounding noise is wide)
+    float off = 4.0e-4 * (length(p) + length(p - cam.eye)) + 1.0e-6;
+    vec3 start = p + nf * off;
+    for (int k = 0; k < 3 && ig_page_shadows != 0 && !ig_page_certain(start); ++k) {
+        off *= 4.0;
+        start = p + nf * off;
+    }
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= ig_page_nlights) {
             break;
