@@ -471,9 +471,10 @@ void main()
       this.coarse = { fbo, rb, w, h };
     }
 
-    /** What each pixel's ray found, at full size, drawn off screen (the canvas keeps its picture): RGBA bytes,
-     * bottom row first, red 255 where it hit, green 255 where float could not decide (IG_UNSURE). */
-    statusPixels() {
+    /** What each pixel's ray found, at full size, drawn off screen (the canvas keeps its picture) in bands of
+     * `band` rows (no single draw long enough for a GPU watchdog): RGBA bytes, bottom row first, red 255 where
+     * it hit, green 255 where float could not decide (IG_UNSURE). */
+    statusPixels(band = 32) {
       const gl = this.gl;
       const out = new Uint8Array(4 * this.width * this.height);
       if (!this.prog) return out;
@@ -486,10 +487,15 @@ void main()
       gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
       gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.RENDERBUFFER, rb);
       gl.useProgram(this.prog);
-      gl.disable(gl.SCISSOR_TEST);
       gl.viewport(0, 0, w, h);
       this._uniforms(w, h, 1);
-      gl.drawArrays(gl.TRIANGLES, 0, 3);
+      gl.enable(gl.SCISSOR_TEST);
+      for (let y = 0; y < h; y += band) {
+        gl.scissor(0, y, w, Math.min(band, h - y));
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+        gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4)); // finish this band first
+      }
+      gl.disable(gl.SCISSOR_TEST);
       gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, out);
       gl.bindFramebuffer(gl.FRAMEBUFFER, null);
       gl.deleteFramebuffer(fbo);
