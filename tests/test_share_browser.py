@@ -346,12 +346,13 @@ def test_a_clip_box_cuts_the_solid_and_shows_its_inside(gl, tmp_path):
     """The infinite cylinder x^2 + z^2 < 1 in the clip box [-0.8, 0.8]^3: where a ray enters the box inside the
     solid, the page shows the cut face, flat on the box, in the inside colour; where it misses the box, the
     background. Checked against the camera, the box and the shading computed here in double precision, away
-    from the cut faces' edges."""
+    from the cut faces' edges. Unticking "cut solid" shows the surface cut open instead (the viewer's default):
+    no cut face is painted."""
     spec_path = SHAPES_DIR / "cylinder.yaml"
-    d = open_page(gl, make_page(tmp_path, spec_path, "--clip", "box", "--clip-size", "0.8"))
+    d = open_page(gl, make_page(tmp_path, spec_path, "--clip", "box", "--clip-size", "0.8", "--cut"))
     state = page_state(d)
     page = canvas(d)[::-1, :, :3].astype(int)  # top row first
-    assert state["clip"] == {"kind": "box", "size": 0.8}
+    assert state["clip"] == {"kind": "box", "size": 0.8, "cut": True}
     cam = state["camera"]
     eye, look, up = (np.asarray(cam[k], float) for k in ("eye", "target", "up"))
     w_ = (eye - look) / np.linalg.norm(eye - look)
@@ -386,6 +387,12 @@ def test_a_clip_box_cuts_the_solid_and_shows_its_inside(gl, tmp_path):
     assert (np.abs(page - bg).max(-1)[miss] <= 2).all()
     for face in range(3):  # the picture shows cut faces on three sides of the box, each in its own shade
         assert (cut & (axis == face)).sum() > 50
+    d.find_element("id", "ig-cut").click()
+    wait_idle(d)
+    assert page_state(d)["clip"]["cut"] is False
+    opened = canvas(d)[::-1, :, :3].astype(int)
+    assert (np.abs(opened - want).max(-1)[cut] <= 2).mean() < 0.05  # no cut face
+    assert (np.abs(opened - bg).max(-1)[miss] <= 2).all()
 
 
 def test_a_frame_drawn_in_bands_is_the_frame_drawn_at_once(gl, tmp_path):

@@ -20,7 +20,7 @@ import pytest
 from conftest import ROOT, SHAPES_DIR
 from implgen.cli import main
 from implgen.codegen.emit import generate
-from implgen.codegen.glslprogram import runtime_text
+from implgen.codegen.glslprogram import HEADERS, runtime_text
 from implgen.codegen.spec import load_spec
 from implgen.share.page import script_json
 
@@ -161,9 +161,14 @@ def test_params_ranges_and_clip_from_the_options(tmp_path, capsys):
         ("a", 1.0, 0.0, 2.0),
         ("b", 0.4, 0.05, 0.5),
     ]
-    assert data["clip"] == {"kind": "box", "size": 1.5}
+    assert data["clip"] == {"kind": "box", "size": 1.5, "cut": False}  # the viewer's default: cut open
     (selected,) = [a["value"] for t, a in p.tags if t == "option" and "selected" in a]
     assert selected == "box"
+    assert not [a for t, a in p.tags if t == "input" and a.get("id") == "ig-cut" and "checked" in a]
+    assert share(tmp_path, str(SHAPES_DIR / "torus_y.yaml"), *args, "--cut", capsys=capsys)[0] == 0
+    _, p = parse_page(out)
+    assert page_data(p)["clip"] == {"kind": "box", "size": 1.5, "cut": True}
+    assert [a for t, a in p.tags if t == "input" and a.get("id") == "ig-cut" and "checked" in a]
 
 
 def test_a_slider_runs_over_the_spec_s_own_range(tmp_path, capsys):
@@ -233,16 +238,16 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, argv, messag
 
 def _page_fragment(html: str) -> tuple[str, str]:
     """The fragment shader a page compiles, assembled as surface.js's fragmentSource does: the header, the
-    runtime and the shape from the JSON block, the main from surface.js's MAIN (SHAPE and MATERIAL replaced)."""
+    runtime and the shape from the JSON block, the main from surface.js's MAIN (SHAPE and MAX_LIGHTS replaced)."""
     p = Elements()
     p.feed(html)
     data = page_data(p)
     surface = p.raw["script"][1]
     main_src = re.search(r"const MAIN = `(.*?)`;", surface, re.S).group(1)
-    material = re.search(r'const MATERIAL = "([^"]+)";', surface).group(1)
-    header = "#version 300 es\nprecision highp float;\nprecision highp int;\n"
-    main_src = main_src.replace("SHAPE", data["name"]).replace("MATERIAL", material)
-    return data["name"], header + data["runtime"] + "\n" + data["shape"] + "\n" + main_src
+    lights = re.search(r"const MAX_LIGHTS = (\d+);", surface).group(1)
+    assert data["header"] == HEADERS["es"]  # the one source of the GLSL ES header
+    main_src = main_src.replace("SHAPE", data["name"]).replace("MAX_LIGHTS", lights)
+    return data["name"], data["header"] + data["runtime"] + "\n" + data["shape"] + "\n" + main_src
 
 
 @pytest.mark.needs_program("glslangValidator")

@@ -23,6 +23,7 @@ from implgen.scene import build
 from implgen.scene.load import parse_scene
 from implgen.scene.render import render
 from implgen.scene.tracer import CScene
+from implgen.view import frames as view_frames
 from implgen.view import session as session_mod
 from implgen.view.command import document_factory
 from implgen.view.document import Document
@@ -171,6 +172,7 @@ def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
             "params": {"r": 1.5},
             "values": {"r": 1.5},
             "degree": 2,
+            "shape_id": 1,  # the first shape accepted since the hello (the GPU preview's GLSL names it)
             "fit": None,  # not asked for
             "objects": [],  # a scene file's, to pick from
         }
@@ -293,7 +295,7 @@ def test_failures_are_one_error_reply_and_the_page_keeps_going(client, monkeypat
 
     with client.websocket_connect("/ws") as ws:
         hello = reply(ws)
-        monkeypatch.setattr(session_mod, "RenderJob", bug)
+        monkeypatch.setattr(view_frames, "RenderJob", bug)
         ws.send_text(render_msg(hello, seq=1, refine=False))
         assert reply(ws) == {
             "type": "error",
@@ -302,7 +304,7 @@ def test_failures_are_one_error_reply_and_the_page_keeps_going(client, monkeypat
         }
         monkeypatch.undo()
         for raise_, line in ((bug, "internal error: ZeroDivisionError"), (bad, "save_png: too big for today")):
-            monkeypatch.setattr(session_mod, "_file_png", raise_)  # the save, on its pool thread
+            monkeypatch.setattr(view_frames, "file_png", raise_)  # the save, on its pool thread
             ws.send_text(json.dumps({"type": "save_png", "width": 32, "height": 32, "spp": 1}))
             assert reply(ws) == {"type": "error", "field": "message", "message": line}
         ws.send_text(json.dumps({"type": "shape", "equation": "x^2 +"}))
@@ -577,7 +579,7 @@ def test_export_page_is_the_shared_page_of_this_view(client) -> None:
     start = html.index('<script type="application/json" id="ig-data">')
     data = json.loads(html[html.index(">", start) + 1 : html.index("</script>", start)])
     assert data["orbit"] == {**orbit, "target": list(orbit["target"])}
-    assert data["clip"] == {"kind": "box", "size": 2.5}
+    assert data["clip"] == {"kind": "box", "size": 2.5, "cut": False}
     assert {p["name"]: p["value"] for p in data["params"]} == pytest.approx(values)
     for p in data["params"]:
         assert p["min"] <= p["value"] <= p["max"]

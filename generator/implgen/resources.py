@@ -54,6 +54,12 @@ def gallery_dir() -> Path:
     return installed if installed.is_dir() else _TREE / "examples" / "shapes"
 
 
+def surface_js() -> Path:
+    """The WebGL2 drawing code (`IgSurface`): the shared page's and the viewer's renderer, and the compile step of
+    the GLSL browser harness (implgen.bench.webgl). Package data of implgen.share."""
+    return _PACKAGE_DIR / "share" / "static" / "surface.js"
+
+
 def runtime_sources(*groups: tuple[str, ...]) -> list[Path]:
     """Paths of the runtime sources in the given groups (e.g. SOLVER_SOURCES, SHAPE_SOURCES), in order."""
     return [runtime_dir() / name for group in groups for name in group]

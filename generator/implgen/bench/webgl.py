@@ -8,7 +8,9 @@ explicitly, so the same renderer is used with or without a GPU on the machine.
 `WebGL.run(fragment, size, uniforms, origins, dirs)` runs a fragment shader once per ray: origin and direction
 come in as RGBA32F textures (xyz, and w = tmin for the origin, tmax for the direction), the shader writes an
 RGBA32F pixel, and the pixels come back as a float32 array, tile by tile (a long draw is split into bands of
-rows, each finished and read before the next, so no single draw runs long enough for a watchdog).
+rows, each finished and read before the next, so no single draw runs long enough for a watchdog). The harness
+page compiles and draws with the renderer's own code (share/static/surface.js: `IgSurface.compileProgram`,
+`IgSurface.fullScreenTriangle`, the one vertex shader), run before the harness's script.
 """
 
 from __future__ import annotations
@@ -17,6 +19,8 @@ import base64
 import shutil
 
 import numpy as np
+
+from implgen.resources import surface_js
 
 FLAGS = (
     "--headless=new",
@@ -27,16 +31,15 @@ FLAGS = (
     "--window-size=800,600",
 )
 
+# After surface.js (the shared page's and the viewer's renderer, whose compile step and full-screen triangle it
+# uses: one copy of that code): a canvas whose shader runs once per ray of a texture.
 _HARNESS = r"""
 const canvas = document.createElement('canvas');
 document.body.appendChild(canvas);
 const gl = canvas.getContext('webgl2', {antialias: false, preserveDrawingBuffer: true});
 if (!gl) { window.ig = {error: 'no WebGL2'}; return 'no WebGL2'; }
 if (!gl.getExtension('EXT_color_buffer_float')) { window.ig = {error: 'no EXT_color_buffer_float'}; return 'no float'; }
-const vsrc = '#version 300 es\nin vec2 p;\nvoid main() { gl_Position = vec4(p, 0.0, 1.0); }\n';
-const vbo = gl.createBuffer();
-gl.bindBuffer(gl.ARRAY_BUFFER, vbo);
-gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-1, -1, 3, -1, -1, 3]), gl.STATIC_DRAW);
+const vbo = IgSurface.fullScreenTriangle(gl);
 function b64floats(s) {
   const bin = atob(s); const bytes = new Uint8Array(bin.length);
   for (let i = 0; i < bin.length; ++i) bytes[i] = bin.charCodeAt(i);
@@ -61,18 +64,8 @@ window.ig = {
     return [gl.getParameter(gl.VERSION), e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER)];
   },
   compile(fsrc) {
-    const shader = (type, src) => {
-      const s = gl.createShader(type); gl.shaderSource(s, src); gl.compileShader(s);
-      if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
-      return s;
-    };
     try {
-      const prog = gl.createProgram();
-      gl.attachShader(prog, shader(gl.VERTEX_SHADER, vsrc));
-      gl.attachShader(prog, shader(gl.FRAGMENT_SHADER, fsrc));
-      gl.bindAttribLocation(prog, 0, 'p');
-      gl.linkProgram(prog);
-      if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
+      const prog = IgSurface.compileProgram(gl, fsrc);
       if (this.prog) gl.deleteProgram(this.prog);
       this.prog = prog;
       return '';
@@ -154,7 +147,7 @@ class WebGL:
     def harness(self) -> None:
         """Load the harness page (again, after the driver has visited another page, e.g. a shared page)."""
         self.driver.get("about:blank")
-        err = self.driver.execute_script(_HARNESS)
+        err = self.driver.execute_script(surface_js().read_text(encoding="utf-8") + _HARNESS)
         if err:
             raise RuntimeError(f"headless Chromium has no usable WebGL2: {err}")
 

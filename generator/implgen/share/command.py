@@ -116,6 +116,12 @@ def _parser() -> ArgumentParser:
     )
     p.add_argument("--clip", choices=CLIPS, default=None, help="the clip the page starts with (default: sphere)")
     p.add_argument("--clip-size", type=str, default=None, metavar="S", help="its radius, or half the box's edge")
+    p.add_argument(
+        "--cut",
+        action="store_true",
+        help="start with the solid (f < 0) cut by the clip, its cut face in the inside colour (default: the surface "
+        "inside the clip, cut open, as the viewer)",
+    )
     p.add_argument("--object", default=None, metavar="NAME", help="for a scene: the shape to share (its first object)")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     return p
@@ -140,6 +146,7 @@ def main(argv: Sequence[str]) -> int:
     look = Look(
         clip=args.clip or look.clip,
         clip_size=clip_size if clip_size is not None else auto_size,
+        cut=args.cut,
         outside=look.outside,
         inside=look.inside,
         background=look.background,

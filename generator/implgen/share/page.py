@@ -28,7 +28,7 @@ import jinja2
 
 from implgen import __version__
 from implgen.codegen.emit import generate
-from implgen.codegen.glslprogram import runtime_text
+from implgen.codegen.glslprogram import HEADERS, runtime_text
 from implgen.codegen.specmodel import Spec
 
 STATIC = Path(__file__).resolve().parent / "static"
@@ -51,6 +51,7 @@ class Look:
 
     clip: str = "sphere"
     clip_size: float = 3.0
+    cut: bool = False  # False: the surface inside the clip, cut open (the viewer's default); True: the cut solid
     outside: tuple[float, float, float] = (0.95, 0.75, 0.3)
     inside: tuple[float, float, float] = (0.35, 0.55, 0.95)
     background: tuple[float, float, float] = (0.12, 0.12, 0.14)
@@ -154,9 +155,10 @@ def render_page(spec: Spec, sliders: list[Slider], look: Look, source_name: str,
         "name": spec.name,
         "shape": shape,
         "runtime": runtime_text(),
+        "header": HEADERS["es"],
         "params": [{"name": s.name, "value": s.value, "min": s.lo, "max": s.hi} for s in sliders],
         "orbit": orbit,
-        "clip": {"kind": look.clip, "size": look.clip_size},
+        "clip": {"kind": look.clip, "size": look.clip_size, "cut": look.cut},
     }
     scripts = [static_text(name) for name in SCRIPTS]
     css = static_text("page.css")
@@ -200,6 +202,7 @@ def render_page(spec: Spec, sliders: list[Slider], look: Look, source_name: str,
             clips=CLIPS,
             clip=look.clip,
             clip_size=_number(look.clip_size),
+            cut=look.cut,
             outside=_hex(look.outside),
             inside=_hex(look.inside),
             background=_hex(look.background),

@@ -17,6 +17,19 @@ from implgen.scene.model import Camera, Clip, Csg, Leaf, Light, Material, Node, 
 
 CLIPS = ("none", "sphere", "box")
 LIGHTS = ("studio", "headlight", "top", "scene")
+# The light presets, the one statement of them: the server's picture (Document.lights) and the page's GPU
+# preview (view/static/gpu.js, sent in the hello message) place the same lights. A light is `camera`: at
+# target + 2 d (r right + u up + b back), moving with the orbit camera, or `world`: at target + d (x, y, z),
+# fixed in the world; d is the camera's distance to its target. (The headlight is the eye: camera 0, 0, 0.5.)
+LIGHT_PRESETS: dict[str, list[dict]] = {
+    "studio": [
+        {"frame": "camera", "at": (-0.6, 0.8, 1.0), "colour": (0.8, 0.8, 0.8)},
+        {"frame": "camera", "at": (0.9, 0.1, 0.5), "colour": (0.35, 0.35, 0.4)},
+    ],
+    "headlight": [{"frame": "camera", "at": (0.0, 0.0, 0.5), "colour": (1.0, 1.0, 1.0)}],
+    "top": [{"frame": "world", "at": (0.0, 3.0, 0.3), "colour": (1.0, 1.0, 1.0)}],
+}
+MATERIAL = {"ambient": 0.12, "diffuse": 0.75, "specular": 0.45, "shininess": 40.0}  # the shape's, both sides
 
 # The starter shape: Suffern's torus about the y-axis.
 STARTER = {
@@ -182,26 +195,27 @@ class Document:
 
     def lights(self) -> list[Light]:
         """Light presets move with the camera (the lit side stays in view while orbiting), except `top`."""
+        preset = self.options.lights
+        if preset == "scene" and self.base is not None:
+            return list(self.base.lights)
         pos, right, up = self.orbit.basis()
         back = (pos - np.asarray(self.orbit.target)) / self.orbit.distance
         d = self.orbit.distance
         t = np.asarray(self.orbit.target)
-
-        def at(r: float, u: float, b: float) -> tuple[float, float, float]:
-            return tuple(t + 2.0 * d * (r * right + u * up + b * back))
-
-        preset = self.options.lights
-        if preset == "scene" and self.base is not None:
-            return list(self.base.lights)
-        if preset == "headlight":
-            return [Light(tuple(pos), (1.0, 1.0, 1.0))]
-        if preset == "top":
-            return [Light(tuple(t + (0.0, 3.0 * d, 0.3 * d)), (1.0, 1.0, 1.0))]
-        return [Light(at(-0.6, 0.8, 1.0), (0.8, 0.8, 0.8)), Light(at(0.9, 0.1, 0.5), (0.35, 0.35, 0.4))]
+        out = []
+        for light in LIGHT_PRESETS.get(preset, LIGHT_PRESETS["studio"]):
+            r, u, b = light["at"]
+            where = (
+                t + 2.0 * d * (r * right + u * up + b * back)
+                if light["frame"] == "camera"
+                else t + d * np.array(light["at"])
+            )
+            out.append(Light(tuple(float(v) for v in where), light["colour"]))
+        return out
 
     def material(self) -> Material:
         o = self.options
-        return Material(color=o.color, inside=o.inside, ambient=0.12, diffuse=0.75, specular=0.45, shininess=40.0)
+        return Material(color=o.color, inside=o.inside, **MATERIAL)
 
     def _shape_node(self) -> Node:
         leaf = Leaf(spec=self.spec, params=dict(self.values), matrix=np.eye(3, 4), material=None, where="shape")

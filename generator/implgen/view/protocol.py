@@ -5,7 +5,10 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
     {"type": "shape", "equation": "...", "params": {"a": 1.0}}        a new equation and its param defaults
                                                                       (optional "bounds" as in a spec)
     {"type": "render", "seq": 7, "refine": true, "width": 640, "height": 480,
-     "values": {"a": 1.2}, "orbit": {...}, "options": {...}}          the view to show (the newest wins)
+     "values": {"a": 1.2}, "orbit": {...}, "options": {...},
+     "gpu": false}                                                    the view to show (the newest wins); gpu:
+                                                                      the page draws the live picture itself,
+                                                                      so no coarse frames, only the refined
     {"type": "save_png", "width": 1920, "height": 1080, "spp": 16}    the current view through render()
     {"type": "save_yaml", "width": 640, "height": 480}               the view as a scene file (its full frame)
     {"type": "save_mesh", "cells": 128, "values": {...},
@@ -13,6 +16,7 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
     {"type": "stop_mesh"}                                             stop the mesh in progress
     {"type": "show_c"}                                                the generated C
     {"type": "export_page"}                                           the view as `implgen share`'s page
+    {"type": "glsl"}                                                  the GPU preview: the shape's GLSL (gpu.py)
     {"type": "pick", "x": 120, "y": 80, "width": 640, "height": 480}  a scene file: edit the object at a pixel
     {"type": "object", "index": 2}                                    a scene file: edit this leaf
 
@@ -45,7 +49,7 @@ MAX_SAVE = (8192, 8192)  # the largest saved picture
 MAX_SAVE_PIXELS = 8192 * 4608  # 8K at 16:9
 MAX_SAVE_SPP = 64
 MESH_TYPES = ("save_mesh", "stop_mesh")  # meshsave.py
-TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object", "export_page", *MESH_TYPES)
+TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object", "export_page", "glsl", *MESH_TYPES)
 PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
 
 _parsed: OrderedDict[str, Spec | UserError] = OrderedDict()
@@ -61,6 +65,7 @@ class RenderRequest:
     values: dict[str, float]
     orbit: Orbit
     options: Options
+    gpu: bool = False  # the page draws the live frames (WebGL2): send the refined frames only
 
 
 def decode(text: str | bytes) -> dict[str, Any]:
@@ -221,6 +226,7 @@ def parse_render(data: dict, spec: Spec) -> RenderRequest:
         values=parse_values(data.get("values"), spec),
         orbit=parse_orbit(data.get("orbit", {})),
         options=parse_options(data.get("options", {})),
+        gpu=data.get("gpu", False) is True,
     )
 
 

@@ -46,6 +46,10 @@ STATIC = {
     "/share.js": ("share.js", "text/javascript; charset=utf-8"),
     "/mesh.js": ("mesh.js", "text/javascript; charset=utf-8"),
     "/style.css": ("style.css", "text/css; charset=utf-8"),
+    "/gpu.js": ("gpu.js", "text/javascript; charset=utf-8"),
+    # the GPU preview draws with the shared page's renderer and orbit camera: the same files, not copies
+    "/surface.js": ("share:surface.js", "text/javascript; charset=utf-8"),
+    "/orbit.js": ("share:orbit.js", "text/javascript; charset=utf-8"),
 }
 HEADERS = {
     "Cache-Control": "no-store",
@@ -87,7 +91,8 @@ async def _close(ws: WebSocket, code: int, reason: str) -> None:
 
 
 def _static(name: str, media: str, token: str | None) -> Callable:
-    body = resources.files("implgen.view").joinpath("static", name).read_bytes()
+    package, _, file = name.rpartition(":")
+    body = resources.files(f"implgen.{package or 'view'}").joinpath("static", file).read_bytes()
     guarded = name == "index.html"  # the page itself; its script and style are the package's, public anyway
 
     async def serve(request) -> Response:

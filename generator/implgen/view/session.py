@@ -27,17 +27,12 @@ import time
 from collections.abc import Awaitable, Callable
 from dataclasses import replace
 
-import numpy as np
-
 from implgen import validate
 from implgen.errors import UserError
-from implgen.imagefile import encode_jpeg, encode_png, to_uint8
 from implgen.scene.build import BuildResult, build_scene, runtime_ready
 from implgen.scene.model import Scene
 from implgen.scene.render import usable_cores
-from implgen.scene.renderjob import RenderJob
-from implgen.scene.tracer import CScene
-from implgen.view import dump, fit, pick, protocol, sharepage
+from implgen.view import dump, fit, frames, gpu, pick, protocol, sharepage
 from implgen.view.document import Document
 from implgen.view.meshsave import MeshSaver
 from implgen.view.pace import CUT, Pace
@@ -51,57 +46,10 @@ BUILD_QUIET, BUILD_POLL = 0.2, 0.4  # seconds: a build says nothing before the f
 REFINE_TARGET = 0.4  # seconds: a refined frame expected to take longer is first sent at 1 sample (KIND_ONE)
 HEADER = struct.Struct(">IBBxxHH")  # seq, kind, flags, width, height; the image bytes follow
 FLAG_EMPTY = 1  # no pixel of the frame shows anything but the background: no real points in view
-LIVE_JPEG_QUALITY = 88  # the coarse frame: small and soon replaced
-LIVE_PNG_LEVEL = 1  # the full frame: speed over size (zlib level 1)
-BAND = 256  # rows converted to 8 bits at a time: no float temporaries the size of a whole saved picture
 
 log = logging.getLogger("implgen.view")
 
 Send = Callable[[dict | bytes], Awaitable[None]]
-
-
-def _live_jpeg(rgb8: np.ndarray) -> bytes:
-    return encode_jpeg(rgb8, LIVE_JPEG_QUALITY)
-
-
-def _live_png(rgb8: np.ndarray) -> bytes:
-    return encode_png(rgb8, LIVE_PNG_LEVEL)
-
-
-def _file_png(rgb8: np.ndarray) -> bytes:
-    return encode_png(rgb8)  # the encoder and level write_png uses: the bytes `implgen render` writes
-
-
-def _eight_bits(img: np.ndarray) -> np.ndarray:
-    """to_uint8 band by band (the same values as on the whole picture, a fraction of its temporaries)."""
-    out = np.empty(img.shape, np.uint8)
-    for y in range(0, img.shape[0], BAND):
-        out[y : y + BAND] = to_uint8(img[y : y + BAND])
-    return out
-
-
-def _trace(ticket: Ticket, loop, sc: Scene, lib: BuildResult, spp: int, threads: int, encode):
-    """On a pool thread: one C render of `sc` under its ticket, encoded, and whether it shows nothing but the
-    background; None when cancelled (by the page, or by the budget: ticket.expired says which). The same
-    context and samples as render() (renderjob.py)."""
-    if ticket.cancelled:
-        return None
-    cs = CScene(sc, lib.for_scene(sc, fold=False))
-    try:
-        with RenderJob(cs, sc.width, sc.height, spp, sc.max_depth, threads) as job:
-            ticket.attach(job, loop)
-            try:
-                img = job.run()
-            finally:
-                ticket.detach()
-            rgb8 = None if img is None else _eight_bits(img)
-            job.image = img = None  # the float picture is not kept while the bytes are encoded
-    finally:
-        cs.close()
-    if rgb8 is None:
-        return None
-    background = to_uint8(np.asarray(sc.background, np.float32).reshape(1, 1, 3))
-    return encode(rgb8), bool((rgb8 == background).all())
 
 
 _default_work: Work | None = None
@@ -136,13 +84,15 @@ class Session:
         self._saving: asyncio.Task | None = None
         self.frames = 0  # frames sent (for tests)
         self.meshes = MeshSaver(self.work, send, lambda stl: send(HEADER.pack(0, KIND_MESH, 0, 0, 0) + stl))
+        self._shape_id = 0  # numbers the shapes sent to the page (hello, shape replies), for the GPU preview
 
     # ------------------------------------------------------------------ messages
 
     def hello(self) -> dict:
         """The state the page starts from."""
         limits = {"frame": protocol.MAX_FRAME, "save": protocol.MAX_SAVE, "save_spp": protocol.MAX_SAVE_SPP}
-        return {"type": "hello", **self.doc.state(), "limits": limits}
+        hello = {"type": "hello", **self.doc.state(), "limits": limits}
+        return {**hello, "gpu": gpu.hello_part(), "shape_id": self._shape_id}
 
     def _shape_reply(self, **extra) -> dict:
         """The page's new shape: its name, equation, params and their values (and what `extra` adds)."""
@@ -154,6 +104,7 @@ class Session:
             "params": spec.params,
             "values": self.doc.values,
             "degree": spec.degree,
+            "shape_id": self._shape_id,
             **extra,
         }
 
@@ -187,6 +138,9 @@ class Session:
             elif kind == "export_page":
                 name, html = await self.work.call(self.work.parse, sharepage.page_text, replace(self.doc))
                 await self.send({"type": "page", "name": name, "text": html})
+            elif kind == "glsl":  # the page's GPU preview asks for the current shape's GLSL
+                msg = await self.work.call(self.work.parse, gpu.program_message, replace(self.doc))
+                await self.send({**msg, "shape_id": self._shape_id})
             elif kind == "show_c":
                 await self.send(
                     {"type": "c", "text": await self.work.call(self.work.parse, dump.c_text, self.doc.spec)}
@@ -210,6 +164,7 @@ class Session:
         self.doc.select(index)
         self._cost = None
         self.pace.new_shape()
+        self._shape_id += 1
         await self.send(self._shape_reply(fit=None, object=index, objects=self.doc.objects()))
 
     def _mode(self) -> str:
@@ -228,6 +183,7 @@ class Session:
         self._shown = None  # an accepted shape is drawn coarse first, even the same one again
         self._cost = None  # measured anew by the new shape's first render
         self.pace.new_shape()
+        self._shape_id += 1
         await self.send(self._shape_reply(fit=fitted, objects=self.doc.objects()))
 
     # ------------------------------------------------------------------ rendering
@@ -296,10 +252,12 @@ class Session:
 
     async def _frames(self, req: protocol.RenderRequest) -> None:
         view = (req.width, req.height, req.values, req.orbit, req.options, id(self.doc.spec))
-        while not (req.refine and view == self._shown):
+        if req.gpu and not req.refine:
+            return  # the page draws the live picture itself: the view is noted (and a refinement cancelled)
+        while not (req.refine and (view == self._shown or req.gpu)):
             cw, ch = self.pace.size(req.width, req.height)
             smallest = self.pace.smallest(req.width, req.height, cw)
-            data, ticket = await self._render(cw, ch, 1, _live_jpeg, full=False, cut=not smallest)
+            data, ticket = await self._render(cw, ch, 1, frames.live_jpeg, full=False, cut=not smallest)
             if data is not None:
                 self.pace.measured(cw * ch, self._seconds)
                 self._shown = view
@@ -318,11 +276,11 @@ class Session:
         if req.refine and self._pending is None:
             per_pixel = self.pace.seconds_per_pixel
             if per_pixel is None or per_pixel * req.width * req.height * FULL_SPP > REFINE_TARGET:
-                data, _ = await self._render(req.width, req.height, 1, _live_png, full=True)
+                data, _ = await self._render(req.width, req.height, 1, frames.live_png, full=True)
                 if data is None or self._pending is not None:
                     return
                 await self._send_frame(req.seq, KIND_ONE, req.width, req.height, *data)
-            data, _ = await self._render(req.width, req.height, FULL_SPP, _live_png, full=True)
+            data, _ = await self._render(req.width, req.height, FULL_SPP, frames.live_png, full=True)
             if data is not None:
                 await self._send_frame(req.seq, KIND_FULL, req.width, req.height, *data)
 
@@ -346,7 +304,7 @@ class Session:
         self._live, self._live_full = ticket, full
         t0 = time.perf_counter()
         try:
-            data = await self.work.trace(self.work.render, ticket, _trace, sc, lib, spp, self.threads, encode)
+            data = await self.work.trace(self.work.render, ticket, frames.trace, sc, lib, spp, self.threads, encode)
         finally:
             self._seconds = time.perf_counter() - t0  # the render and its encoding, as the page waits for them
             self._live = None
@@ -364,7 +322,9 @@ class Session:
             ticket = Ticket(self.work.limits.save_budget, "save", "save_png", width, spp, self.threads)
             ticket.check_rows(self._cost)
             self._save = ticket
-            data = await self.work.trace(self.work.save, ticket, _trace, sc, lib, spp, self.threads, _file_png)
+            data = await self.work.trace(
+                self.work.save, ticket, frames.trace, sc, lib, spp, self.threads, frames.file_png
+            )
             self._cost = ticket.cost or self._cost
             if data is None:
                 if ticket.expired:

@@ -18,7 +18,7 @@ def page_text(doc: Document) -> tuple[str, str]:
     spec, o = doc.spec, doc.options
     sliders = [slider(name, float(doc.values.get(name, default)), spec.ranges) for name, default in spec.params.items()]
     clip = o.clip if o.clip in CLIPS else "sphere"
-    look = Look(clip=clip, clip_size=o.clip_size, outside=o.color, inside=o.inside, background=o.background)
+    look = Look(clip=clip, clip_size=o.clip_size, cut=o.cut, outside=o.color, inside=o.inside, background=o.background)
     orbit = asdict(doc.orbit)
     orbit["target"] = list(orbit["target"])
     return f"{spec.name}.html", render_page(spec, sliders, look, f"implgen view: {spec.name}", orbit)

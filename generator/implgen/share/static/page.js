@@ -28,7 +28,7 @@
 
   function start() {
     const log = r.setEquationProgram({
-      name: data.name, shape: data.shape, runtime: data.runtime, params: data.params.length,
+      name: data.name, shape: data.shape, runtime: data.runtime, header: data.header, params: data.params.length,
     });
     if (log) {
       fail(`the shader did not compile on this browser: ${log.split("\n")[0]}`);
@@ -64,7 +64,11 @@
       r.setParams(values);
       r.setCamera(orbit.camera());
       const size = parseFloat($("ig-clip-size").value);
-      r.setClip({ kind: $("ig-clip").value, size: size > 0 && Number.isFinite(size) ? size : data.clip.size });
+      r.setClip({
+        kind: $("ig-clip").value,
+        size: size > 0 && Number.isFinite(size) ? size : data.clip.size,
+        cut: $("ig-cut").checked,
+      });
       r.setColours({
         outside: fromHex($("ig-outside").value),
         inside: fromHex($("ig-inside").value),
@@ -105,7 +109,7 @@
       $(id).addEventListener("input", () => changed(true));
       $(id).addEventListener("change", () => changed(false));
     }
-    for (const id of ["ig-clip", "ig-unsure"]) $(id).addEventListener("change", () => changed(false));
+    for (const id of ["ig-clip", "ig-cut", "ig-unsure"]) $(id).addEventListener("change", () => changed(false));
     $("ig-reset").addEventListener("click", () => {
       orbit.reset();
       changed(false);

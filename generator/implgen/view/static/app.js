@@ -11,6 +11,9 @@
   const RANK = { [KIND_COARSE]: 0, [KIND_ONE]: 1, [KIND_FULL]: 2 }; // a newer frame of the same request wins
   const KIND_NAME = { [KIND_COARSE]: "coarse", [KIND_ONE]: "full, 1 sample", [KIND_FULL]: "full" };
   const FLAG_EMPTY = 1; // the frame shows nothing but the background
+  // the GPU preview (gpu.js): draws the live picture in this browser where it can, else null or inactive
+  const gpu = window.ImplgenGpu ? ImplgenGpu.create({ stage: $("stage"), view: canvas, note: $("gpu-note"),
+    toggle: $("gpu"), compare: $("compare"), status: $("status") }) : null;
 
   const state = {
     params: {}, // name -> default (as the server parsed it)
@@ -80,9 +83,8 @@
     };
   }
 
-  // A render request goes out at most once per animation frame; the newest view is what is sent.
-  // (The GPU preview, project issue 24 item 2, would draw the live picture itself here while the view moves,
-  // and leave the server's refined frame to replace it when the view rests.)
+  // A render request goes out at most once per animation frame; the newest view is what is sent. With the GPU
+  // preview, the page draws the live picture itself and asks the server for the refined frame only.
   function requestRender(refine) {
     if (queued) { queued.refine = queued.refine || refine; return; }
     queued = { refine };
@@ -93,9 +95,12 @@
       state.options = readOptions();
       if (q.refine) keepLink();
       sentAt.set(seq, { t: performance.now(), clip: state.options.clip_size });
+      const onGpu = gpu !== null && gpu.draw({ orbit: state.orbit, values: state.values, options: state.options },
+        !q.refine);
+      if (onGpu) { drawnSeq = seq; drawnKind = -1; } // older server frames are stale; this request's are not
       send({
         type: "render", seq, refine: q.refine, width: canvas.width, height: canvas.height,
-        values: state.values, orbit: state.orbit, options: state.options,
+        values: state.values, orbit: state.orbit, options: state.options, gpu: onGpu,
       });
     });
   }
@@ -289,6 +294,7 @@
     // a picture drawn: the last error is over (not a field's own complaint while it still holds no number)
     if (messageIsError && fseq > errorSeq && !$("clip-size").classList.contains("bad")) showMessage("", false);
     $("status").textContent = `${KIND_NAME[kind]} ${w} x ${h}${ms}`;
+    if (gpu && kind !== KIND_COARSE) gpu.serverFrame(ctx2d);
     showEmpty((flags & FLAG_EMPTY) !== 0);
     for (const k of sentAt.keys()) if (k < fseq) sentAt.delete(k);
   }
@@ -320,6 +326,7 @@
       if (msg.mode !== "scene") $("lights").querySelector("option[value=scene]").disabled = true;
       else for (const id of ["clip", "clip-size", "cut", "color", "inside"]) $(id).disabled = true; // the file's own
       showShape(msg);
+      if (gpu) gpu.hello(msg, send);
       if (!openLink()) requestRender(true); // with a link's equation: drawn once it is built
     } else if (msg.type === "shape") {
       if (linkValues) { // the link's slider values, for the params the shape has
@@ -339,8 +346,11 @@
       }
       if (sceneMode && msg.objects) showObjects(msg.objects, msg.object ?? Number($("object").value));
       showShape(msg);
+      if (gpu) gpu.shape(msg);
       if ("fit" in msg) fitClip(msg.fit);
       requestRender(true);
+    } else if (msg.type === "glsl") {
+      if (gpu) gpu.program(msg);
     } else if (msg.type === "status") {
       overlay.build = msg.text;
       showOverlay();

@@ -1,0 +1,111 @@
+"""The server's side of the viewer's GPU preview (view/gpu.py; docs/viewer.md, "The GPU preview"), through
+Starlette's test client: the hello carries the GLSL ES header, the runtime, the light presets and the material;
+a `glsl` request answers with the current shape's generated GLSL (the same text `implgen SPEC --lang glsl`
+writes), numbered like the shape replies; a scene file is the server's, and the reply says why; a render
+request with `gpu` gets no coarse frames; the served surface.js and orbit.js are the shared page's files.
+The browser side is tests/test_view_gpu_browser.py."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from starlette.testclient import TestClient
+
+from conftest import ROOT
+from implgen.codegen.emit import generate
+from implgen.codegen.glslprogram import HEADERS, runtime_text
+from implgen.scene.load import load_scene
+from implgen.view import gpu
+from implgen.view.command import document_factory
+from implgen.view.document import LIGHT_PRESETS, Document
+from implgen.view.server import create_app
+from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_ONE
+from test_view_api import picture, render_msg, reply
+
+SCENES = ROOT / "examples" / "scenes"
+SHARE_STATIC = ROOT / "generator" / "implgen" / "share" / "static"
+
+
+@pytest.fixture()
+def client():
+    with TestClient(create_app(document_factory(None), threads=2)) as c:
+        yield c
+
+
+def test_the_hello_and_the_glsl_of_each_shape(client) -> None:
+    with client.websocket_connect("/ws") as ws:
+        hello = reply(ws)
+        assert hello["gpu"]["header"] == HEADERS["es"] and hello["gpu"]["runtime"] == runtime_text()
+        assert hello["gpu"]["material"] == {"ambient": 0.12, "diffuse": 0.75, "specular": 0.45, "shininess": 40.0}
+        assert set(hello["gpu"]["lights"]) == set(LIGHT_PRESETS) and hello["shape_id"] == 0
+        ws.send_text(json.dumps({"type": "glsl"}))
+        first = reply(ws)
+        doc = document_factory(None)()
+        assert first == {
+            "type": "glsl",
+            "name": "torus",
+            "shape": generate(doc.spec, ("glsl",))["torus.glsl"],
+            "params": ["a", "b"],
+            "shape_id": 0,
+        }
+        ws.send_text(json.dumps({"type": "shape", "equation": "x^2 + y^2 + z^2 - r^2", "params": {"r": 1.5}}))
+        shape = reply(ws)
+        ws.send_text(json.dumps({"type": "glsl"}))
+        second = reply(ws)
+    assert shape["shape_id"] == second["shape_id"] == 1
+    assert second["params"] == ["r"] and second["name"] == shape["name"]
+    assert "f(x, y, z) = -r^2 + x^2 + y^2 + z^2" in second["shape"] and second["shape"] != first["shape"]
+
+
+def test_a_scene_file_is_drawn_by_the_server_and_says_why(tmp_path) -> None:
+    """glassware.yaml has CSG, glass and several shapes: the reply names them and carries no GLSL."""
+    doc = Document.for_scene(load_scene(SCENES / "glassware.yaml"))
+    msg = gpu.program_message(doc)
+    assert "shape" not in msg and msg["reason"].startswith("a scene file (")
+    for word in ("CSG", "glass", "shapes"):
+        assert word in msg["reason"], msg["reason"]
+    assert gpu.server_only(document_factory(None)()) is None
+
+
+def test_the_presets_place_the_lights_the_tracer_gets() -> None:
+    """Document.lights() from the one table: studio's key light at target + 2 d (-0.6 right + 0.8 up + back),
+    the headlight at the eye, top above the target; computed here from the orbit's formula."""
+    doc = document_factory(None)()
+    doc.orbit.yaw, doc.orbit.pitch, doc.orbit.distance, doc.orbit.target = 70.0, -20.0, 7.0, (0.5, -1.0, 2.0)
+    y, p = np.radians(70.0), np.radians(-20.0)
+    back = np.array([np.cos(p) * np.sin(y), np.sin(p), np.cos(p) * np.cos(y)])
+    right = np.array([np.cos(y), 0.0, -np.sin(y)])
+    up = np.cross(back, right)
+    t = np.array([0.5, -1.0, 2.0])
+    key = doc.lights()[0]
+    assert np.allclose(key.position, t + 14.0 * (-0.6 * right + 0.8 * up + back), atol=1e-12)
+    assert key.color == (0.8, 0.8, 0.8) and len(doc.lights()) == 2
+    doc.options.lights = "headlight"
+    assert np.allclose(doc.lights()[0].position, t + 7.0 * back, atol=1e-12)
+    doc.options.lights = "top"
+    assert np.allclose(doc.lights()[0].position, t + (0.0, 21.0, 2.1), atol=1e-12)
+
+
+def test_a_gpu_request_gets_no_coarse_frames(client) -> None:
+    """The page draws the live picture itself: a moving request is noted (no frame), a resting one goes straight
+    to the full frame."""
+    with client.websocket_connect("/ws") as ws:
+        hello = reply(ws)
+        ws.send_text(render_msg(hello, seq=1, refine=False, gpu=True, w=64, h=48))
+        ws.send_text(render_msg(hello, seq=2, refine=True, gpu=True, w=64, h=48))
+        kinds = []
+        while not kinds or kinds[-1] != KIND_FULL:
+            seq, kind = HEADER.unpack(picture(ws)[: HEADER.size])[:2]
+            kinds.append(kind)
+            assert seq == 2
+    assert KIND_COARSE not in kinds and set(kinds) <= {KIND_ONE, KIND_FULL}
+
+
+def test_the_page_s_scripts_are_the_shared_page_s_files(client) -> None:
+    for name in ("surface.js", "orbit.js"):
+        r = client.get(f"/{name}")
+        assert r.status_code == 200 and r.headers["content-type"].startswith("text/javascript")
+        assert r.content == (SHARE_STATIC / name).read_bytes()
+    assert client.get("/gpu.js").status_code == 200
