@@ -130,15 +130,22 @@ class Document:
         doc.options = Options(clip="none", lights="scene", background=scene.background)
         return doc
 
+    def shape_state(self) -> dict:
+        """The shape the page shows: its name, equation, params, their values and the degree."""
+        spec = self.spec
+        return {
+            "name": spec.name,
+            "equation": spec.equation,
+            "params": spec.params,
+            "values": self.values,
+            "degree": spec.degree,
+        }
+
     def state(self) -> dict:
         """What the page starts from: the shape, its values, the camera, the options (and a scene's objects)."""
         o, orbit = self.options, self.orbit
         return {
-            "name": self.spec.name,
-            "equation": self.spec.equation,
-            "params": self.spec.params,
-            "values": self.values,
-            "degree": self.spec.degree,
+            **self.shape_state(),
             "mode": "spec" if self.base is None else "scene",
             "objects": self.objects(),
             "object": self.object_index(),

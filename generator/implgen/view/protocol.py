@@ -30,9 +30,8 @@ session runs it on its parse pool, never on the event loop.
 
 from __future__ import annotations
 
+import functools
 import json
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Any
 
@@ -51,9 +50,6 @@ MAX_SAVE_SPP = 64
 MESH_TYPES = ("save_mesh", "stop_mesh")  # meshsave.py
 TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object", "export_page", "glsl", *MESH_TYPES)
 PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
-
-_parsed: OrderedDict[str, Spec | UserError] = OrderedDict()
-_parsed_lock = threading.Lock()
 
 
 @dataclass
@@ -111,22 +107,17 @@ def _bounds_text(spec: Spec) -> dict[str, list[str]] | None:
     return {a: [format_expression(lo, names), format_expression(hi, names)] for a, (lo, hi) in spec.bounds.items()}
 
 
+@functools.lru_cache(maxsize=PARSE_CACHE)  # thread-safe; a refusal is remembered as well
+def _parse_text(key: str) -> Spec | UserError:
+    try:
+        return parse_spec(json.loads(key), "equation")
+    except UserError as err:
+        return err
+
+
 def _parse(mapping: dict[str, Any]) -> Spec:
-    """parse_spec(mapping, "equation"), remembered by the mapping's JSON text (an LRU, thread-safe)."""
-    key = json.dumps(mapping, sort_keys=True)
-    with _parsed_lock:
-        hit = _parsed.get(key)
-        if hit is not None:
-            _parsed.move_to_end(key)
-    if hit is None:
-        try:
-            hit = parse_spec(mapping, "equation")
-        except UserError as err:
-            hit = err
-        with _parsed_lock:
-            _parsed[key] = hit
-            while len(_parsed) > PARSE_CACHE:
-                _parsed.popitem(last=False)
+    """parse_spec(mapping, "equation"), remembered by the mapping's JSON text (the last PARSE_CACHE of them)."""
+    hit = _parse_text(json.dumps(mapping, sort_keys=True))
     if isinstance(hit, UserError):
         raise UserError(hit.source, hit.message)
     return hit

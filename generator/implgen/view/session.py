@@ -96,17 +96,7 @@ class Session:
 
     def _shape_reply(self, **extra) -> dict:
         """The page's new shape: its name, equation, params and their values (and what `extra` adds)."""
-        spec = self.doc.spec
-        return {
-            "type": "shape",
-            "name": spec.name,
-            "equation": spec.equation,
-            "params": spec.params,
-            "values": self.doc.values,
-            "degree": spec.degree,
-            "shape_id": self._shape_id,
-            **extra,
-        }
+        return {"type": "shape", **self.doc.shape_state(), "shape_id": self._shape_id, **extra}
 
     async def handle(self, text: str | bytes) -> None:
         """One message from the page. Bad input is answered with an error message; nothing raises."""
