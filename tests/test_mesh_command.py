@@ -78,6 +78,7 @@ def test_scene_object_placed_by_its_transform(tmp_path):
         (["-o", "{d}/x.stl", "--param", "q=1"], "--param"),
         (["-o", "{d}/x.stl", "--param", "r=abc"], "--param"),
         (["-o", "{d}/x.stl", "--param", "r=0.1", "--param", "r=0.2"], "given twice"),
+        (["-o", "{d}/x.stl", "--param", "r\n=0.1"], "--param 'r\\n=0.1'"),  # a newline stays escaped: one line
         (["-o", "{d}/x.stl", "--report", "{d}/r.txt"], "--report"),
         (["-o", "{d}/x.stl", "--object", "torus"], "--object"),
         (["-o", "{d}/no/such/x.stl"], "-o"),

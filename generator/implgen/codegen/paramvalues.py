@@ -142,7 +142,7 @@ def named_items(option: str, items: Sequence[str], shape: str, params: Mapping[s
     out: dict[str, str] = {}
     for item in items:
         name, eq, text = item.partition("=")
-        label = f"{option} {item[:60]}"
+        label = f"{option} {item[:60] if item.isprintable() else validate.describe(item)}"  # one line, whatever came
         if not eq or not name:
             raise UserError(label, "expected NAME=VALUE" if option == "--param" else "expected NAME=LOW:HIGH")
         if name not in params:

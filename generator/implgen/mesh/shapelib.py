@@ -150,8 +150,16 @@ class ShapeLib:
         sheets = np.ascontiguousarray(sheets, dtype=np.int8)
         points, normals, origin = (np.ascontiguousarray(a, dtype=np.float64) for a in (points, normals, origin))
         piece = np.ascontiguousarray(piece, dtype=np.intc)
-        if not (len(sheets) == len(corner) == len(first) and len(keys) == len(points) == len(normals) == len(piece)):
-            raise ValueError("sheet_points: array lengths disagree")
+        n, m = len(corner), len(keys)  # what the C reads: every shape checked, and the keys ascending
+        if not (
+            corner.shape == first.shape == (n,)
+            and sheets.shape == (n, 12)
+            and strides.shape == origin.shape == (3,)
+            and points.shape == normals.shape == (m, 3)
+            and piece.shape == (m,)
+            and bool(np.all(keys[1:] >= keys[:-1]))
+        ):
+            raise ValueError("sheet_points: array shapes disagree, or the crossing keys are not ascending")
         out = np.zeros((nverts, 3))
         mask = np.zeros(nverts, dtype=_LONG)
         nearest = np.full(nverts, -1, dtype=_LONG)
