@@ -146,6 +146,8 @@ const ImplgenGpu = (() => {
     function draw(v, moving) {
       if (!active()) return false;
       const key = JSON.stringify(v);
+      // at rest on the view the server's refined picture already shows (a second request for it): keep that
+      if (!moving && key === g.key && view.dataset.shown === "server") return true;
       try {
         apply(v);
       } catch (err) { // a view the renderer refuses (it should not happen): the server draws, and says so
