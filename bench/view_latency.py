@@ -65,6 +65,19 @@ class Page:
     def send(self, msg: dict) -> None:
         self.ws.send(json.dumps(msg))
 
+    def orbit_for(self, seconds: float) -> tuple[int, float, float]:
+        """Turn the camera 3 degrees a frame, each coarse frame awaited, for `seconds`: (frames, the longest
+        wait for one, seconds elapsed)."""
+        frames, longest = 0, 0.0
+        start = time.perf_counter()
+        while time.perf_counter() - start < seconds:
+            self.orbit["yaw"] = (self.orbit["yaw"] + 3.0) % 360.0
+            t0 = time.perf_counter()
+            self.frame(self.render(False), KIND_COARSE)
+            longest = max(longest, time.perf_counter() - t0)
+            frames += 1
+        return frames, longest, time.perf_counter() - start
+
     def render(self, refine: bool) -> int:
         self.seq += 1
         self.send(
@@ -306,15 +319,7 @@ def neighbours(url: str, seconds: float) -> dict[str, float]:
     for t in threads:
         t.start()
     time.sleep(1.0)  # their first equations are being parsed
-    frames, longest = 0, 0.0
-    start = time.perf_counter()
-    while time.perf_counter() - start < seconds:
-        good.orbit["yaw"] = (good.orbit["yaw"] + 3.0) % 360.0
-        t0 = time.perf_counter()
-        good.frame(good.render(False), KIND_COARSE)
-        longest = max(longest, time.perf_counter() - t0)
-        frames += 1
-    elapsed = time.perf_counter() - start
+    frames, longest, elapsed = good.orbit_for(seconds)
     stop.set()
     good.ws.close()
     return {"fps": frames / elapsed, "longest": longest, "equations": sent[0], "seconds": elapsed}

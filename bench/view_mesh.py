@@ -26,7 +26,7 @@ import threading
 import time
 from pathlib import Path
 
-from view_latency import Page  # the page's side of the protocol (bench/view_latency.py)
+from view_latency import Page, start_server  # the page's side of the protocol, the server (view_latency.py)
 from websockets.exceptions import ConnectionClosed
 
 from implgen.bench.machine import describe as machine
@@ -36,13 +36,6 @@ from implgen.view.session import KIND_COARSE
 ROOT = Path(__file__).resolve().parents[1]
 MESH_CELLS = 128
 OCTIC = ROOT / "examples" / "shapes" / "chmutov8.yaml"
-
-
-def start_server() -> tuple[subprocess.Popen, str]:
-    cmd = [sys.executable, "-m", "implgen.cli", "view", "--no-browser", "--port", "0"]
-    server = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True, env=dict(os.environ))
-    line = server.stdout.readline()
-    return server, "ws://" + line.split("http://", 1)[1].split("/", 1)[0] + "/ws"
 
 
 def mesher(url: str, stop: threading.Event, times: list[float], ready: threading.Event) -> None:
@@ -94,15 +87,7 @@ def orbit(url: str, seconds: float, kind: str, folder: Path) -> dict[str, float]
         other.start()
         ready.wait(120)
         time.sleep(0.5)  # its first mesh under way
-    frames, longest = 0, 0.0
-    start = time.perf_counter()
-    while time.perf_counter() - start < seconds:
-        good.orbit["yaw"] = (good.orbit["yaw"] + 3.0) % 360.0
-        t0 = time.perf_counter()
-        good.frame(good.render(False), KIND_COARSE)
-        longest = max(longest, time.perf_counter() - t0)
-        frames += 1
-    elapsed = time.perf_counter() - start
+    frames, longest, elapsed = good.orbit_for(seconds)
     stop.set()
     if other is not None:
         other.join(120)
@@ -117,7 +102,7 @@ def main() -> int:
     ap.add_argument("-o", "--output", type=Path, default=ROOT / "bench" / "results" / "view_mesh.md")
     args = ap.parse_args()
     load_before = load_average()
-    server, url = start_server()
+    server, url = start_server(dict(os.environ), None)
     runs: dict[str, list[dict]] = {"quiet": [], "meshing": [], "apart": []}
     folder = Path(tempfile.mkdtemp(prefix="implgen-bench-view-mesh-"))
     try:

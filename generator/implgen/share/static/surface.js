@@ -462,13 +462,19 @@ void main()
         gl.deleteFramebuffer(this.coarse.fbo);
         gl.deleteRenderbuffer(this.coarse.rb);
       }
+      this.coarse = { ...this._offscreen(w, h), w, h };
+    }
+
+    /** An RGBA8 framebuffer of w x h pixels, bound: { fbo, rb } (the caller deletes them). */
+    _offscreen(w, h) {
+      const gl = this.gl;
       const rb = gl.createRenderbuffer();
       gl.bindRenderbuffer(gl.RENDERBUFFER, rb);
       gl.renderbufferStorage(gl.RENDERBUFFER, gl.RGBA8, w, h);
       const fbo = gl.createFramebuffer();
       gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
       gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.RENDERBUFFER, rb);
-      this.coarse = { fbo, rb, w, h };
+      return { fbo, rb };
     }
 
     /** What each pixel's ray found, at full size, drawn off screen (the canvas keeps its picture) in bands of
@@ -480,12 +486,7 @@ void main()
       if (!this.prog) return out;
       const w = this.width;
       const h = this.height;
-      const rb = gl.createRenderbuffer();
-      gl.bindRenderbuffer(gl.RENDERBUFFER, rb);
-      gl.renderbufferStorage(gl.RENDERBUFFER, gl.RGBA8, w, h);
-      const fbo = gl.createFramebuffer();
-      gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
-      gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.RENDERBUFFER, rb);
+      const { fbo, rb } = this._offscreen(w, h);
       gl.useProgram(this.prog);
       gl.viewport(0, 0, w, h);
       this._uniforms(w, h, 1);
