@@ -1,8 +1,9 @@
 """The lifetime of Save mesh's child process (view/meshsave.py, mesh/job.py): a Ctrl-C at the terminal (SIGINT to
 the whole process group) is the server's one line and leaves no mesh running; a server killed outright leaves no
 mesh running on to its budget, and nothing on stderr; a mesh whose page closes while it waits in the save pool
-never starts a process; its budget counts from when the pool starts it; a bug in the child is its kind on the
-page and its traceback in the server's log; the child imports nothing of the viewer."""
+never starts a process; a child killed from outside is one line; its budget counts from when the pool starts it;
+a bug in the child is its kind on the page and its traceback in the server's log; the child imports nothing of
+the viewer."""
 
 from __future__ import annotations
 
@@ -171,3 +172,25 @@ def test_the_mesh_process_imports_nothing_of_the_viewer() -> None:
     code = "import sys, implgen.mesh.job; print(sorted(m for m in sys.modules if m.startswith('implgen.view')))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout == "[]\n", out
+
+
+def test_a_mesh_process_killed_from_outside_is_one_line(heavy_built) -> None:
+    """The system's OOM killer, say: the page hears how the process ended, in one line."""
+    job = MeshJob(load_spec(HEAVY), {}, [], None, 128)
+    out: list = []
+
+    def mesh() -> None:
+        try:
+            meshsave.run(job, 300.0, threading.Event(), lambda: None)
+        except Exception as err:
+            out.append(err)
+
+    t = threading.Thread(target=mesh)
+    t.start()
+    deadline = time.monotonic() + GUARD
+    while not (kids := mesh_children(os.getpid())):
+        assert time.monotonic() < deadline, "no mesh process"
+        time.sleep(0.05)
+    os.kill(kids[0], signal.SIGKILL)
+    t.join(GUARD)
+    assert [str(e) for e in out] == ["save_mesh: the mesh's process ended with exit code -9: try fewer cells"]

@@ -126,7 +126,9 @@ def run(job: MeshJob, seconds: float, stop: threading.Event, started: Callable[[
         except OSError:  # it has ended already: its pipe says so below
             pass
         hard = deadline + GRACE
-        while not select.select([receive], [], [], POLL)[0]:
+        ready = select.poll()  # not select(): a busy server's descriptors may pass FD_SETSIZE
+        ready.register(read_fd, select.POLLIN)  # the reply's first bytes, or its end (POLLHUP)
+        while not ready.poll(POLL * 1000):
             if stop.is_set():
                 raise Stopped
             if time.monotonic() > hard:
