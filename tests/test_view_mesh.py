@@ -70,6 +70,13 @@ def mesh_replies(ws, until=("done", "failed", "stopped")) -> tuple[list[dict], b
     raise AssertionError(f"no end of the mesh: {said}")
 
 
+def meshing(ws) -> None:
+    """Wait until the save pool has started the mesh (the running line past "waiting for the saves"): a page closed
+    before then takes its mesh out of the pool's queue (test_view_mesh_process.py)."""
+    while "waiting for the saves" in mesh_replies(ws, until=("running",))[0][-1]["text"]:
+        pass
+
+
 def save_mesh(ws, hello: dict, cells: int, **options) -> dict:
     return {"type": "save_mesh", "cells": cells, "values": hello["values"], "options": {**hello["options"], **options}}
 
@@ -198,7 +205,7 @@ def test_one_mesh_a_page_stop_and_a_closed_page_stop_it(heavy_built, monkeypatch
         with c.websocket_connect("/ws") as ws:
             hello = ws.receive_json()
             ws.send_text(json.dumps(save_mesh(ws, hello, 128)))  # seconds of work
-            mesh_replies(ws, until=("running",))
+            meshing(ws)
             ws.send_text(json.dumps(save_mesh(ws, hello, 32)))
             said, _ = mesh_replies(ws, until=("failed",))
             assert said[-1]["text"] == "save_mesh: a mesh is already being made: wait for it, or stop it"
@@ -207,7 +214,7 @@ def test_one_mesh_a_page_stop_and_a_closed_page_stop_it(heavy_built, monkeypatch
             assert said[-1] == {"type": "mesh", "state": "stopped", "text": "meshing stopped"} and data is None
             assert ended == ["stopped"] and not mesh_processes()  # killed, not left running
             ws.send_text(json.dumps(save_mesh(ws, hello, 128)))  # again, then the page closes
-            mesh_replies(ws, until=("running",))
+            meshing(ws)
         deadline = time.monotonic() + GUARD
         while len(ended) < 2:
             assert time.monotonic() < deadline, "the closed page's mesh went on"
