@@ -136,7 +136,10 @@ def run(job: MeshJob, seconds: float, stop: threading.Event, started: Callable[[
         try:
             kind, *what = read_message(receive)
         except EOFError:
-            code = child.wait(GRACE)
+            try:
+                code = child.wait(GRACE)
+            except subprocess.TimeoutExpired:
+                code = "none (it hung up)"
             raise UserError(SOURCE, f"the mesh's process ended with exit code {code}: try fewer cells") from None
     finally:
         _end(child)
@@ -153,9 +156,12 @@ def _end(child: subprocess.Popen) -> None:
     if child.poll() is None:
         child.kill()
     try:
-        child.wait(GRACE)
         child.stdin.close()
-    except (OSError, subprocess.TimeoutExpired):
+    except OSError:
+        pass
+    try:
+        child.wait(GRACE)
+    except subprocess.TimeoutExpired:  # a killed process not gone in GRACE s: the kernel's to finish
         pass
     with _children_lock:
         _children.discard(child)
