@@ -42,7 +42,7 @@ def test_a_tiny_budget_stops_a_heavy_mesh_soon_after_its_deadline(heavy) -> None
     for seconds in (0.05, 0.6):
         t0 = time.monotonic()
         with pytest.raises(OverBudget) as info:
-            mesh_spec(heavy, {}, 192, [], deadline=t0 + seconds)
+            mesh_spec(heavy, {}, 192, [], deadline=t0 + seconds, seconds=seconds)
         late = time.monotonic() - t0 - seconds
         assert 0 <= late < LATE, late
         assert str(info.value) == (
@@ -55,6 +55,35 @@ def test_a_past_deadline_stops_before_the_shape_is_built(monkeypatch) -> None:
     monkeypatch.setattr(pipeline, "ShapeLib", lambda *a: pytest.fail("built after the deadline"))
     with pytest.raises(OverBudget, match="building the shape"):
         mesh_spec(load_spec(TORUS), {}, 16, [], deadline=time.monotonic() - 1)
+
+
+def test_the_message_names_the_budget_given_not_what_is_left_of_it(monkeypatch) -> None:
+    """A pause between the deadline and the mesh's start (a loaded machine, a process starting) shortens what is
+    left of the budget: the message still says the seconds given."""
+    now = [1000.0]
+    monkeypatch.setattr(budget.time, "monotonic", lambda: now[0])
+    timed = budget.Budget(1000.0 + 0.05, None, 192, "meshing", seconds=0.05)
+    now[0] = 1000.0 + 0.05 + 1e-3
+    with pytest.raises(OverBudget) as info:
+        timed.check()
+    assert str(info.value) == "mesh: over its time budget of 0.05 s at 192 cells (meshing); try fewer cells"
+    now[0] = 1000.0
+    late = budget.Budget(1000.0 + 0.05 - 1e-4, None, 192, "meshing", seconds=0.05)  # made after a pause
+    now[0] = 1001.0
+    with pytest.raises(OverBudget, match="of 0.05 s at 192 cells"):
+        late.check()
+    with pytest.raises(OverBudget, match="of 0.05 s at 16 cells"):  # mesh_spec passes it on
+        mesh_spec(load_spec(TORUS), {}, 16, [], deadline=now[0] - 1, seconds=0.05)
+
+
+def test_bad_cells_name_the_option_given() -> None:
+    for name in ("--cells", "cells"):
+        with pytest.raises(UserError) as info:
+            mesh_spec(load_spec(TORUS), {}, 3, [], cells_name=name)
+        assert info.value.source == name
+    with pytest.raises(UserError) as info:
+        mesh_spec(load_spec(TORUS), {}, 3, [])
+    assert info.value.source == "--cells"
 
 
 def test_a_generous_budget_gives_the_same_mesh_slice_by_slice(monkeypatch) -> None:

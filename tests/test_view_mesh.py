@@ -2,8 +2,9 @@
 as a closed binary STL, read back with trimesh and checked against analytic volumes; a scene's picked object
 placed by its transform and cut by its own clip; and every way it can fail said in one line, with no file: a
 surface that runs on without end, no real points, a mesh beyond the saves' memory, over its time budget, a
-second mesh while one runs. Stop and a closed page stop the mesh in progress. First through Starlette's test
-client, then in real headless Chromium: the button, its status while it runs, the file handed to the browser.
+second mesh while one runs. Stop and a closed page stop the mesh in progress (the life of its process:
+test_view_mesh_process.py). First through Starlette's test client, then in real headless Chromium: the button, its
+status while it runs, the file handed to the browser.
 """
 
 from __future__ import annotations
@@ -12,9 +13,8 @@ import base64
 import io
 import json
 import math
-import multiprocessing
+import os
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -31,7 +31,7 @@ from implgen.view.command import document_factory
 from implgen.view.server import create_app
 from implgen.view.session import HEADER
 from implgen.view.work import Limits
-from view_fixtures import view_process
+from view_fixtures import mesh_children, view_process
 
 HEAVY = ROOT / "examples/mesh/chmutov20.yaml"  # degree 20: the costliest of bench/results/mesh_budget.md
 TORUS_VOLUME = 2 * math.pi**2 * 1.0 * 0.35**2  # the starter torus: 2 pi^2 R r^2, R = a = 1, r = b = 0.35
@@ -70,13 +70,20 @@ def mesh_replies(ws, until=("done", "failed", "stopped")) -> tuple[list[dict], b
     raise AssertionError(f"no end of the mesh: {said}")
 
 
+def meshing(ws) -> None:
+    """Wait until the save pool has started the mesh (the running line past "waiting for the saves"): a page closed
+    before then takes its mesh out of the pool's queue (test_view_mesh_process.py)."""
+    while "waiting for the saves" in mesh_replies(ws, until=("running",))[0][-1]["text"]:
+        pass
+
+
 def save_mesh(ws, hello: dict, cells: int, **options) -> dict:
     return {"type": "save_mesh", "cells": cells, "values": hello["values"], "options": {**hello["options"], **options}}
 
 
-def mesh_processes() -> list:
+def mesh_processes() -> list[int]:
     """The meshes' child processes still alive (the test client runs the server in this process)."""
-    return [p for p in multiprocessing.active_children() if p.name == "implgen-view-mesh"]
+    return mesh_children(os.getpid())
 
 
 @pytest.fixture(scope="module")
@@ -198,7 +205,7 @@ def test_one_mesh_a_page_stop_and_a_closed_page_stop_it(heavy_built, monkeypatch
         with c.websocket_connect("/ws") as ws:
             hello = ws.receive_json()
             ws.send_text(json.dumps(save_mesh(ws, hello, 128)))  # seconds of work
-            mesh_replies(ws, until=("running",))
+            meshing(ws)
             ws.send_text(json.dumps(save_mesh(ws, hello, 32)))
             said, _ = mesh_replies(ws, until=("failed",))
             assert said[-1]["text"] == "save_mesh: a mesh is already being made: wait for it, or stop it"
@@ -207,7 +214,7 @@ def test_one_mesh_a_page_stop_and_a_closed_page_stop_it(heavy_built, monkeypatch
             assert said[-1] == {"type": "mesh", "state": "stopped", "text": "meshing stopped"} and data is None
             assert ended == ["stopped"] and not mesh_processes()  # killed, not left running
             ws.send_text(json.dumps(save_mesh(ws, hello, 128)))  # again, then the page closes
-            mesh_replies(ws, until=("running",))
+            meshing(ws)
         deadline = time.monotonic() + GUARD
         while len(ended) < 2:
             assert time.monotonic() < deadline, "the closed page's mesh went on"
@@ -251,57 +258,6 @@ def test_ctrl_c_kills_a_mesh_in_progress(heavy_built) -> None:
         assert time.monotonic() < deadline
         time.sleep(0.05)
     assert ended == ["stopped"] and not mesh_processes()
-
-
-def _mesh_children(pid: int) -> list[int]:
-    """The processes `pid` spawned for meshes (multiprocessing's spawn_main), from /proc."""
-    out = []
-    for d in Path("/proc").iterdir():
-        try:
-            ppid = int((d / "stat").read_text().rsplit(")", 1)[1].split()[1]) if d.name.isdigit() else -1
-            cmd = (d / "cmdline").read_bytes() if ppid == pid else b""
-        except OSError:
-            continue
-        if b"spawn_main" in cmd:
-            out.append(int(d.name))
-    return out
-
-
-def test_ctrl_c_on_the_real_server_leaves_no_mesh_process(heavy_built) -> None:
-    """`implgen view` meshing in a child process, then Ctrl-C: the server ends within 2 s and so does the child."""
-    import signal
-    import subprocess
-    import sys
-
-    from websockets.sync.client import connect
-
-    cmd = [sys.executable, "-m", "implgen.cli", "view", str(HEAVY), "--no-browser", "--port", "0"]
-    srv = subprocess.Popen(
-        cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )  # fmt: skip
-    try:
-        url = "ws://" + srv.stdout.readline().split("http://", 1)[1].split("/", 1)[0] + "/ws"
-        with connect(url, max_size=2**26) as ws:
-            hello = json.loads(ws.recv())
-            ws.send(json.dumps(save_mesh(ws, hello, 128)))
-            deadline = time.monotonic() + GUARD
-            while not (kids := _mesh_children(srv.pid)):
-                assert time.monotonic() < deadline, "no mesh process"
-                time.sleep(0.05)
-            t0 = time.monotonic()
-            srv.send_signal(signal.SIGINT)
-            srv.wait(GUARD)
-        assert time.monotonic() - t0 < 2 and srv.returncode == 130
-        assert srv.stderr.read() == "implgen: interrupted\n"  # one line, no traceback
-        deadline = time.monotonic() + 5
-        while any(Path(f"/proc/{k}").exists() for k in kids):
-            assert time.monotonic() < deadline, "the mesh process outlived the server"
-            time.sleep(0.05)
-    finally:
-        if srv.poll() is None:
-            srv.kill()
-            srv.wait(30)
 
 
 # ------------------------------------------------------------------------------------- in Chromium

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import threading
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from implgen.errors import UserError
 from implgen.mesh.region import Clip, Grid, HalfSpace, Sphere, make_grid
@@ -49,16 +49,17 @@ class Stopped(Exception):
 @dataclass
 class Budget:
     """The deadline (time.monotonic(), or None) and the stop of one mesh. `phase` names what runs, for the
-    message; `seconds` is the budget the deadline gave at the start."""
+    message; `seconds` is the budget the message names: the seconds the deadline was given (by default how far
+    off it is when the Budget is made, which a pause before it would shorten)."""
 
     deadline: float | None = None
     cancel: threading.Event | None = None
     cells: int = 0
     phase: str = "starting"
-    seconds: float = field(init=False, default=0.0)
+    seconds: float | None = None
 
     def __post_init__(self) -> None:
-        if self.deadline is not None:
+        if self.seconds is None and self.deadline is not None:
             self.seconds = max(0.0, self.deadline - time.monotonic())
 
     def check(self) -> None:
@@ -66,7 +67,7 @@ class Budget:
         if self.cancel is not None and self.cancel.is_set():
             raise Stopped
         if self.deadline is not None and time.monotonic() > self.deadline:
-            raise OverBudget(self.seconds, self.cells, self.phase)
+            raise OverBudget(self.seconds or 0.0, self.cells, self.phase)
 
 
 def check_cells(cells: int, source: str = "--cells") -> int:

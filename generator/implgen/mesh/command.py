@@ -131,7 +131,14 @@ def main(argv: Sequence[str]) -> int:
     values.update(_params(spec, args.param))
     deadline = None if limit is None else time.monotonic() + limit  # counted from here: the file is read
     result = mesh_spec(
-        spec, values, args.cells, clips, singular=not args.no_singular, what=args.file, deadline=deadline
+        spec,
+        values,
+        args.cells,
+        clips,
+        singular=not args.no_singular,
+        what=args.file,
+        deadline=deadline,
+        seconds=limit,
     )
     verts, faces = result.mesh.vertices, result.mesh.faces
     normals = vertex_normals(result.lib, result.clips, verts)

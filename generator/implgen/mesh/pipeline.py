@@ -62,12 +62,14 @@ def mesh_spec(
     deadline: float | None = None,
     cancel: threading.Event | None = None,
     cells_name: str = "--cells",
+    seconds: float | None = None,
 ) -> Result:
     """Mesh the solid f < 0 (∩ the spec's box, ∩ the user's clip) of `spec` with these param values. Past
     `deadline` (a time.monotonic() value) it raises budget.OverBudget, once `cancel` is set budget.Stopped.
     A mesh with no faces is a UserError: no real points in the region, or (crossings on the grid lines but no
-    grid vertex in the solid) too few cells, the option named by `cells_name`."""
-    budget = Budget(deadline, cancel, check_cells(cells, "cells"), "building the shape")
+    grid vertex in the solid) too few cells, the option named by `cells_name`. `seconds`, the budget the deadline
+    was given, is what OverBudget's message names (by default, how far off the deadline is at the start)."""
+    budget = Budget(deadline, cancel, check_cells(cells, cells_name), "building the shape", seconds)
     budget.check()
     t0 = time.perf_counter()
     full = {**spec.params, **values}

@@ -7,61 +7,59 @@ is the picked object alone, cut by its own clip (if the file gives it one) and p
 
 Each mesh has bounds, checked before any work: cells in [MIN_CELLS, MAX_CELLS]; an upper estimate of its memory
 (mesh/budget.py) reserved from the saves' memory (work.py); a time budget (Limits.mesh_budget, counted from when
-the save pool starts it). The mesh is NumPy work in Python, so it runs in a child process (spawned, never forked
-from the threaded server): in the server's own process it held the GIL long enough to cost the other pages
-half their frames (bench/view_mesh.py). The child stops itself at its budget, saying in which phase; a save pool
-thread waits for it and kills it at once on Stop, when its page closes or at Ctrl-C, or GRACE seconds past its
-budget. A page meshes one shape at a time. The singular-point search of `implgen mesh` is skipped: its time and memory
-do not depend on the cells (tens of seconds and hundreds of MB on a degree-20 surface); nodes are closed around.
+the save pool starts it). The mesh is NumPy work in Python that would hold the server's GIL, so it runs in a
+child process (mesh/job.py: a fresh interpreter, never a fork of the threaded server, in a session of its own so
+that a Ctrl-C at the terminal is the server's alone). The child stops itself at its budget, saying in which
+phase, and when the server goes (its stdin ends); a save pool thread waits for it and kills it at once on Stop,
+when its page closes or at Ctrl-C, or GRACE seconds past its budget; the children left at exit are killed. A
+page meshes one shape at a time. The singular-point search of `implgen mesh` is skipped: its time and memory do
+not depend on the cells (18 s and 443 MB on a degree-20 surface, bench/results/mesh_budget.md); nodes are
+closed around.
 
 The page hears, as `{"type": "mesh", "state": ..., "text": ...}`: `running` (with the file's name), then the
-file as a binary frame (session.KIND_MESH) and `done`, or `failed` (one line), or `stopped`.
+file as a binary frame (session.KIND_MESH) and `done`, or `failed` (one line; a bug in the child is
+"internal error: Kind", its traceback in the server's log), or `stopped`.
 """
 
 from __future__ import annotations
 
 import asyncio
+import atexit
 import logging
 import math
-import multiprocessing
+import os
+import select
+import subprocess
+import sys
 import threading
 import time
 from collections.abc import Awaitable, Callable
-from dataclasses import dataclass
 
 import numpy as np
 
-from implgen.codegen.spec import Spec
 from implgen.errors import UserError
 from implgen.mesh.budget import OverBudget, Stopped, estimate_bytes
-from implgen.mesh.pipeline import closed_and_euler, mesh_spec
+from implgen.mesh.job import CHILD, SOURCE, MeshJob, read_message, write_message
 from implgen.mesh.region import Clip, Sphere, box_clips
-from implgen.mesh.write import mesh_bytes, place, vertex_normals
 from implgen.view import protocol
 from implgen.view.document import Document, Options
 from implgen.view.work import Work
 
-SOURCE = "save_mesh"
 GRACE = 10.0  # seconds a mesh's process may run past its budget (its start, one uncut phase) before it is killed
 POLL = 0.05  # seconds between looks at the stop
 
 log = logging.getLogger("implgen.view")
 Send = Callable[[dict | bytes], Awaitable[None]]
+_children: set[subprocess.Popen] = set()  # the meshes' processes alive now (any save thread)
+_children_lock = threading.Lock()
 
 
-@dataclass
-class MeshJob:
-    """What to mesh, from validated values only."""
+class ChildBug(Exception):
+    """A bug in the mesh's process: its exception's kind (the page's line) and its traceback (the log)."""
 
-    spec: Spec
-    values: dict[str, float]
-    clips: list[Clip]
-    matrix: np.ndarray | None  # object -> world (a scene's object), or None
-    cells: int
-
-    @property
-    def name(self) -> str:
-        return f"{self.spec.name}.stl"  # a spec name is an identifier (checked by the spec parser)
+    def __init__(self, kind: str, text: str):
+        super().__init__(kind)
+        self.kind, self.text = kind, text
 
 
 def _clips(kind: str, size: float, center=(0.0, 0.0, 0.0)) -> list[Clip]:
@@ -97,68 +95,87 @@ def estimate(job: MeshJob) -> int:
 
 
 def run(job: MeshJob, seconds: float, stop: threading.Event, started: Callable[[], None]) -> tuple[bytes, str]:
-    """On the save pool: the STL's bytes and a line saying what they hold, made in a child process (`make`). The
-    budget starts now; the child stops itself at it (OverBudget, with its phase) and is killed at once on `stop`,
-    or GRACE seconds past the budget when its work is not cut soon enough."""
+    """On the save pool: the STL's bytes and a line saying what they hold, made in a child process (mesh/job.py).
+    The budget starts now, the child's start counted in it; a stop set while this waited in the pool ends it
+    before the child is started. The child stops itself at the budget (OverBudget, with its phase) and is killed
+    at once on `stop`, or GRACE seconds past the budget when its work is not cut soon enough."""
+    deadline = time.monotonic() + seconds  # CLOCK_MONOTONIC: the same clock in the child
+    if stop.is_set():
+        raise Stopped
     started()
-    ctx = multiprocessing.get_context("spawn")  # a fresh interpreter: never a fork of the threaded server
-    receive, send = ctx.Pipe(duplex=False)
-    child = ctx.Process(target=_child, args=(job, seconds, send), name="implgen-view-mesh", daemon=True)
-    hard = time.monotonic() + seconds + GRACE
-    child.start()
-    send.close()
+    read_fd, write_fd = os.pipe()
     try:
-        while not receive.poll(POLL):
+        child = subprocess.Popen(
+            [sys.executable, *CHILD, str(write_fd)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.DEVNULL,
+            pass_fds=(write_fd,),
+            start_new_session=True,  # a Ctrl-C at the terminal is the server's: it kills this
+        )
+    except BaseException:
+        os.close(read_fd)
+        raise
+    finally:
+        os.close(write_fd)
+    with _children_lock:
+        _children.add(child)
+    receive = os.fdopen(read_fd, "rb")
+    try:
+        try:
+            write_message(child.stdin.fileno(), (job, deadline, seconds))
+        except OSError:  # it has ended already: its pipe says so below
+            pass
+        hard = deadline + GRACE
+        ready = select.poll()  # not select(): a busy server's descriptors may pass FD_SETSIZE
+        ready.register(read_fd, select.POLLIN)  # the reply's first bytes, or its end (POLLHUP)
+        while not ready.poll(POLL * 1000):
             if stop.is_set():
                 raise Stopped
             if time.monotonic() > hard:
                 raise OverBudget(seconds, job.cells, "killed")
-            if not child.is_alive() and not receive.poll(0):
-                raise UserError(SOURCE, f"the mesh's process ended with exit code {child.exitcode}: try fewer cells")
         try:
-            kind, *what = receive.recv()
+            kind, *what = read_message(receive)
         except EOFError:
-            raise UserError(SOURCE, f"the mesh's process ended with exit code {child.exitcode}") from None
+            try:
+                code = child.wait(GRACE)
+            except subprocess.TimeoutExpired:
+                code = "none (it hung up)"
+            raise UserError(SOURCE, f"the mesh's process ended with exit code {code}: try fewer cells") from None
     finally:
-        if child.is_alive():
-            child.kill()
-        child.join(GRACE)
+        _end(child)
         receive.close()
     if kind == "ok":
         return what[0], what[1]
     if kind == "user":
         raise UserError(what[0], what[1])
-    raise RuntimeError(f"in the mesh's process: {what[0]}")
+    raise ChildBug(what[0], what[1])
 
 
-def _child(job: MeshJob, seconds: float, send) -> None:
-    """The child process: make the mesh, send ("ok", bytes, line), ("user", source, message) or ("bug", text)."""
+def _end(child: subprocess.Popen) -> None:
+    """Kill the child if it still runs, and reap it."""
+    if child.poll() is None:
+        child.kill()
     try:
-        reply = ("ok", *make(job, time.monotonic() + seconds))
-    except UserError as err:
-        reply = ("user", err.source, err.message)
-    except Exception as err:  # a bug: its kind and text to the server's log
-        reply = ("bug", f"{type(err).__name__}: {err}")
-    send.send(reply)
-    send.close()
+        child.stdin.close()
+    except OSError:
+        pass
+    try:
+        child.wait(GRACE)
+    except subprocess.TimeoutExpired:  # a killed process not gone in GRACE s: the kernel's to finish
+        pass
+    with _children_lock:
+        _children.discard(child)
 
 
-def make(job: MeshJob, deadline: float) -> tuple[bytes, str]:
-    """The STL's bytes and a line saying what they hold (in the child process)."""
-    t0 = time.monotonic()
-    result = mesh_spec(job.spec, job.values, job.cells, job.clips, False, SOURCE, deadline, cells_name="cells")
-    verts, faces = result.mesh.vertices, result.mesh.faces
-    normals = vertex_normals(result.lib, result.clips, verts)
-    if job.matrix is not None:
-        verts, faces, normals = place(job.matrix, verts, faces, normals)
-    closed, euler = closed_and_euler(faces, len(verts))
-    data = mesh_bytes("stl", verts, faces, normals)
-    shape = "closed" if closed else "NOT closed"
-    line = (
-        f"saved {job.name}: {len(faces)} triangles at {job.cells} cells, {shape}, Euler characteristic {euler} "
-        f"({time.monotonic() - t0:.1f} s)"
-    )
-    return data, line
+@atexit.register
+def _kill_children() -> None:
+    """At exit (Ctrl-C: the save threads are daemons and may not get their turn), no mesh's process outlives the
+    server."""
+    with _children_lock:
+        left = list(_children)
+    for child in left:
+        if child.poll() is None:
+            child.kill()
 
 
 class MeshSaver:
@@ -204,6 +221,10 @@ class MeshSaver:
             )
         except Stopped:
             await self._tell("stopped", "meshing stopped")
+            return
+        except ChildBug as err:  # the page: its kind; the log: the child's traceback
+            log.error("viewer mesh failed in its process:\n%s", err.text.rstrip())
+            await self._tell("failed", f"internal error: {err.kind}")
             return
         except Exception as err:  # bad input or its budget: one line; a bug: logged too
             if not isinstance(err, UserError):

@@ -256,38 +256,41 @@ class Work:
             if self.closed:
                 raise asyncio.CancelledError
             self._tickets.add(ticket)
-        fut = asyncio.wrap_future(pool.submit(fn, ticket, asyncio.get_running_loop(), *args))
         try:
-            return await asyncio.shield(fut)
-        except asyncio.CancelledError:
-            ticket.cancel()
-            if not self.closed:
-                await asyncio.wait([fut])
-            raise
+            return await self._shielded(pool.submit(fn, ticket, asyncio.get_running_loop(), *args), ticket.cancel)
         finally:
             ticket.disarm()
             with self._lock:
                 self._tickets.discard(ticket)
 
     async def stoppable(self, pool: Pool, stop: threading.Event, fn: Callable, *args) -> Any:
-        """fn(*args) on the pool, fn looking at `stop` as it goes (a mesh): a cancelled caller sets it and waits for
-        fn to end (its page is counted until then); shutdown sets it too."""
+        """fn(*args) on the pool, fn looking at `stop` as it goes (a mesh): a cancelled caller sets it, takes fn out
+        of the pool's queue if it has not started, or waits for it to end (its page is counted until then);
+        shutdown sets it too."""
         with self._lock:
             if self.closed:
                 raise asyncio.CancelledError
             self._stops.add(stop)
-        fut = asyncio.wrap_future(pool.submit(fn, *args))
+        try:
+            return await self._shielded(pool.submit(fn, *args), stop.set)
+        finally:
+            with self._lock:
+                self._stops.discard(stop)
+
+    async def _shielded(self, work: Future, on_cancel: Callable[[], None]) -> Any:
+        """The pool's result for `work`, which a cancel of the caller does not cut short: the caller's cancel calls
+        `on_cancel` (fn stops soon), cancels `work` if it still waits in the queue (the pool skips it), else waits
+        for it to end -- unless the server is shutting down."""
+        fut = asyncio.wrap_future(work)
         fut.add_done_callback(lambda f: f.cancelled() or f.exception())  # heard even when no one waits (Ctrl-C)
         try:
             return await asyncio.shield(fut)
         except asyncio.CancelledError:
-            stop.set()
+            on_cancel()
+            work.cancel()  # only a queued item: a running one cannot be cancelled
             if not self.closed:
                 await asyncio.wait([fut])
             raise
-        finally:
-            with self._lock:
-                self._stops.discard(stop)
 
     def reserve_save(self, pixels: int) -> Callable[[], None]:
         """Reserve a picture's memory, or refuse it in one line; returns the release (call it once, any thread)."""
