@@ -55,7 +55,7 @@ def overrun(spec, seconds: float) -> tuple[float, str]:
     """(seconds from the deadline to the OverBudget, or NaN when the mesh finished; the phase it stopped in)."""
     t0 = time.monotonic()
     try:
-        mesh_spec(spec, {}, OVERRUN_CELLS, [], deadline=t0 + seconds)
+        mesh_spec(spec, {}, OVERRUN_CELLS, [], deadline=t0 + seconds, seconds=seconds)
     except OverBudget as err:
         return time.monotonic() - t0 - seconds, err.phase
     return float("nan"), "finished"
