@@ -14,6 +14,7 @@ import io
 import json
 import math
 import os
+import threading
 import time
 
 import numpy as np
@@ -29,7 +30,7 @@ from implgen.mesh.pipeline import mesh_spec
 from implgen.view import meshsave
 from implgen.view.command import document_factory
 from implgen.view.server import create_app
-from implgen.view.session import HEADER
+from implgen.view.session import HEADER, KIND_SAVE
 from implgen.view.work import Limits
 from view_fixtures import mesh_children, view_process
 
@@ -71,9 +72,9 @@ def mesh_replies(ws, until=("done", "failed", "stopped")) -> tuple[list[dict], b
 
 
 def meshing(ws) -> None:
-    """Wait until the save pool has started the mesh (the running line past "waiting for the saves"): a page closed
+    """Wait until the mesh pool has started the mesh (the running line past "waiting for the meshes"): a page closed
     before then takes its mesh out of the pool's queue (test_view_mesh_process.py)."""
-    while "waiting for the saves" in mesh_replies(ws, until=("running",))[0][-1]["text"]:
+    while "waiting for the meshes" in mesh_replies(ws, until=("running",))[0][-1]["text"]:
         pass
 
 
@@ -220,6 +221,37 @@ def test_one_mesh_a_page_stop_and_a_closed_page_stop_it(heavy_built, monkeypatch
             assert time.monotonic() < deadline, "the closed page's mesh went on"
             time.sleep(0.05)
         assert ended == ["stopped", "stopped"] and not mesh_processes()
+
+
+def test_a_save_png_does_not_wait_behind_a_mesh(monkeypatch) -> None:
+    """A mesh holds its pool's thread until its process ends (here: held until the picture has come); Save PNG
+    has a pool of its own, so the picture comes meanwhile, and the mesh then ends as usual."""
+    gate = threading.Event()
+    real_run = meshsave.run
+
+    def run(*args):
+        gate.wait(GUARD)
+        return real_run(*args)
+
+    monkeypatch.setattr(meshsave, "run", run)
+    with client() as c, c.websocket_connect("/ws") as ws:
+        hello = ws.receive_json()
+        ws.send_text(json.dumps(save_mesh(ws, hello, 24)))
+        assert mesh_replies(ws, until=("running",))[0][-1]["state"] == "running"  # taken by the mesh pool
+        ws.send_text(json.dumps({"type": "save_png", "width": 32, "height": 24, "spp": 1}))
+        deadline = time.monotonic() + GUARD
+        while True:
+            assert time.monotonic() < deadline and not gate.is_set()
+            msg = ws.receive()
+            assert "text" in msg or msg.get("bytes") is not None, msg  # not the socket's close
+            if msg.get("bytes") is not None:
+                _, kind, _, w, h = HEADER.unpack(msg["bytes"][: HEADER.size])
+                assert (kind, w, h) == (KIND_SAVE, 32, 24)  # the picture, while the mesh still waits
+                break
+            assert json.loads(msg["text"]).get("state") not in ("done", "failed", "stopped"), msg
+        gate.set()
+        said, data = mesh_replies(ws)
+        assert said[-1]["state"] == "done" and stl(data).is_watertight, said
 
 
 def test_ctrl_c_kills_a_mesh_in_progress(heavy_built) -> None:

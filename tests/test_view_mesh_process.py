@@ -1,6 +1,6 @@
 """The lifetime of Save mesh's child process (view/meshsave.py, mesh/job.py): a Ctrl-C at the terminal (SIGINT to
 the whole process group) is the server's one line and leaves no mesh running; a server killed outright leaves no
-mesh running on to its budget, and nothing on stderr; a mesh whose page closes while it waits in the save pool
+mesh running on to its budget, and nothing on stderr; a mesh whose page closes while it waits in its pool
 never starts a process; a child killed from outside is one line; its budget counts from when the pool starts it;
 a bug in the child is its kind on the page and its traceback in the server's log; the child imports nothing of
 the viewer."""

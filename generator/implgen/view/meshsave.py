@@ -7,10 +7,10 @@ is the picked object alone, cut by its own clip (if the file gives it one) and p
 
 Each mesh has bounds, checked before any work: cells in [MIN_CELLS, MAX_CELLS]; an upper estimate of its memory
 (mesh/budget.py) reserved from the saves' memory (work.py); a time budget (Limits.mesh_budget, counted from when
-the save pool starts it). The mesh is NumPy work in Python that would hold the server's GIL, so it runs in a
+the mesh pool starts it). The mesh is NumPy work in Python that would hold the server's GIL, so it runs in a
 child process (mesh/job.py: a fresh interpreter, never a fork of the threaded server, in a session of its own so
 that a Ctrl-C at the terminal is the server's alone). The child stops itself at its budget, saying in which
-phase, and when the server goes (its stdin ends); a save pool thread waits for it and kills it at once on Stop,
+phase, and when the server goes (its stdin ends); a mesh pool thread waits for it and kills it at once on Stop,
 when its page closes or at Ctrl-C, or GRACE seconds past its budget; the children left at exit are killed. A
 page meshes one shape at a time. The singular-point search of `implgen mesh` is skipped: its time and memory do
 not depend on the cells (18 s and 443 MB on a degree-20 surface, bench/results/mesh_budget.md); nodes are
@@ -50,7 +50,7 @@ POLL = 0.05  # seconds between looks at the stop
 
 log = logging.getLogger("implgen.view")
 Send = Callable[[dict | bytes], Awaitable[None]]
-_children: set[subprocess.Popen] = set()  # the meshes' processes alive now (any save thread)
+_children: set[subprocess.Popen] = set()  # the meshes' processes alive now (any mesh thread)
 _children_lock = threading.Lock()
 
 
@@ -95,7 +95,7 @@ def estimate(job: MeshJob) -> int:
 
 
 def run(job: MeshJob, seconds: float, stop: threading.Event, started: Callable[[], None]) -> tuple[bytes, str]:
-    """On the save pool: the STL's bytes and a line saying what they hold, made in a child process (mesh/job.py).
+    """On the mesh pool: the STL's bytes and a line saying what they hold, made in a child process (mesh/job.py).
     The budget starts now, the child's start counted in it; a stop set while this waited in the pool ends it
     before the child is started. The child stops itself at the budget (OverBudget, with its phase) and is killed
     at once on `stop`, or GRACE seconds past the budget when its work is not cut soon enough."""
@@ -169,7 +169,7 @@ def _end(child: subprocess.Popen) -> None:
 
 @atexit.register
 def _kill_children() -> None:
-    """At exit (Ctrl-C: the save threads are daemons and may not get their turn), no mesh's process outlives the
+    """At exit (Ctrl-C: the mesh threads are daemons and may not get their turn), no mesh's process outlives the
     server."""
     with _children_lock:
         left = list(_children)
@@ -211,13 +211,13 @@ class MeshSaver:
         loop = asyncio.get_running_loop()
         text = f"meshing {job.spec.name} at {job.cells} cells"
 
-        def started() -> None:  # the save pool's thread: the mesh starts now (it may have waited behind saves)
+        def started() -> None:  # the mesh pool's thread: the mesh starts now (it may have waited behind another)
             asyncio.run_coroutine_threadsafe(self._tell("running", text, job), loop)
 
-        await self._tell("running", f"{text}: waiting for the saves before it", job)
+        await self._tell("running", f"{text}: waiting for the meshes before it", job)
         try:
             data, line = await self.work.stoppable(
-                self.work.save, stop, run, job, self.work.limits.mesh_budget, stop, started
+                self.work.mesh, stop, run, job, self.work.limits.mesh_budget, stop, started
             )
         except Stopped:
             await self._tell("stopped", "meshing stopped")

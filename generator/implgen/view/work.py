@@ -5,8 +5,10 @@ C render, one memory bound for all saves.
             thread, so heavy equations queue up there and never stop the event loop; the libraries built are
             kept for every page that shows the same shapes
     render  the pages' live frames, each encoded on the same thread: a few at once
-    save    Save PNG and Save mesh: one at a time; the memory of every save asked for, running or waiting, is
+    save    Save PNG: one at a time; the memory of every save asked for (a mesh's too), running or waiting, is
             reserved when it is asked for and refused beyond the bound
+    mesh    Save mesh: one at a time, each thread waiting for its mesh's own process; a pool of its own, so a
+            Save PNG never waits behind a mesh
 
 A C render (a live frame or a save) runs under a `Ticket`: the page cancels it when a newer request comes or when
 it closes, and a timer on the event loop cancels it when its time budget is spent (rt_render_cancel: the C threads
@@ -60,6 +62,7 @@ class Limits:
     parse_threads: int = 1  # SymPy holds the GIL: a second thread parses no faster and slows the event loop
     render_threads: int = 4
     save_threads: int = 1
+    mesh_threads: int = 1
 
     @staticmethod
     def from_env(env: Mapping[str, str] = os.environ) -> Limits:
@@ -216,6 +219,7 @@ class Work:
         self.parse = Pool("parse", self.limits.parse_threads)
         self.render = Pool("render", self.limits.render_threads)
         self.save = Pool("save", self.limits.save_threads)
+        self.mesh = Pool("mesh", self.limits.mesh_threads)
         self._lock = threading.Lock()
         self._tickets: set[Ticket] = set()
         self._stops: set[threading.Event] = set()  # the meshes running or waiting (stoppable)
@@ -340,5 +344,5 @@ class Work:
                 fut.cancel()
             except RuntimeError:  # its loop has ended
                 pass
-        for pool in (self.parse, self.render, self.save):
+        for pool in (self.parse, self.render, self.save, self.mesh):
             pool.shutdown(wait=False, cancel_futures=True)
