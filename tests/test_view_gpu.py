@@ -8,6 +8,7 @@ The browser side is tests/test_view_gpu_browser.py."""
 from __future__ import annotations
 
 import json
+import threading
 
 import numpy as np
 import pytest
@@ -101,6 +102,36 @@ def test_a_gpu_request_gets_no_coarse_frames(client) -> None:
             kinds.append(kind)
             assert seq == 2
     assert KIND_COARSE not in kinds and set(kinds) <= {KIND_ONE, KIND_FULL}
+
+
+def test_a_slow_glsl_does_not_hold_the_renders_behind_it(client, monkeypatch) -> None:
+    """The GLSL's derivation (SymPy: seconds at a high degree) runs beside the page's messages: a render sent
+    after the `glsl` request is answered while the derivation is held, and the GLSL then comes, numbered as the
+    shape it was asked for."""
+    gate = threading.Event()
+    real = gpu.program_message
+
+    def held(doc):
+        gate.wait(30)
+        return real(doc)
+
+    monkeypatch.setattr(gpu, "program_message", held)
+    with client.websocket_connect("/ws") as ws:
+        hello = reply(ws)
+        ws.send_text(render_msg(hello, seq=1, refine=False, w=64, h=48))
+        picture(ws)  # the shape is built (as it is when the page asks for its GLSL: after the shape reply)
+        ws.send_text(json.dumps({"type": "glsl"}))
+        ws.send_text(render_msg(hello, seq=2, refine=True, gpu=True, w=64, h=48))
+        seq, kind = HEADER.unpack(picture(ws)[: HEADER.size])[:2]
+        assert seq == 2 and kind in (KIND_ONE, KIND_FULL) and not gate.is_set()  # the frame, the GLSL still held
+        gate.set()
+        texts = []
+        while not texts or texts[-1]["type"] != "glsl":  # past the refined frame that may follow
+            msg = ws.receive()
+            assert "text" in msg or msg.get("bytes") is not None, msg  # not the socket's close
+            if msg.get("text") is not None:
+                texts.append(json.loads(msg["text"]))
+        assert texts[-1]["shape_id"] == hello["shape_id"] == 0 and texts[-1]["name"] == "torus"
 
 
 def test_the_page_s_scripts_are_the_shared_page_s_files(client) -> None:

@@ -82,6 +82,7 @@ class Session:
         self._last_start = 0.0
         self._task: asyncio.Task | None = None
         self._saving: asyncio.Task | None = None
+        self._glsl: asyncio.Task | None = None
         self.frames = 0  # frames sent (for tests)
         self.meshes = MeshSaver(self.work, send, lambda stl: send(HEADER.pack(0, KIND_MESH, 0, 0, 0) + stl))
         self._shape_id = 0  # numbers the shapes sent to the page (hello, shape replies), for the GPU preview
@@ -128,9 +129,10 @@ class Session:
             elif kind == "export_page":
                 name, html = await self.work.call(self.work.parse, sharepage.page_text, replace(self.doc))
                 await self.send({"type": "page", "name": name, "text": html})
-            elif kind == "glsl":  # the page's GPU preview asks for the current shape's GLSL
-                msg = await self.work.call(self.work.parse, gpu.program_message, replace(self.doc))
-                await self.send({**msg, "shape_id": self._shape_id})
+            elif kind == "glsl":  # the GPU preview asks for the current shape's GLSL: derived (SymPy) in a task of
+                if self._glsl is not None:  # its own, so the renders behind it are read meanwhile; a newer ask wins
+                    self._glsl.cancel()
+                self._glsl = asyncio.get_running_loop().create_task(self._send_glsl(replace(self.doc), self._shape_id))
             elif kind == "show_c":
                 await self.send(
                     {"type": "c", "text": await self.work.call(self.work.parse, dump.c_text, self.doc.spec)}
@@ -333,13 +335,21 @@ class Session:
             log.error(what, exc_info=err)
         await self.send(protocol.error_for(err))
 
+    async def _send_glsl(self, doc: Document, shape_id: int) -> None:
+        """The `glsl` message of `doc`'s shape, numbered as that shape was (never a newer shape's number)."""
+        try:
+            msg = await self.work.call(self.work.parse, gpu.program_message, doc)
+            await self.send({**msg, "shape_id": shape_id})
+        except UserError as err:
+            await self.send(protocol.error_for(err))
+
     async def close(self) -> None:
         """The page has gone: cancel its renders and its save, and return once they have stopped."""
         self._pending = None
         for ticket in (self._live, self._save):
             if ticket is not None:
                 ticket.cancel()
-        tasks = [t for t in (self._task, self._saving) if t is not None and not t.done()]
+        tasks = [t for t in (self._task, self._saving, self._glsl) if t is not None and not t.done()]
         for t in tasks:
             t.cancel()
         await asyncio.gather(*tasks, return_exceptions=True)  # work.trace waits for the C threads to stop

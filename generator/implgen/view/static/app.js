@@ -294,7 +294,7 @@
     // a picture drawn: the last error is over (not a field's own complaint while it still holds no number)
     if (messageIsError && fseq > errorSeq && !$("clip-size").classList.contains("bad")) showMessage("", false);
     $("status").textContent = `${KIND_NAME[kind]} ${w} x ${h}${ms}`;
-    if (gpu && kind !== KIND_COARSE) gpu.serverFrame(ctx2d);
+    if (gpu && kind !== KIND_COARSE) gpu.serverFrame(ctx2d, kind === KIND_FULL);
     showEmpty((flags & FLAG_EMPTY) !== 0);
     for (const k of sentAt.keys()) if (k < fseq) sentAt.delete(k);
   }

@@ -78,6 +78,7 @@ const ImplgenGpu = (() => {
       g.shapeId = msg.shape_id;
       g.shape = null;
       g.view = null;
+      g.key = ""; // the next view is drawn, even one equal to the last shape's
       g.reason = "";
       stop();
       ask();
@@ -167,11 +168,11 @@ const ImplgenGpu = (() => {
     }
 
     /** The server's refined frame is on the page's canvas: it replaces the GPU's picture (and is compared). */
-    function serverFrame(ctx2d) {
+    function serverFrame(ctx2d, final) {
       view.dataset.shown = "server";
       if (!active() || !g.view) { stop(); overlay.hidden = true; return; }
       stop();
-      if (compare.checked) runCompare(ctx2d);
+      if (compare.checked && final) runCompare(ctx2d); // the 4-sample frame only: one compare a rest
       else overlay.hidden = true;
     }
 
@@ -180,6 +181,7 @@ const ImplgenGpu = (() => {
     // the server antialiased, at 4 samples a pixel, is not a difference; the GPU draws 1, at the centre).
     function runCompare(ctx2d) {
       const r = g.renderer;
+      if (r.gl.isContextLost()) { overlay.hidden = true; return; } // its pixels would read as zeros
       apply(g.view);
       for (let y = 0; y < r.height; y += 32) r.draw({ rows: [y, y + 32] }); // bands: no draw long enough for a watchdog
       const w = r.width, h = r.height;
@@ -238,6 +240,7 @@ const ImplgenGpu = (() => {
       e.preventDefault();
       g.failure = "GPU preview off: the browser took the GPU away (WebGL context lost)";
       stop();
+      overlay.hidden = true;
       say();
     });
     say();
