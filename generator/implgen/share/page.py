@@ -35,6 +35,8 @@ STATIC = Path(__file__).resolve().parent / "static"
 SCRIPTS = ("surface.js", "orbit.js", "page.js")  # in this order: page.js uses the other two
 CLIPS = ("none", "sphere", "box")
 MAX_DESCRIPTION = 400  # characters of the spec's description shown on the page
+# the shape's Phong material, both sides: the shared page's and the viewer's (view/document.py, its GPU preview)
+MATERIAL = {"ambient": 0.12, "diffuse": 0.75, "specular": 0.45, "shininess": 40.0}
 
 
 @dataclass(frozen=True)
@@ -159,6 +161,7 @@ def render_page(spec: Spec, sliders: list[Slider], look: Look, source_name: str,
         "params": [{"name": s.name, "value": s.value, "min": s.lo, "max": s.hi} for s in sliders],
         "orbit": orbit,
         "clip": {"kind": look.clip, "size": look.clip_size, "cut": look.cut},
+        "material": MATERIAL,
     }
     scripts = [static_text(name) for name in SCRIPTS]
     css = static_text("page.css")

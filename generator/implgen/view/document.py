@@ -14,6 +14,7 @@ import numpy as np
 
 from implgen.codegen.spec import Spec, parse_spec
 from implgen.scene.model import Camera, Clip, Csg, Leaf, Light, Material, Node, Scene
+from implgen.share.page import MATERIAL  # the shape's material, both sides: the shared page's too
 
 CLIPS = ("none", "sphere", "box")
 LIGHTS = ("studio", "headlight", "top", "scene")
@@ -29,7 +30,6 @@ LIGHT_PRESETS: dict[str, list[dict]] = {
     "headlight": [{"frame": "camera", "at": (0.0, 0.0, 0.5), "colour": (1.0, 1.0, 1.0)}],
     "top": [{"frame": "world", "at": (0.0, 3.0, 0.3), "colour": (1.0, 1.0, 1.0)}],
 }
-MATERIAL = {"ambient": 0.12, "diffuse": 0.75, "specular": 0.45, "shininess": 40.0}  # the shape's, both sides
 
 # The starter shape: Suffern's torus about the y-axis.
 STARTER = {

@@ -21,7 +21,8 @@ from implgen.codegen.emit import generate
 from implgen.codegen.glslprogram import HEADERS, runtime_text
 from implgen.errors import UserError
 from implgen.scene.model import Csg, Leaf, Node
-from implgen.view.document import LIGHT_PRESETS, MATERIAL, Document
+from implgen.share.page import MATERIAL
+from implgen.view.document import LIGHT_PRESETS, Document
 
 log = logging.getLogger("implgen.view")
 

@@ -30,6 +30,7 @@
     const log = r.setEquationProgram({
       name: data.name, shape: data.shape, runtime: data.runtime, header: data.header, params: data.params.length,
     });
+    r.setMaterial(data.material); // the viewer's (share/page.py MATERIAL)
     if (log) {
       fail(`the shader did not compile on this browser: ${log.split("\n")[0]}`);
       console.error(log);

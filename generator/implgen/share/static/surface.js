@@ -268,7 +268,7 @@ void main()
       this.params = [];
       this.camera = { eye: [3, 2, 4], target: [0, 0, 0], up: [0, 1, 0], fov: 40 };
       this.clip = { kind: "none", size: 1, cut: false };
-      this.material = { ambient: 0.12, diffuse: 0.75, specular: 0.45, shininess: 40 }; // the viewer's
+      this.material = null; // the page's (share/page.py MATERIAL, in its data): set before the first draw
       this.lights = [{ direction: LIGHT, colour: [1, 1, 1] }];
       this.shadows = false;
       this.colours = { outside: [0.95, 0.75, 0.3], inside: [0.35, 0.55, 0.95], background: [0.12, 0.12, 0.14] };
@@ -394,6 +394,7 @@ void main()
       gl.uniform1f(loc("ig_page_clip_size"), this.clip.size);
       gl.uniform1i(loc("ig_page_cut"), this.clip.cut ? 1 : 0);
       const m = this.material;
+      if (!m) throw new Error("IgSurface.Renderer: setMaterial before the first draw");
       gl.uniform4f(loc("ig_page_material"), m.ambient, m.diffuse, m.specular, m.shininess);
       const pos = new Float32Array(4 * MAX_LIGHTS);
       const col = new Float32Array(3 * MAX_LIGHTS);
