@@ -213,7 +213,7 @@ static void embree_scene(const scene_in *s, emb *e, int inst, enum RTCSceneFlags
     int i;
     memset(e, 0, sizeof *e);
     e->inst = inst;
-    e->dev = rtcNewDevice(NULL);
+    e->dev = rtcNewDevice(getenv("IG_EMBREE_CONFIG")); /* e.g. "isa=avx2": every ISA on one machine */
     e->scene = rtcNewScene(e->dev);
     rtcSetSceneFlags(e->scene, flags); /* before the first commit: Embree picks its traversal kernels there */
     e->prims = calloc((size_t)s->n + 1, sizeof *e->prims);
@@ -478,7 +478,7 @@ static void reject_prim(const struct RTCFilterFunctionNArguments *args)
 static int mode_packets(const scene_in *s, int W, int H, int K)
 {
     emb e;
-    int n = W * H, widths[3] = {4, 8, 16}, wi, bad = 0, checked = 0, k;
+    int n = W * H, widths[3] = {4, 8, 16}, native[3], wi, bad = 0, checked = 0, k;
     float(*rays)[6] = malloc(sizeof(float[6]) * (size_t)n);
     struct RTCRayHit *one = malloc(sizeof *one * (size_t)n);
     int *occ1 = malloc(sizeof(int) * (size_t)n);
@@ -487,6 +487,13 @@ static int mode_packets(const scene_in *s, int W, int H, int K)
         fail("out of memory");
     /* with K: a context filter that rejects object K, in every call below */
     embree_scene(s, &e, 0, K >= 0 ? RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION : RTC_SCENE_FLAG_NONE);
+    /* Embree 3 keeps a lane that the valid mask switches off untouched only at widths its ISA runs natively; a
+     * wider packet is traced as a stream of single rays, where the valid mask is not read and a lane is off only
+     * when tnear > tfar (rtcIntersect1M's rule). So lanes off at an emulated width are marked both ways, as a
+     * caller must for every ISA, and at a native width by the valid mask alone. */
+    for (wi = 0; wi < 3; ++wi)
+        native[wi] =
+            rtcGetDeviceProperty(e.dev, (enum RTCDeviceProperty)(RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED + wi)) != 0;
     reject_context ctx1; /* double records of every ray, by its id (= its index) */
     ig_embree_context_init(&ctx1.ig, rec1, (unsigned)n);
     ctx1.prim = (unsigned)K;
@@ -540,6 +547,10 @@ static int mode_packets(const scene_in *s, int W, int H, int K)
                 LANE_F(buf, N, 7, i) = LANE_F(obuf, N, 7, i) = 0.0f;
                 LANE_F(buf, N, 8, i) = INFINITY;
                 LANE_F(obuf, N, 8, i) = isfinite(one[j].ray.tfar) ? 0.999f * one[j].ray.tfar : 20.0f;
+                if (!valid[i] && !native[wi]) { /* emulated width: off by the stream rule too */
+                    LANE_F(buf, N, 3, i) = LANE_F(obuf, N, 3, i) = 1.0f;
+                    LANE_F(buf, N, 8, i) = LANE_F(obuf, N, 8, i) = 0.0f;
+                }
                 LANE_U(buf, N, 9, i) = LANE_U(obuf, N, 9, i) = ~0u;
                 LANE_U(buf, N, 10, i) = LANE_U(obuf, N, 10, i) = (unsigned)j;
                 LANE_U(buf, N, 11, i) = LANE_U(obuf, N, 11, i) = 0;
@@ -561,8 +572,11 @@ static int mode_packets(const scene_in *s, int W, int H, int K)
                 const struct RTCHit *h1 = &one[j].hit;
                 ++checked;
                 if (!valid[i]) {
-                    same = isinf(LANE_F(buf, N, 8, i)) && LANE_U(buf, N, 12 + 6, i) == RTC_INVALID_GEOMETRY_ID &&
-                           LANE_F(obuf, N, 8, i) >= 0.0f;
+                    float far0 = native[wi] ? INFINITY : 0.0f, ofar0 = native[wi] ? 0.999f * one[j].ray.tfar : 0.0f;
+                    if (native[wi] && !isfinite(one[j].ray.tfar))
+                        ofar0 = 20.0f;
+                    same = LANE_F(buf, N, 8, i) == far0 && LANE_U(buf, N, 12 + 6, i) == RTC_INVALID_GEOMETRY_ID &&
+                           LANE_F(obuf, N, 8, i) == ofar0;
                 } else {
                     same = memcmp(&LANE_F(buf, N, 8, i), &one[j].ray.tfar, sizeof(float)) == 0 &&
                            LANE_U(buf, N, 12 + 6, i) == h1->geomID && (LANE_F(obuf, N, 8, i) < 0.0f) == occ1[j];
@@ -585,8 +599,9 @@ static int mode_packets(const scene_in *s, int W, int H, int K)
             }
         }
     }
-    printf("packets: %d lanes of width 4, 8, 16 checked, %d differ; filter rejecting object %d: %d calls\n", checked,
-           bad, K, ctx1.calls);
+    printf("packets: %d lanes of width 4, 8, 16 checked, %d differ; filter rejecting object %d: %d calls; native "
+           "widths%s%s%s\n",
+           checked, bad, K, ctx1.calls, native[0] ? " 4" : "", native[1] ? " 8" : "", native[2] ? " 16" : "");
     free(rays);
     free(one);
     free(occ1);
