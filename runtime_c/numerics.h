@@ -7,7 +7,10 @@
  * - one axis of the slab test of a ray against an axis-aligned box;
  * - affine 3x4 maps (row-major, as tracer.h): a point, a vector, the inverse, a ray's unit object-space
  *   direction, a normal, a box (the tracer and the Embree adapter move rays into object space, normals and
- *   boxes into world space with these, so both see the same numbers to the last bit).
+ *   boxes into world space with these, so both see the same numbers to the last bit);
+ * - the eigen-decomposition of a symmetric 3x3 matrix (the mesh's dual-contouring vertex).
+ *
+ * Each has a named test in tests/c/test_numerics.c, its hard case among them.
  */
 #ifndef IMPLGEN_NUMERICS_H
 #define IMPLGEN_NUMERICS_H
@@ -250,6 +253,49 @@ static inline int ig_affine_box(const double m[12], const double ob[6], double w
         if (!isfinite(wb[a]))
             return 0;
     return 1;
+}
+
+/* The eigenvalues w and unit eigenvectors (columns of v) of the symmetric 3x3 matrix a, by cyclic Jacobi
+ * rotations; a is overwritten. */
+static inline void ig_sym3_eigen(double a[3][3], double w[3], double v[3][3])
+{
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            v[i][j] = i == j;
+    for (int sweep = 0; sweep < 50; ++sweep) {
+        double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        double diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+        if (!(off > 1e-34 * diag))
+            break;
+        for (int p = 0; p < 2; ++p)
+            for (int q = p + 1; q < 3; ++q) {
+                if (a[p][q] == 0.0)
+                    continue;
+                double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                if (!isfinite(t)) /* theta's square overflowed: t ~ 1 / (2 theta) */
+                    t = 0.5 / theta;
+                double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+                double r[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, m[3][3];
+                r[p][p] = r[q][q] = c;
+                r[p][q] = s;
+                r[q][p] = -s;
+                for (int i = 0; i < 3; ++i) /* m = a r */
+                    for (int j = 0; j < 3; ++j)
+                        m[i][j] = a[i][0] * r[0][j] + a[i][1] * r[1][j] + a[i][2] * r[2][j];
+                for (int i = 0; i < 3; ++i) /* a = r^T m */
+                    for (int j = 0; j < 3; ++j)
+                        a[i][j] = r[0][i] * m[0][j] + r[1][i] * m[1][j] + r[2][i] * m[2][j];
+                a[p][q] = a[q][p] = 0.0;
+                for (int i = 0; i < 3; ++i) { /* v = v r */
+                    double vp = v[i][p], vq = v[i][q];
+                    v[i][p] = c * vp - s * vq;
+                    v[i][q] = s * vp + c * vq;
+                }
+            }
+    }
+    for (int i = 0; i < 3; ++i)
+        w[i] = a[i][i];
 }
 
 #endif

@@ -5,15 +5,32 @@ from __future__ import annotations
 
 import pytest
 
+from cdriver import CDriver, case_names
 from conftest import CDIR, RUNTIME, compile_c, run_c
-from implgen.resources import EMBREE_SOURCES, SHAPE_SOURCES, SOLVER_SOURCES, TRACER_SOURCES, runtime_sources
+from implgen.resources import (
+    EMBREE_SOURCES,
+    MESH_SOURCES,
+    SHAPE_SOURCES,
+    SOLVER_SOURCES,
+    TRACER_SOURCES,
+    runtime_sources,
+)
 
 SOLVERS = runtime_sources(SOLVER_SOURCES)
 
 
-def test_roots_hard_cases_under_sanitizers(tmp_path):
-    out = run_c(compile_c(tmp_path / "test_roots", [CDIR / "test_roots.c", *SOLVERS]))
-    assert "all cases passed" in out
+ROOTS_SOURCE = CDIR / "test_roots.c"
+
+
+@pytest.fixture(scope="module")
+def roots_driver(tmp_path_factory) -> CDriver:
+    return CDriver.build(tmp_path_factory.mktemp("roots") / "test_roots", [ROOTS_SOURCE, *SOLVERS])
+
+
+@pytest.mark.parametrize("case", case_names(ROOTS_SOURCE))
+def test_roots_hard_cases_under_sanitizers(roots_driver, case):
+    """tests/c/test_roots.c's named cases, each on every method it names."""
+    roots_driver.check(case)
 
 
 def test_refinement_batched_equals_single_under_sanitizers(tmp_path):
@@ -34,7 +51,14 @@ def _runtime_source(path):
 
 @pytest.mark.parametrize("src", [_runtime_source(p) for p in sorted(RUNTIME.glob("*.c"))])
 def test_runtime_sources_compile_clean(tmp_path, src):
-    assert src.name in (*SOLVER_SOURCES, *SHAPE_SOURCES, *TRACER_SOURCES, *EMBREE_SOURCES, "roots_bench.c")
+    assert src.name in (
+        *SOLVER_SOURCES,
+        *SHAPE_SOURCES,
+        *MESH_SOURCES,
+        *TRACER_SOURCES,
+        *EMBREE_SOURCES,
+        "roots_bench.c",
+    )
     compile_c(tmp_path / "x.o", [src], sanitize=False, flags=["-c"])
 
 
