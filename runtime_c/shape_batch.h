@@ -28,22 +28,4 @@ void ig_shape_values_grid(const ig_shape *shape, const double *params, const dou
 void ig_shape_project_many(const ig_shape *shape, const double *params, long n, double *p, int steps, double tol,
                            double noise, double reach, unsigned char *ok);
 
-/* The dual vertex of every sheet of every active cell of a grid (implgen mesh, dual.py). Cell c has its lower
- * corner at grid vertex corner[c] (flat, C order, strides[3] the grid's vertex strides, nvertices vertices),
- * sheets[12 c + e] the sheet of its edge e (-1: not active; numbering of cells.py) and its sheets' vertices
- * numbered from first[c]. Crossings: keys[ncross] ascending, axis * nvertices + the edge's lower vertex, with
- * points, unit normals (3 each) and piece (0: f, j: clip j). Per vertex: out[3 v ...] the mass point of its
- * crossings, or where a normal lies off their mean by more than acos(crease) the QEF minimiser about it (small
- * eigenvalues, below drop x the largest, dropped), clamped to the cell [origin + h idx, + h]; mask[v] the bits
- * of its crossings' pieces; nearest[v] the index of its crossing nearest out (-1: none); v < nverts, the
- * length of mask and nearest (a sheet numbered past it is skipped). */
-void ig_mesh_sheet_points(long ncells, const long *corner, const signed char *sheets, const long *first,
-                          const long *strides, long nvertices, long ncross, const long *keys, const double *points,
-                          const double *normals, const int *piece, const double *origin, double h, double crease,
-                          double drop, long nverts, double *out, long *mask, long *nearest);
-
-/* Quads (m x 4 vertex ids, counter-clockwise about their edge's axis; flip[i]: reversed) into triangles on the
- * shorter diagonal: tris[3 i ...] the first of quad i, tris[3 (m + i) ...] the second. */
-void ig_mesh_split_quads(long m, const long *quads, const unsigned char *flip, const double *verts, long *tris);
-
 #endif

@@ -85,6 +85,7 @@ def test_every_runtime_source_is_in_exactly_one_library_list():
         resources.SOLVER_SOURCES,
         resources.BENCH_SOURCES,
         resources.SHAPE_SOURCES,
+        resources.MESH_SOURCES,
         resources.TRACER_SOURCES,
         resources.EMBREE_SOURCES,
     ]

@@ -1,9 +1,7 @@
 /* ig_shape_roots_many and ig_shape_eval_many (runtime_c/shape_batch.c) against the single-ray and single-point
  * calls, bit for bit, on the torus fixture: rays through, grazing, parallel to an axis, missing the box, with
- * empty and reversed intervals. ig_shape_project_many against the torus' distance in closed form; the mesh
- * helpers (ig_mesh_sheet_points, ig_mesh_split_quads) on one cell cut by a plane and by a crease, whose dual
- * points are known, and on a quad whose shorter diagonal is known. Built with ASan + UBSan by
- * tests/test_c_drivers_roots.py. */
+ * empty and reversed intervals. ig_shape_project_many against the torus' distance in closed form (the mesh's
+ * own loops: tests/c/test_mesh_kernels.c). Built with ASan + UBSan by tests/test_c_drivers_roots.py. */
 #include "shape_batch.h"
 #include "shape_torus_fixture.h"
 
@@ -51,78 +49,6 @@ static int check_projection(const double params[2])
         if (ok[i] != 1 || torus_distance(p + 3 * i, 1.0, 0.25) > 1e-14) {
             printf("point %d: ok %d, %.3g from the torus\n", i, ok[i], torus_distance(p + 3 * i, 1.0, 0.25));
             ++failures;
-        }
-    return failures;
-}
-
-static int near3(const double *p, double x, double y, double z)
-{
-    return fabs(p[0] - x) < 1e-12 && fabs(p[1] - y) < 1e-12 && fabs(p[2] - z) < 1e-12;
-}
-
-/* The unit cell [0, 1]^3 of a grid of 2 x 2 x 2 vertices (strides 4, 2, 1). First cut by the plane z = 0.3 (four
- * edges along z, one sheet: its point is the crossings' mass point); then the crease x < 0.4, y < 0.6 (two edges
- * along x at y = 0, two along y at x = 0; the last two on a clip): the QEF puts the point on the crease line, at
- * z = 0.5 (no plane bounds z: that eigenvalue is dropped), and the nearest crossing is the first on y = 0.6. */
-static int check_sheet_points(void)
-{
-    const long corner[1] = {0}, first[1] = {0}, strides[3] = {4, 2, 1};
-    const double origin[3] = {0, 0, 0};
-    const signed char plane_sheets[12] = {-1, -1, -1, -1, -1, -1, -1, -1, 0, 0, 0, 0};
-    const long plane_keys[4] = {16 + 0, 16 + 2, 16 + 4, 16 + 6}; /* axis 2: (0,0,0), (0,1,0), (1,0,0), (1,1,0) */
-    const double plane_points[12] = {0, 0, 0.3, 0, 1, 0.3, 1, 0, 0.3, 1, 1, 0.3};
-    const double plane_normals[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
-    const int plane_piece[4] = {0, 0, 0, 0};
-    const signed char crease_sheets[12] = {0, -1, 0, -1, 0, -1, 0, -1, -1, -1, -1, -1};
-    const long crease_keys[4] = {0, 1, 8 + 0, 8 + 1}; /* axis 0 at (0,0,0), (0,0,1); axis 1 at the same */
-    const double crease_points[12] = {0.4, 0, 0, 0.4, 0, 1, 0, 0.6, 0, 0, 0.6, 1};
-    const double crease_normals[12] = {1, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1, 0};
-    const int crease_piece[4] = {0, 0, 1, 1};
-    double out[3];
-    long mask[1], nearest[1];
-    int failures = 0;
-    ig_mesh_sheet_points(1, corner, plane_sheets, first, strides, 8, 4, plane_keys, plane_points, plane_normals,
-                         plane_piece, origin, 1.0, 0.9, 0.1, 1, out, mask, nearest);
-    if (!near3(out, 0.5, 0.5, 0.3) || mask[0] != 1 || nearest[0] != 0) {
-        printf("plane cell: (%g, %g, %g), mask %ld, nearest %ld\n", out[0], out[1], out[2], mask[0], nearest[0]);
-        ++failures;
-    }
-    ig_mesh_sheet_points(1, corner, crease_sheets, first, strides, 8, 4, crease_keys, crease_points, crease_normals,
-                         crease_piece, origin, 1.0, 0.9, 0.1, 1, out, mask, nearest);
-    if (!near3(out, 0.4, 0.6, 0.5) || mask[0] != 3 || nearest[0] != 2) {
-        printf("crease cell: (%g, %g, %g), mask %ld, nearest %ld\n", out[0], out[1], out[2], mask[0], nearest[0]);
-        ++failures;
-    }
-    mask[0] = -7; /* a sheet numbered past nverts: skipped, nothing written */
-    ig_mesh_sheet_points(1, corner, crease_sheets, first, strides, 8, 4, crease_keys, crease_points, crease_normals,
-                         crease_piece, origin, 1.0, 0.9, 0.1, 0, out, mask, nearest);
-    if (mask[0] != -7) {
-        printf("a sheet past nverts was written\n");
-        ++failures;
-    }
-    return failures;
-}
-
-/* A quad in z = 0 whose diagonal 1-3 is the shorter, as given and flipped: the two triangles share that
- * diagonal, and face +z, then -z. */
-static int check_split_quads(void)
-{
-    const double verts[12] = {0, 0, 0, 1, 0, 0, 1.5, 1.5, 0, 0, 1, 0};
-    const long quads[8] = {0, 1, 2, 3, 0, 1, 2, 3};
-    const unsigned char flip[2] = {0, 1};
-    long tris[12];
-    int failures = 0;
-    ig_mesh_split_quads(2, quads, flip, verts, tris);
-    for (int q = 0; q < 2; ++q)
-        for (int t = 0; t < 2; ++t) {
-            const long *tri = tris + 3 * (2 * t + q);
-            const double *a = verts + 3 * tri[0], *b = verts + 3 * tri[1], *c = verts + 3 * tri[2];
-            double nz = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-            int has1 = tri[0] == 1 || tri[1] == 1 || tri[2] == 1, has3 = tri[0] == 3 || tri[1] == 3 || tri[2] == 3;
-            if (!has1 || !has3 || (q == 0 ? nz <= 0 : nz >= 0)) {
-                printf("quad %d, triangle %d: (%ld, %ld, %ld)\n", q, t, tri[0], tri[1], tri[2]);
-                ++failures;
-            }
         }
     return failures;
 }
@@ -178,7 +104,7 @@ int main(void)
             ++failures;
         }
     }
-    failures += check_projection(params) + check_sheet_points() + check_split_quads();
+    failures += check_projection(params);
     {
         const double gx[3] = {-1.0, 0.1, 1.3}, gy[2] = {-0.2, 0.05}, gz[4] = {-0.3, 0.0, 0.125, 2.0};
         double gv[24];

@@ -30,7 +30,14 @@ from implgen.codegen.fingerprint import implgen_fingerprint
 from implgen.codegen.specmodel import Spec
 from implgen.compile import clib
 from implgen.errors import UserError
-from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, TRACER_SOURCES, runtime_dir, runtime_sources
+from implgen.resources import (
+    MESH_SOURCES,
+    SHAPE_SOURCES,
+    SOLVER_SOURCES,
+    TRACER_SOURCES,
+    runtime_dir,
+    runtime_sources,
+)
 
 
 @dataclass(frozen=True)
@@ -102,7 +109,7 @@ LIBRARY_FLAGS = ("-pthread",)
 
 def _runtime_jobs() -> list[tuple[Path, list[Path]]]:
     rt = runtime_dir()
-    return [(src, [rt]) for src in runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES, TRACER_SOURCES)]
+    return [(src, [rt]) for src in runtime_sources(SOLVER_SOURCES, SHAPE_SOURCES, MESH_SOURCES, TRACER_SOURCES)]
 
 
 def runtime_progress() -> tuple[int, int]:

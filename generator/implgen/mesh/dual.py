@@ -18,7 +18,7 @@ from implgen.mesh.crossings import piece_value_gradient
 from implgen.mesh.region import Clip
 from implgen.mesh.shapelib import ShapeLib
 
-# The QEF is one C loop over the cells (ig_mesh_sheet_points, runtime_c/shape_batch.c), given these two:
+# The QEF is one C loop over the cells (ig_mesh_sheet_points, runtime_c/mesh_kernels.c), given these two:
 DROP = 0.1  # eigenvalues below DROP x the largest are dropped (the usual truncation of the QEF's SVD)
 CREASE = 0.9  # a sheet whose crossing normals all lie within acos(0.9) = 26 degrees of their mean is smooth
 NOISE = 1e-10  # a Newton step still this large (times the box) after the last step: f's rounding, accepted

@@ -1,8 +1,9 @@
 """One shape compiled with the runtime (compile/library.py, cached), and its batch entry points
-(runtime_c/shape_batch.c) bound with ctypes: every root of f along many rays at once, and f with its gradient
-at many points at once. Each call is one C loop; Python never loops per ray or per point. With a `budget`
-(budget.py) the C loop runs in slices (ROWS rays, POINTS points, a slab of about POINTS grid vertices) and the
-budget is checked before each: a mesh stops within one slice of its deadline, or of its stop."""
+(runtime_c/shape_batch.c) and the mesh's loops (runtime_c/mesh_kernels.c) bound with ctypes: every root of f
+along many rays at once, and f with its gradient at many points at once. Each call is one C loop; Python never
+loops per ray or per point. With a `budget` (budget.py) the C loop runs in slices (ROWS rays, POINTS points, a
+slab of about POINTS grid vertices) and the budget is checked before each: a mesh stops within one slice of its
+deadline, or of its stop."""
 
 from __future__ import annotations
 
@@ -25,6 +26,34 @@ _IP = ctypes.POINTER(ctypes.c_int)
 _VP = ctypes.c_void_p
 _LONG = np.dtype(f"i{ctypes.sizeof(ctypes.c_long)}")  # C's long, as NumPy holds it
 ROWS = 4096  # rays a slice
+
+
+class _MeshSheets(ctypes.Structure):
+    """runtime_c/mesh_kernels.h's ig_mesh_sheets, field for field."""
+
+    _fields_ = [
+        ("ncells", ctypes.c_long),
+        ("corner", _VP),
+        ("sheets", _VP),
+        ("first", _VP),
+        ("strides", _VP),
+        ("nvertices", ctypes.c_long),
+        ("origin", _VP),
+        ("h", ctypes.c_double),
+        ("ncross", ctypes.c_long),
+        ("keys", _VP),
+        ("points", _VP),
+        ("normals", _VP),
+        ("piece", _VP),
+        ("crease", ctypes.c_double),
+        ("drop", ctypes.c_double),
+        ("nverts", ctypes.c_long),
+        ("out", _VP),
+        ("mask", _VP),
+        ("nearest", _VP),
+    ]
+
+
 POINTS = 1 << 18  # points, grid vertices, cells or quads a slice
 
 
@@ -50,9 +79,7 @@ class ShapeLib:
         lib.ig_shape_project_many.argtypes = [_VP, _DP, ctypes.c_long, _DP, ctypes.c_int, ctypes.c_double,
                                               ctypes.c_double, ctypes.c_double, _VP]  # fmt: skip
         lib.ig_mesh_sheet_points.restype = None
-        lib.ig_mesh_sheet_points.argtypes = [ctypes.c_long, _VP, _VP, _VP, _VP, ctypes.c_long, ctypes.c_long, _VP,
-                                             _DP, _DP, _VP, _DP, ctypes.c_double, ctypes.c_double, ctypes.c_double,
-                                             ctypes.c_long, _DP, _VP, _VP]  # fmt: skip
+        lib.ig_mesh_sheet_points.argtypes = [ctypes.POINTER(_MeshSheets)]
         lib.ig_mesh_split_quads.restype = None
         lib.ig_mesh_split_quads.argtypes = [ctypes.c_long, _VP, _VP, _DP, _VP]
         self._lib = lib
@@ -140,7 +167,7 @@ class ShapeLib:
 
     def sheet_points(self, corner, sheets, first, strides, nvertices: int, keys, points, normals, piece, origin,
                      h: float, crease: float, drop: float, nverts: int):  # fmt: skip
-        """The dual vertex of every sheet of every active cell (ig_mesh_sheet_points, runtime_c/shape_batch.h):
+        """The dual vertex of every sheet of every active cell (ig_mesh_sheet_points, runtime_c/mesh_kernels.h):
         (points (nverts, 3), piece masks, index of the nearest crossing). Not f's: the shape's library holds it."""
 
         def longs(a):
@@ -163,12 +190,17 @@ class ShapeLib:
         out = np.zeros((nverts, 3))
         mask = np.zeros(nverts, dtype=_LONG)
         nearest = np.full(nverts, -1, dtype=_LONG)
+        args = _MeshSheets(
+            strides=strides.ctypes.data, nvertices=nvertices, origin=origin.ctypes.data, h=h, ncross=len(keys),
+            keys=keys.ctypes.data, points=points.ctypes.data, normals=normals.ctypes.data, piece=piece.ctypes.data,
+            crease=crease, drop=drop, nverts=nverts, out=out.ctypes.data, mask=mask.ctypes.data,
+            nearest=nearest.ctypes.data,
+        )  # fmt: skip
         for a, b in self._slices(len(corner), POINTS):  # each cell writes its own vertices (first[c] + sheet)
-            self._lib.ig_mesh_sheet_points(
-                b - a, corner[a:b].ctypes.data, sheets[a:b].ctypes.data, first[a:b].ctypes.data, strides.ctypes.data,
-                nvertices, len(keys), keys.ctypes.data, _ptr(points), _ptr(normals), piece.ctypes.data,
-                _ptr(origin), h, crease, drop, nverts, _ptr(out), mask.ctypes.data, nearest.ctypes.data,
-            )  # fmt: skip
+            args.ncells = b - a
+            args.corner, args.sheets = corner[a:b].ctypes.data, sheets[a:b].ctypes.data
+            args.first = first[a:b].ctypes.data
+            self._lib.ig_mesh_sheet_points(ctypes.byref(args))
         return out, mask.astype(np.int64), nearest.astype(np.int64)
 
     def split_quads(self, quads: np.ndarray, flip: np.ndarray, verts: np.ndarray) -> np.ndarray:
