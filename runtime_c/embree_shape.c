@@ -201,57 +201,87 @@ static int filter_begin(filter_call *fc, void *geometryUserPtr, struct RTCInters
 
 /* ------------------------------------------------------------------ the callbacks */
 
+/* One callback's query: its filter call, what it hands to rtcFilterIntersection or rtcFilterOcclusion, and the
+ * primitive it solves. */
+typedef struct {
+    filter_call fc;
+    const void *args; /* the callback's RTCIntersectFunctionNArguments or RTCOccludedFunctionNArguments */
+    int occlusion;
+    const ig_embree_prim *prim;
+    unsigned int primID, geomID;
+} lane_query;
+
+/* The core both callbacks share: the first root t of lane i's ray in [tnear, hi] that the filters accept, tried
+ * root by root (up to the degree; a rejected root makes way for the next one along the ray). Returns 1 with t,
+ * its unit normal n in double, the lane's tfar = t rounded to float and its accepted candidate (hit fields) in q->fc.cand; 0 with tfar as it
+ * was. */
+static int next_accepted_root(lane_query *q, void *ray, unsigned int N, unsigned int i, double hi, double *t,
+                              double n[3])
+{
+    const ig_embree_prim *p = q->prim;
+    double o[3], d[3], oo[3], u[3], L, lo;
+    float *tfar = ray_f(ray, N, R_TFAR, i);
+    int open = 0, tries;
+    lane_in(ray, N, i, o, d);
+    lo = *ray_f(ray, N, R_TNEAR, i);
+    L = lane_ray(p, o, d, oo, u);
+    if (!(L > 0.0) || !(lo <= hi))
+        return 0;
+    for (tries = 0; tries <= p->prep.degree && next_root(p, oo, u, L, lo, open, hi, t); ++tries) {
+        float old = *tfar;
+        hit_normal(p, oo, u, L, *t, d, n);
+        put_hit(q->fc.cand, N, i, n, q->primID, q->geomID, q->fc.fa.context->instID);
+        q->fc.fvalid[i] = -1;
+        *tfar = (float)*t;
+        if (q->occlusion)
+            rtcFilterOcclusion((const struct RTCOccludedFunctionNArguments *)q->args, &q->fc.fa);
+        else
+            rtcFilterIntersection((const struct RTCIntersectFunctionNArguments *)q->args, &q->fc.fa);
+        if (q->fc.fvalid[i] != 0) {
+            q->fc.fvalid[i] = 0;
+            return 1;
+        }
+        *tfar = old;
+        lo = *t;
+        open = 1;
+    }
+    return 0;
+}
+
 void ig_embree_intersect(const struct RTCIntersectFunctionNArguments *args)
 {
     const ig_embree_shapes *g = (const ig_embree_shapes *)args->geometryUserPtr;
-    const ig_embree_prim *p = &g->prims[args->primID];
-    unsigned int N = args->N, i, instID = args->context->instID[0];
+    unsigned int N = args->N, i, k;
     void *ray = args->rayhit, *hits = (float *)args->rayhit + R_FIELDS * N;
-    filter_call fc;
-    if (!filter_begin(&fc, args->geometryUserPtr, args->context, ray, N))
+    lane_query q;
+    if (!filter_begin(&q.fc, args->geometryUserPtr, args->context, ray, N))
         return;
+    q.args = args;
+    q.occlusion = 0;
+    q.prim = &g->prims[args->primID];
+    q.primID = args->primID;
+    q.geomID = args->geomID;
     for (i = 0; i < N; ++i) {
-        double o[3], d[3], oo[3], u[3], L, lo, hi, t, n[3];
-        float *tfar = ray_f(ray, N, R_TFAR, i);
         ig_embree_hit *rec;
-        int open = 0, tries;
-        if (args->valid[i] == 0)
+        double hi, t, n[3];
+        if (args->valid[i] == 0) /* an inactive lane is never read nor written */
             continue;
-        lane_in(ray, N, i, o, d);
-        lo = *ray_f(ray, N, R_TNEAR, i);
-        hi = *tfar;
+        hi = *ray_f(ray, N, R_TFAR, i);
         rec = record(g, args->context, ray, N, i);
         /* the current hit is one of ours: its double distance orders the surfaces, not the float tfar */
         if (rec && rec->geomID == *ray_u(hits, N, H_GEOM, i) && rec->primID == *ray_u(hits, N, H_PRIM, i) &&
             rec->instID == *ray_u(hits, N, H_INST, i) && rec->t < hi)
             hi = rec->t;
-        L = lane_ray(p, o, d, oo, u);
-        if (!(L > 0.0) || !(lo <= hi))
+        if (!next_accepted_root(&q, ray, N, i, hi, &t, n))
             continue;
-        for (tries = 0; tries <= p->prep.degree && next_root(p, oo, u, L, lo, open, hi, &t); ++tries) {
-            float old = *tfar;
-            hit_normal(p, oo, u, L, t, d, n);
-            put_hit(fc.cand, N, i, n, args->primID, args->geomID, args->context->instID);
-            fc.fvalid[i] = -1;
-            *tfar = (float)t;
-            rtcFilterIntersection(args, &fc.fa);
-            if (fc.fvalid[i] != 0) {
-                unsigned int k;
-                for (k = 0; k < H_FIELDS; ++k)
-                    *ray_u(hits, N, (int)k, i) = fc.cand[k * N + i].u;
-                if (rec) {
-                    rec->t = t;
-                    memcpy(rec->n, n, sizeof rec->n);
-                    rec->geomID = args->geomID;
-                    rec->primID = args->primID;
-                    rec->instID = instID;
-                }
-                fc.fvalid[i] = 0;
-                break;
-            }
-            *tfar = old; /* rejected by a filter: the next root along the ray */
-            lo = t;
-            open = 1;
+        for (k = 0; k < H_FIELDS; ++k)
+            *ray_u(hits, N, (int)k, i) = q.fc.cand[k * N + i].u;
+        if (rec) {
+            rec->t = t;
+            memcpy(rec->n, n, sizeof rec->n);
+            rec->geomID = args->geomID;
+            rec->primID = args->primID;
+            rec->instID = args->context->instID[0];
         }
     }
 }
@@ -259,40 +289,19 @@ void ig_embree_intersect(const struct RTCIntersectFunctionNArguments *args)
 void ig_embree_occluded(const struct RTCOccludedFunctionNArguments *args)
 {
     const ig_embree_shapes *g = (const ig_embree_shapes *)args->geometryUserPtr;
-    const ig_embree_prim *p = &g->prims[args->primID];
     unsigned int N = args->N, i;
-    void *ray = args->ray;
-    filter_call fc;
-    if (!filter_begin(&fc, args->geometryUserPtr, args->context, ray, N))
+    lane_query q;
+    if (!filter_begin(&q.fc, args->geometryUserPtr, args->context, args->ray, N))
         return;
+    q.args = args;
+    q.occlusion = 1;
+    q.prim = &g->prims[args->primID];
+    q.primID = args->primID;
+    q.geomID = args->geomID;
     for (i = 0; i < N; ++i) {
-        double o[3], d[3], oo[3], u[3], L, lo, hi, t, n[3];
-        float *tfar = ray_f(ray, N, R_TFAR, i);
-        int open = 0, tries;
-        if (args->valid[i] == 0)
-            continue;
-        lane_in(ray, N, i, o, d);
-        lo = *ray_f(ray, N, R_TNEAR, i);
-        hi = *tfar;
-        L = lane_ray(p, o, d, oo, u);
-        if (!(L > 0.0) || !(lo <= hi))
-            continue;
-        for (tries = 0; tries <= p->prep.degree && next_root(p, oo, u, L, lo, open, hi, &t); ++tries) {
-            float old = *tfar;
-            hit_normal(p, oo, u, L, t, d, n);
-            put_hit(fc.cand, N, i, n, args->primID, args->geomID, args->context->instID);
-            fc.fvalid[i] = -1;
-            *tfar = (float)t;
-            rtcFilterOcclusion(args, &fc.fa);
-            if (fc.fvalid[i] != 0) {
-                *tfar = -INFINITY; /* Embree's mark of an occluded ray */
-                fc.fvalid[i] = 0;
-                break;
-            }
-            *tfar = old;
-            lo = t;
-            open = 1;
-        }
+        double t, n[3];
+        if (args->valid[i] != 0 && next_accepted_root(&q, args->ray, N, i, *ray_f(args->ray, N, R_TFAR, i), &t, n))
+            *ray_f(args->ray, N, R_TFAR, i) = -INFINITY; /* Embree's mark of an occluded ray */
     }
 }
 

@@ -28,105 +28,123 @@ static inline int leaf_roots_unit(const rt_node *n, const double oo[3], const do
  * an object scaled by 1e3 would otherwise hand the solver coefficients c_k ~ 1e-3k. */
 int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r)
 {
-    double L = sqrt(rt_dot(od, od)), u[3];
+    double at[3], u[3], L = ig_affine_unit_ray(NULL, oo, od, at, u); /* already in object space */
     if (!(L > 0.0) || !isfinite(L))
         return 0;
-    u[0] = od[0] / L;
-    u[1] = od[1] / L;
-    u[2] = od[2] / L;
     return leaf_roots_unit(n, oo, u, L, lo, hi, r);
+}
+
+/* A leaf's ray as its solve takes it: origin, direction, inverse direction (NULL when it is not the world
+ * ray's), unit direction u and its length L in the leaf's object space. */
+typedef struct {
+    const double *o, *d, *inv, *u;
+    double L;
+    double own_o[3], own_d[3], own_u[3];
+} leaf_ray;
+
+static void leaf_ray_of(const rt_node *n, const rt_ray *ray, leaf_ray *lr)
+{
+    lr->o = ray->o;
+    lr->d = ray->d;
+    lr->inv = ray->inv;
+    lr->u = ray->u;
+    lr->L = ray->len;
+    if (!n->identity) { /* an identity leaf takes the world ray as it is, with its inverse and unit direction */
+        rt_xform_point(n->minv, ray->o, lr->own_o);
+        rt_xform_vector(n->minv, ray->d, lr->own_d);
+        lr->o = lr->own_o;
+        lr->d = lr->own_d;
+        lr->inv = NULL;
+    }
+}
+
+/* Breakpoints x[0] = a <= roots <= x[nx - 1] = b (returns nx). A root within rounding of a box face means the
+ * surface touches its box there (a cylinder tangent to its box's side): that end is the surface, not the face
+ * (*f0, *f1 cleared). */
+static int leaf_breakpoints(const double *r, int nr, double a, double b, int *f0, int *f1, double *x)
+{
+    double tol = 1e-9 * (b - a);
+    int i, nx = 0;
+    for (i = 0; i < nr; ++i) {
+        if (*f0 && fabs(r[i] - a) <= tol)
+            *f0 = 0;
+        if (*f1 && fabs(r[i] - b) <= tol)
+            *f1 = 0;
+    }
+    x[nx++] = a;
+    for (i = 0; i < nr; ++i)
+        if (r[i] > x[nx - 1] && r[i] < b)
+            x[nx++] = r[i];
+    x[nx++] = b;
+    return nx;
+}
+
+/* The inside-intervals of leaf k between the breakpoints x[0..nx): the sign of f at each piece's midpoint (NaN
+ * counts as outside); adjacent inside pieces merge. ends: what a span starting at x[0] or ending at x[nx - 1]
+ * ends on (a box face of this leaf, or -1: open where the ray's range starts or stops inside). */
+static int spans_by_sign(const rt_node *n, int k, const leaf_ray *lr, const double *x, int nx, const rt_end ends[2],
+                         rt_span *out, int max)
+{
+    rt_end start;
+    int i, cnt = 0, inside_prev = 0;
+    start.t = x[0];
+    start.leaf = -1;
+    start.face = 0;
+    for (i = 0; i + 1 < nx; ++i) {
+        double tm = 0.5 * (x[i] + x[i + 1]), q[3];
+        int inside;
+        q[0] = lr->o[0] + tm * lr->d[0];
+        q[1] = lr->o[1] + tm * lr->d[1];
+        q[2] = lr->o[2] + tm * lr->d[2];
+        inside = n->shape->value(q, n->params) < 0.0;
+        if (inside && !inside_prev) {
+            start.t = x[i];
+            start.leaf = i == 0 ? ends[0].leaf : k;
+            start.face = i == 0 ? ends[0].face : 0;
+        } else if (!inside && inside_prev && cnt < max) {
+            out[cnt].in = start;
+            out[cnt].out.t = x[i];
+            out[cnt].out.leaf = k;
+            out[cnt].out.face = 0;
+            ++cnt;
+        }
+        inside_prev = inside;
+    }
+    if (inside_prev && cnt < max) {
+        out[cnt].in = start;
+        out[cnt].out = ends[1];
+        ++cnt;
+    }
+    return cnt;
 }
 
 /* Spans of one leaf solid over [a, b]. */
 static int leaf_spans(const rt_scene *s, int k, const rt_ray *ray, double a, double b, rt_span *out, int max)
 {
     const rt_node *n = &s->nodes[k];
-    double own_o[3], own_d[3], own_u[3], r[IG_MAX_DEGREE + 2], x[IG_MAX_DEGREE + 2], L;
-    const double *oo = ray->o, *od = ray->d, *inv = ray->inv, *u = ray->u;
-    int f0 = 0, f1 = 0, nr, nx, i, cnt = 0, inside_prev = 0, lo_leaf, hi_leaf;
-    rt_end start;
-
-    if (!n->identity) { /* an identity leaf takes the world ray as it is, with its inverse and unit direction */
-        rt_xform_point(n->minv, ray->o, own_o);
-        rt_xform_vector(n->minv, ray->d, own_d);
-        oo = own_o;
-        od = own_d;
-        inv = NULL;
-    }
-    if (!rt_clip_slabs(n->obox, oo, od, inv, &a, &b, &f0, &f1))
+    double r[IG_MAX_DEGREE + 2], x[IG_MAX_DEGREE + 2];
+    int f0 = 0, f1 = 0, nr, nx;
+    rt_end ends[2];
+    leaf_ray lr;
+    leaf_ray_of(n, ray, &lr);
+    if (!rt_clip_slabs(n->obox, lr.o, lr.d, lr.inv, &a, &b, &f0, &f1))
         return 0;
     if (!(b > a))
         return 0;
-    if (n->identity) {
-        L = ray->len;
-    } else {
-        L = sqrt(rt_dot(od, od));
-        if (L > 0.0 && isfinite(L)) {
-            own_u[0] = od[0] / L;
-            own_u[1] = od[1] / L;
-            own_u[2] = od[2] / L;
-        }
-        u = own_u;
+    if (!n->identity) {
+        double at[3];
+        lr.L = ig_affine_unit_ray(NULL, lr.o, lr.d, at, lr.own_u); /* o, d: already in the leaf's object space */
+        lr.u = lr.own_u;
     }
-    nr = (L > 0.0 && isfinite(L)) ? leaf_roots_unit(n, oo, u, L, a, b, r) : 0;
-    /* Breakpoints a = x[0] <= roots <= x[nx - 1] = b. A root within rounding of a box face means the surface
-     * touches its box there (a cylinder tangent to its box's side): the endpoint is the surface, not the face. */
-    lo_leaf = f0 ? k : -1; /* a box face, or open where the ray's range starts inside */
-    hi_leaf = f1 ? k : -1;
-    {
-        double tol = 1e-9 * (b - a);
-        for (i = 0; i < nr; ++i) {
-            if (f0 && fabs(r[i] - a) <= tol)
-                f0 = 0;
-            if (f1 && fabs(r[i] - b) <= tol)
-                f1 = 0;
-        }
-    }
-    nx = 0;
-    x[nx++] = a;
-    for (i = 0; i < nr; ++i)
-        if (r[i] > x[nx - 1] && r[i] < b)
-            x[nx++] = r[i];
-    x[nx++] = b;
-    start.t = a;
-    start.leaf = -1;
-    start.face = 0;
-    for (i = 0; i + 1 < nx; ++i) {
-        double tm = 0.5 * (x[i] + x[i + 1]), q[3], f;
-        int inside;
-        q[0] = oo[0] + tm * od[0];
-        q[1] = oo[1] + tm * od[1];
-        q[2] = oo[2] + tm * od[2];
-        f = n->shape->value(q, n->params);
-        inside = f < 0.0; /* NaN counts as outside */
-        if (inside && !inside_prev) {
-            start.t = x[i];
-            if (i == 0) {
-                start.leaf = lo_leaf;
-                start.face = f0;
-            } else {
-                start.leaf = k;
-                start.face = 0;
-            }
-        } else if (!inside && inside_prev) {
-            if (cnt < max) {
-                out[cnt].in = start;
-                out[cnt].out.t = x[i];
-                out[cnt].out.leaf = k;
-                out[cnt].out.face = 0;
-                ++cnt;
-            }
-        }
-        inside_prev = inside;
-    }
-    if (inside_prev && cnt < max) {
-        out[cnt].in = start;
-        out[cnt].out.t = b;
-        out[cnt].out.leaf = hi_leaf;
-        out[cnt].out.face = f1;
-        ++cnt;
-    }
-    return cnt;
+    nr = (lr.L > 0.0 && isfinite(lr.L)) ? leaf_roots_unit(n, lr.o, lr.u, lr.L, a, b, r) : 0;
+    ends[0].leaf = f0 ? k : -1; /* a box face, or open where the ray's range starts inside */
+    ends[1].leaf = f1 ? k : -1;
+    nx = leaf_breakpoints(r, nr, a, b, &f0, &f1, x);
+    ends[0].t = a;
+    ends[0].face = f0;
+    ends[1].t = b;
+    ends[1].face = f1;
+    return spans_by_sign(n, k, &lr, x, nx, ends, out, max);
 }
 
 static int op_state(int op, int in_a, int in_b)
