@@ -122,7 +122,7 @@ def _quiet_dask():
 
 
 @contextmanager
-def connect(local_workers: int | None = None, address: str | None = None, threads_per_task: int | None = None):
+def connect(local_workers: int | None = None, address: str | None = None):
     """A dask.distributed Client: to the scheduler at `address` (probed first), or to a LocalCluster of
     `local_workers` processes (one task at a time each). Closed, with the local cluster, on exit."""
     from dask.distributed import Client, LocalCluster

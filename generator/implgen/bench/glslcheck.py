@@ -164,10 +164,6 @@ class Comparison:
     def wrong_share(self) -> float:
         return self.glsl_wrong / max(self.object_pixels, 1)
 
-    @property
-    def flagged_share(self) -> float:
-        return self.flagged / max(self.object_pixels, 1)
-
 
 def silhouette(mask: np.ndarray) -> np.ndarray:
     edge = np.zeros_like(mask)

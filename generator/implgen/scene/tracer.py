@@ -150,12 +150,6 @@ class CScene:
             return hit
         return None
 
-    def spawn(self, hit, d: Sequence[float]) -> list[float]:
-        """Origin of a secondary ray leaving `hit` in direction d (offset by the hit's error bound)."""
-        out = (ctypes.c_double * 3)()
-        self.lib.rt_spawn_origin(ctypes.byref(hit), darr(d), out)
-        return list(out)
-
     def close(self) -> None:
         if getattr(self, "ptr", None):
             self.lib.rt_scene_free(self.ptr)
