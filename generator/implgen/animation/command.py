@@ -21,7 +21,7 @@ from implgen.args import ArgumentParser
 from implgen.errors import UserError
 from implgen.imagefile import write_png
 from implgen.scene.keys import MAX_FRAMES
-from implgen.scene.render import DEFAULT_FOLD, RenderInfo, check_options, render
+from implgen.scene.render import DEFAULT_FOLD, RenderInfo, image_options, render
 
 MAX_RETRIES = 100
 
@@ -113,16 +113,10 @@ def main(argv: Sequence[str]) -> int:
 
 
 def _options(args: argparse.Namespace, frames: Frames) -> FrameOptions:
-    sc = frames.first
-    opts = FrameOptions(
-        width=args.width or sc.width,
-        height=args.height or sc.height,
-        spp=args.spp or sc.spp,
-        max_depth=sc.max_depth if args.max_depth is None else args.max_depth,
-        threads=args.threads,
+    o = image_options(
+        frames.first, width=args.width, height=args.height, spp=args.spp, max_depth=args.max_depth, threads=args.threads
     )
-    check_options(width=opts.width, height=opts.height, spp=opts.spp, threads=opts.threads, max_depth=opts.max_depth)
-    return opts
+    return FrameOptions(**dataclasses.asdict(o))
 
 
 def _still(args: argparse.Namespace, frames: Frames, frame: int, opts: FrameOptions, out: FrameOutput) -> int:

@@ -34,7 +34,7 @@ from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.build import build_scene
 from implgen.scene.load import load_scene
 from implgen.scene.model import Scene
-from implgen.scene.render import MAX_THREADS, check_options
+from implgen.scene.render import MAX_THREADS, image_options
 from implgen.scene.renderjob import RenderJob
 from implgen.scene.tracer import CScene
 
@@ -76,8 +76,8 @@ def _measure(cs: CScene, sc: Scene, args, threads: int) -> tuple[float, float, d
 
 
 def _prepared(path: Path, args, fold: bool = False) -> tuple[CScene, Scene]:
-    check_options(width=args.width, height=args.height, spp=args.spp)
     sc = load_scene(path)
+    image_options(sc, width=args.width, height=args.height, spp=args.spp)  # the options' ranges, checked
     return CScene(sc, build_scene(sc, fold=fold)), sc
 
 

@@ -9,6 +9,7 @@ for the progress bar (`_run_polled`); what the render did, recorded (`_record`).
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import threading
 from dataclasses import dataclass, field
@@ -25,7 +26,7 @@ from implgen.scene.tracer import CScene
 
 MAX_THREADS = 1024
 # The render options a caller may set, as the command line names them, each with its range: render() and
-# `implgen render` (animation/command.py) check them through check_options, so both say the same.
+# `implgen render` (animation/command.py) resolve and check them through image_options, so both say the same.
 OPTION_RANGES = (
     ("width", "--width", 1, MAX_SIZE),
     ("height", "--height", 1, MAX_SIZE),
@@ -74,6 +75,40 @@ def check_options(
             validate.whole(option, "", given[name], lo, hi)
 
 
+@dataclass(frozen=True)
+class ImageOptions:
+    """The image one render makes: the scene's `image` settings with the caller's options over them."""
+
+    width: int
+    height: int
+    spp: int
+    max_depth: int
+    threads: int | None  # None: every usable core of the machine that renders
+
+
+def image_options(
+    sc: Scene,
+    *,
+    width: int | None = None,
+    height: int | None = None,
+    spp: int | None = None,
+    max_depth: int | None = None,
+    threads: int | None = None,
+) -> ImageOptions:
+    """The one place where an option given (not None; for a size, spp or threads not 0) wins over the scene's
+    own setting, and where the result is checked in the options' ranges (OPTION_RANGES): render(), `implgen
+    render` and `implgen bench render` all come here."""
+    opts = ImageOptions(
+        width=width or sc.width,
+        height=height or sc.height,
+        spp=spp or sc.spp,
+        max_depth=sc.max_depth if max_depth is None else max_depth,
+        threads=threads or None,
+    )
+    check_options(**dataclasses.asdict(opts))
+    return opts
+
+
 def _as_scene(scene: Scene | str | Path | dict) -> Scene:
     if isinstance(scene, Scene):
         return scene
@@ -96,16 +131,8 @@ class _Settings:
 
 
 def _settings(sc: Scene, width, height, spp, threads, max_depth, seed, rows) -> _Settings:
-    s = _Settings(
-        width=width or sc.width,
-        height=height or sc.height,
-        spp=spp or sc.spp,
-        max_depth=sc.max_depth if max_depth is None else max_depth,
-        threads=threads or usable_cores(),
-        seed=seed,
-        rows=rows,
-    )
-    check_options(width=s.width, height=s.height, spp=s.spp, threads=s.threads, max_depth=s.max_depth)
+    o = image_options(sc, width=width, height=height, spp=spp, max_depth=max_depth, threads=threads)
+    s = _Settings(o.width, o.height, o.spp, o.max_depth, o.threads or usable_cores(), seed=seed, rows=rows)
     y0, y1 = (0, s.height) if rows is None else rows
     if not 0 <= y0 < y1 <= s.height:
         raise ValueError(f"rows {rows} outside the image's {s.height} rows")

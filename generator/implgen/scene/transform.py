@@ -153,4 +153,3 @@ def check_matrix(source: str, key: str, m: np.ndarray) -> None:
         )
     if np.abs(m[:, 3]).max() > validate.MAX_COORDINATE:
         raise UserError(source, f"{key}: the transform moves the object beyond {validate.MAX_COORDINATE:g}")
-
