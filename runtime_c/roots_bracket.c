@@ -117,6 +117,112 @@ static inline double level_guess(const double *ddq, int m, const double *xs, con
     return x0;
 }
 
+/* One level of the chain: p^(j) at the points a, its critical points inside (a, b), and b; each point's value,
+ * sign, whether the sign is unsure, and where a polish moved it. */
+typedef struct {
+    const double (*chain)[IG_MAX_DEGREE + 1];
+    const double *q, *ddq; /* p^(j) and p^(j+2), scaled */
+    int n, m, np, final;
+    double big, g2m, tol;
+    double xs[IG_MAX_DEGREE + 2], v[IG_MAX_DEGREE + 2], rv[IG_MAX_DEGREE + 2];
+    int s[IG_MAX_DEGREE + 2], unsure[IG_MAX_DEGREE + 2];
+} level;
+
+static void level_init(level *L, const double (*chain)[IG_MAX_DEGREE + 1], int j, int n, double a, double b,
+                       const double *crit, int nc, int final)
+{
+    L->chain = chain;
+    L->q = chain[j];
+    L->ddq = chain[j + 2];
+    L->n = n;
+    L->m = n - j;
+    L->final = final;
+    L->np = 0;
+    L->xs[L->np++] = a;
+    for (int i = 0; i < nc; ++i)
+        if (crit[i] > L->xs[L->np - 1] && crit[i] < b)
+            L->xs[L->np++] = crit[i];
+    if (b > a)
+        L->xs[L->np++] = b;
+    level_bounds(L->q, L->m, a, b, final, &L->big, &L->g2m);
+    L->tol = final ? 2.0 * IG_U : 1e-7;
+}
+
+/* Point i evaluated; an unsure sign polished when it is not an end. */
+static void level_eval(level *L, int i)
+{
+    level_point(L->q, L->m, L->xs[i], L->final, L->big, L->g2m, &L->v[i], &L->s[i], &L->unsure[i]);
+    L->rv[i] = L->xs[i];
+}
+
+static void level_settle(level *L, int i)
+{
+    if (L->unsure[i] && L->s[i] != 0 && i > 0 && i < L->np - 1) {
+        level_polish(L->chain, L->n, L->xs, i, &L->s[i], &L->rv[i]);
+        L->unsure[i] = 0;
+    }
+}
+
+/* Whether point i's zero is a root of this level (an end's zero counts only at the final level). */
+static int level_zero(const level *L, int i) { return L->s[i] == 0 && (L->final || (i > 0 && i < L->np - 1)); }
+
+/* The first root only: points evaluated (and polished) left to right as far as the first root needs; the point
+ * after a bracket too, since a polish reads both neighbours of a point. */
+static int level_first(level *L, double *out)
+{
+    int known = 0;
+    for (int i = 0; i < L->np; ++i) {
+        for (; known < L->np && known <= i + 1; ++known)
+            level_eval(L, known);
+        for (int k = i; k <= i + 1 && k < L->np; ++k)
+            level_settle(L, k);
+        if (level_zero(L, i)) {
+            /* a polished zero may lie anywhere between its neighbours, so the next point's, when it is a
+             * zero too, can be the smaller one (two critical points at a triple root); no later one can */
+            int next = i + 1 < L->np && level_zero(L, i + 1) && L->rv[i + 1] < L->rv[i];
+            out[0] = next ? L->rv[i + 1] : L->rv[i];
+            return 1;
+        }
+        if (i + 1 < L->np && L->s[i] * L->s[i + 1] < 0) { /* ig_refine_many is ig_refine lane by lane */
+            out[0] = ig_refine(L->q, L->m, L->xs[i], L->xs[i + 1], L->v[i], L->v[i + 1], L->tol,
+                               level_guess(L->ddq, L->m, L->xs, L->v, i, L->np - 1));
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Every root: every point evaluated, then the brackets refined all at once (ig_refine_many); slot[] is where
+ * each root goes in out[]. */
+static int level_all(level *L, double *out)
+{
+    double bl[IG_MAX_DEGREE + 1], br[IG_MAX_DEGREE + 1], bvl[IG_MAX_DEGREE + 1], bvr[IG_MAX_DEGREE + 1];
+    double bx0[IG_MAX_DEGREE + 1], broot[IG_MAX_DEGREE + 1];
+    int slot[IG_MAX_DEGREE + 1], nb = 0, cnt = 0;
+    for (int i = 0; i < L->np; ++i) {
+        level_eval(L, i);
+        level_settle(L, i);
+    }
+    for (int i = 0; i < L->np; ++i) {
+        if (level_zero(L, i))
+            out[cnt++] = L->rv[i];
+        if (i + 1 < L->np && L->s[i] * L->s[i + 1] < 0) {
+            bl[nb] = L->xs[i];
+            br[nb] = L->xs[i + 1];
+            bvl[nb] = L->v[i];
+            bvr[nb] = L->v[i + 1];
+            bx0[nb] = level_guess(L->ddq, L->m, L->xs, L->v, i, L->np - 1);
+            slot[nb++] = cnt++;
+        }
+    }
+    if (nb > 0) {
+        ig_refine_many(L->q, L->m, nb, bl, br, bvl, bvr, L->tol, bx0, broot);
+        for (int i = 0; i < nb; ++i)
+            out[slot[i]] = broot[i];
+    }
+    return cnt;
+}
+
 /* Roots of q (degree m) on [a, b] given its critical points crit[] (ascending, inside (a, b)): q is
  * monotonic between consecutive points. final != 0: q is the polynomial itself -- refine to full accuracy,
  * decide zeros with the certified sign (after polishing the critical point on dq = q' when q is small
@@ -126,78 +232,9 @@ static inline double level_guess(const double *ddq, int m, const double *xs, con
 static int monotone_level(const double (*chain)[IG_MAX_DEGREE + 1], int j, int n, double a, double b,
                           const double *crit, int nc, int final, int first, double *out)
 {
-    const double *q = chain[j], *ddq = chain[j + 2];
-    const int m = n - j;
-    double xs[IG_MAX_DEGREE + 2], v[IG_MAX_DEGREE + 2], rv[IG_MAX_DEGREE + 2];
-    int s[IG_MAX_DEGREE + 2];
-    int np = 0;
-    xs[np++] = a;
-    for (int i = 0; i < nc; ++i)
-        if (crit[i] > xs[np - 1] && crit[i] < b)
-            xs[np++] = crit[i];
-    if (b > a)
-        xs[np++] = b;
-    double big, g2m;
-    level_bounds(q, m, a, b, final, &big, &g2m);
-    double tol = final ? 2.0 * IG_U : 1e-7;
-    int unsure[IG_MAX_DEGREE + 2];
-    if (first) {
-        /* the first root only: points evaluated (and polished) left to right as far as the first root needs;
-         * the point after a bracket too, since a polish reads both neighbours of a point */
-        int known = 0;
-        for (int i = 0; i < np; ++i) {
-            for (; known < np && known <= i + 1; ++known) {
-                level_point(q, m, xs[known], final, big, g2m, &v[known], &s[known], &unsure[known]);
-                rv[known] = xs[known];
-            }
-            for (int k = i; k <= i + 1 && k < np; ++k)
-                if (unsure[k] && s[k] != 0 && k > 0 && k < np - 1) {
-                    level_polish(chain, n, xs, k, &s[k], &rv[k]);
-                    unsure[k] = 0;
-                }
-            if (s[i] == 0 && (final || (i > 0 && i < np - 1))) {
-                /* a polished zero may lie anywhere between its neighbours, so the next point's, when it is a
-                 * zero too, can be the smaller one (two critical points at a triple root); no later one can */
-                int next = i + 1 < np && s[i + 1] == 0 && (final || i + 1 < np - 1) && rv[i + 1] < rv[i];
-                out[0] = next ? rv[i + 1] : rv[i];
-                return 1;
-            }
-            if (i + 1 < np && s[i] * s[i + 1] < 0) { /* ig_refine_many is ig_refine lane by lane */
-                out[0] = ig_refine(q, m, xs[i], xs[i + 1], v[i], v[i + 1], tol, level_guess(ddq, m, xs, v, i, np - 1));
-                return 1;
-            }
-        }
-        return 0;
-    }
-    for (int i = 0; i < np; ++i) {
-        level_point(q, m, xs[i], final, big, g2m, &v[i], &s[i], &unsure[i]);
-        rv[i] = xs[i];
-        if (unsure[i] && s[i] != 0 && i > 0 && i < np - 1)
-            level_polish(chain, n, xs, i, &s[i], &rv[i]);
-    }
-    /* brackets to refine, all at once (ig_refine_many); slot[] is where each root goes in out[] */
-    double bl[IG_MAX_DEGREE + 1], br[IG_MAX_DEGREE + 1], bvl[IG_MAX_DEGREE + 1], bvr[IG_MAX_DEGREE + 1];
-    double bx0[IG_MAX_DEGREE + 1], broot[IG_MAX_DEGREE + 1];
-    int slot[IG_MAX_DEGREE + 1], nb = 0;
-    int cnt = 0;
-    for (int i = 0; i < np; ++i) {
-        if (s[i] == 0 && (final || (i > 0 && i < np - 1)))
-            out[cnt++] = rv[i];
-        if (i + 1 < np && s[i] * s[i + 1] < 0) {
-            bl[nb] = xs[i];
-            br[nb] = xs[i + 1];
-            bvl[nb] = v[i];
-            bvr[nb] = v[i + 1];
-            bx0[nb] = level_guess(ddq, m, xs, v, i, np - 1);
-            slot[nb++] = cnt++;
-        }
-    }
-    if (nb > 0) {
-        ig_refine_many(q, m, nb, bl, br, bvl, bvr, tol, bx0, broot);
-        for (int i = 0; i < nb; ++i)
-            out[slot[i]] = broot[i];
-    }
-    return cnt;
+    level L;
+    level_init(&L, chain, j, n, a, b, crit, nc, final);
+    return first ? level_first(&L, out) : level_all(&L, out);
 }
 
 /* chain[j] = p^(j) scaled to keep the leading coefficient of p: degree n - j, so p^(j) = n (n-1) ... (n-j+1)

@@ -96,12 +96,64 @@ typedef struct {
     int vl, vr;
 } piece;
 
+/* A root of even multiplicity alone in piece pc (one root by the count, no sign change): narrowed by
+ * counting, then Newton on p', for which an even-multiplicity root of p is a root of odd multiplicity, kept
+ * inside the piece. A floating-point Sturm count can be wrong: 1 with *x only when the zero is certified. */
+static int even_root(const double *p, int n, const sturm_seq *s, piece pc, double *x)
+{
+    double l = pc.l, r = pc.r, d1[IG_MAX_DEGREE], vx;
+    int vl = pc.vl;
+    for (int it = 0; it < 80; ++it) {
+        double m = ig_ordered_mid(l, r);
+        if (!(m > l && m < r) || r - l <= 4.0 * IG_U * fabs(m))
+            break;
+        int vm = variations(s, m);
+        if (vl - vm >= 1)
+            r = m;
+        else {
+            l = m;
+            vl = vm;
+        }
+    }
+    /* the count is blind near a multiple root: finish with Newton on p' */
+    *x = ig_ordered_mid(l, r);
+    for (int j = 0; j < n; ++j)
+        d1[j] = (j + 1) * p[j + 1];
+    for (int it = 0; it < 8; ++it) {
+        double v, dv;
+        ig_horner2(d1, n - 1, *x, &v, &dv);
+        double xn = *x - v / dv;
+        if (v == 0.0 || !(xn >= pc.l && xn <= pc.r) || xn == *x)
+            break;
+        *x = xn;
+    }
+    return ig_sign_certified(p, n, *x, &vx) == 0;
+}
+
+/* The one root of piece pc: its right end when p vanishes there, the refined bracket when p changes sign, else a
+ * root of even multiplicity. Returns 1 with *x, 0 when none is certified. */
+static int single_root(const double *p, int n, const sturm_seq *s, piece pc, double *x)
+{
+    double fl, fr;
+    int sl = ig_sign_certified(p, n, pc.l, &fl);
+    int sr = ig_sign_certified(p, n, pc.r, &fr);
+    if (sr == 0) {
+        *x = pc.r;
+        return 1;
+    }
+    if (sl * sr < 0) {
+        *x = ig_refine(p, n, pc.l, pc.r, fl, fr, 2.0 * IG_U, NAN);
+        return 1;
+    }
+    return even_root(p, n, s, pc, x);
+}
+
 int ig_sturm_interval(const double *p, int n, double a, double b, double *out)
 {
     sturm_seq s;
     build(p, n, &s);
     int cnt = 0;
-    double va, vb;
+    double va;
     if (ig_sign_certified(p, n, a, &va) == 0)
         out[cnt++] = a;
     if (!(b > a))
@@ -116,46 +168,9 @@ int ig_sturm_interval(const double *p, int n, double a, double b, double *out)
         if (k <= 0)
             continue;
         if (k == 1) {
-            double fl, fr;
-            int sl = ig_sign_certified(p, n, pc.l, &fl);
-            int sr = ig_sign_certified(p, n, pc.r, &fr);
-            if (sr == 0) {
-                out[cnt++] = pc.r;
-            } else if (sl * sr < 0) {
-                out[cnt++] = ig_refine(p, n, pc.l, pc.r, fl, fr, 2.0 * IG_U, NAN);
-            } else {
-                /* even multiplicity: narrow by counting */
-                double l = pc.l, r = pc.r;
-                int vl = pc.vl;
-                for (int it = 0; it < 80; ++it) {
-                    double m = ig_ordered_mid(l, r);
-                    if (!(m > l && m < r) || r - l <= 4.0 * IG_U * fabs(m))
-                        break;
-                    int vm = variations(&s, m);
-                    if (vl - vm >= 1)
-                        r = m;
-                    else {
-                        l = m;
-                        vl = vm;
-                    }
-                }
-                /* the count is blind near a multiple root: finish with Newton on p', for which an even-
-                 * multiplicity root of p is a root of odd multiplicity, kept inside [l, r] */
-                double x = ig_ordered_mid(l, r), d1[IG_MAX_DEGREE];
-                for (int j = 0; j < n; ++j)
-                    d1[j] = (j + 1) * p[j + 1];
-                for (int it = 0; it < 8; ++it) {
-                    double v, dv;
-                    ig_horner2(d1, n - 1, x, &v, &dv);
-                    double xn = x - v / dv;
-                    if (v == 0.0 || !(xn >= pc.l && xn <= pc.r) || xn == x)
-                        break;
-                    x = xn;
-                }
-                double vx; /* a floating-point Sturm count can be wrong: keep only a certified zero */
-                if (ig_sign_certified(p, n, x, &vx) == 0)
-                    out[cnt++] = x;
-            }
+            double x;
+            if (single_root(p, n, &s, pc, &x))
+                out[cnt++] = x;
             continue;
         }
         double m = ig_ordered_mid(pc.l, pc.r);
@@ -167,6 +182,5 @@ int ig_sturm_interval(const double *p, int n, double a, double b, double *out)
         st[sp++] = (piece){m, pc.r, vm, pc.vr};
         st[sp++] = (piece){pc.l, m, pc.vl, vm};
     }
-    (void)vb;
     return ig_sort_unique(out, cnt);
 }

@@ -281,37 +281,96 @@ void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lz)
 
 int rt_spawn_skip(const rt_scene *s, const rt_hit *h) { return s->flat[h->object] ? h->object : -1; }
 
+/* One closest-hit (or any-opaque-hit) search along a ray: what rt_scene_closest's steps share. */
+typedef struct {
+    const rt_scene *s;
+    rt_ray ray;
+    double tmin, best; /* hits are looked for in [tmin, best); best shrinks as they are found */
+    int mode, skip, found;
+    rt_pending *out;
+} rt_search;
+
+/* Object obj's hit, kept when it is closer than the best so far (rt_object_hit only reports t < best). Returns
+ * 1 when the search is over: in RT_ANY_OPAQUE mode, a hit on an opaque material. */
+static inline int search_take(rt_search *q, int obj)
+{
+    rt_pending h;
+    if (obj == q->skip || !rt_object_hit(q->s, obj, &q->ray, q->tmin, q->best, q->mode == RT_ANY_OPAQUE, &h))
+        return 0;
+    *q->out = h;
+    q->best = h.t;
+    q->found = 1;
+    return q->mode == RT_ANY_OPAQUE && rt_leaf_opaque(q->s, &q->s->nodes[h.leaf]);
+}
+
+/* The objects of BVH leaf b. A leaf's box holds its objects' boxes, which may be far apart (a scene's objects to
+ * the left and right of the one in the middle): each object's own box first, before its solve sets up. */
+static inline int search_leaf(rt_search *q, const rt_bvh_node *b)
+{
+    const rt_scene *s = q->s;
+    int i;
+    for (i = b->first; i < b->first + b->count; ++i) {
+        double o0 = q->tmin, o1 = q->best;
+        if (b->count > 1 && !ray_box(s->nodes[s->objects[s->order[i]]].wbox, &q->ray, &o0, &o1))
+            continue;
+        if (search_take(q, s->order[i]))
+            return 1;
+    }
+    return 0;
+}
+
+/* The children of inner node b that the ray enters before the best hit, pushed with their entry t, the nearer
+ * child last so that it is visited first. */
+static inline int search_push(const rt_search *q, const rt_bvh_node *b, int *stack, double *entry, int sp)
+{
+    const rt_bvh_node *l = &q->s->bvh[b->left], *r = &q->s->bvh[b->right];
+    double la = q->tmin, lb = q->best, ra = q->tmin, rb = q->best;
+    int lhit = ray_box(l->box, &q->ray, &la, &lb);
+    int rhit = ray_box(r->box, &q->ray, &ra, &rb);
+    if (lhit && rhit && la > ra) {
+        stack[sp] = b->left;
+        entry[sp++] = la;
+        stack[sp] = b->right;
+        entry[sp++] = ra;
+        return sp;
+    }
+    if (rhit) {
+        stack[sp] = b->right;
+        entry[sp++] = ra;
+    }
+    if (lhit) {
+        stack[sp] = b->left;
+        entry[sp++] = la;
+    }
+    return sp;
+}
+
 int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
                      int skip, rt_pending *out)
 {
-    double best = tmax;
-    int found = 0, i, sp = 0;
-    int stack[128];
+    int i, sp = 0, stack[128];
     double entry[128];
-    rt_ray ray;
-    rt_pending h;
+    rt_search q;
     if (!s->committed)
         return 0;
     if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]) || !isfinite(o[0]) || !isfinite(o[1]) || !isfinite(o[2]))
         return 0;
-    rt_ray_init(&ray, o, d, s->far);
-    /* A hit is kept when it is closer than the best so far (rt_object_hit only reports t < best). In
-     * RT_ANY_OPAQUE mode a hit on an opaque material ends the search. */
-#define RT_TAKE(obj)                                                                                                   \
-    if ((obj) != skip && rt_object_hit(s, (obj), &ray, tmin, best, mode == RT_ANY_OPAQUE, &h)) {                       \
-        *out = h;                                                                                                      \
-        best = h.t;                                                                                                    \
-        found = 1;                                                                                                     \
-        if (mode == RT_ANY_OPAQUE && rt_leaf_opaque(s, &s->nodes[h.leaf]))                                             \
-            return 1;                                                                                                  \
-    }
+    q.s = s;
+    rt_ray_init(&q.ray, o, d, s->far);
+    q.tmin = tmin;
+    q.best = tmax;
+    q.mode = mode;
+    q.skip = skip;
+    q.found = 0;
+    q.out = out;
     for (i = 0; i < s->nunbounded; ++i)
-        RT_TAKE(s->unbounded[i])
+        if (search_take(&q, s->unbounded[i]))
+            return 1;
     /* Each stack entry carries the t where the ray enters its box, so a node is clipped once and skipped
      * when a closer hit has been found since it was pushed. */
     if (s->nbvh > 0) {
-        double t0 = tmin, t1 = best;
-        if (ray_box(s->bvh[0].box, &ray, &t0, &t1)) {
+        double t0 = tmin, t1 = q.best;
+        if (ray_box(s->bvh[0].box, &q.ray, &t0, &t1)) {
             stack[sp] = 0;
             entry[sp++] = t0;
         }
@@ -319,43 +378,17 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
     while (sp > 0) {
         const rt_bvh_node *b;
         --sp;
-        if (entry[sp] > best)
+        if (entry[sp] > q.best)
             continue;
         b = &s->bvh[stack[sp]];
         if (b->left < 0) {
-            for (i = b->first; i < b->first + b->count; ++i) {
-                /* A leaf's box holds its objects' boxes, which may be far apart (a scene's objects to the left
-                 * and right of the one in the middle): each object's own box first, before its solve sets up. */
-                double o0 = tmin, o1 = best;
-                if (b->count > 1 && !ray_box(s->nodes[s->objects[s->order[i]]].wbox, &ray, &o0, &o1))
-                    continue;
-                RT_TAKE(s->order[i])
-            }
+            if (search_leaf(&q, b))
+                return 1;
         } else if (sp + 2 <= (int)(sizeof stack / sizeof stack[0])) {
-            /* visit the nearer child first: push it last */
-            const rt_bvh_node *l = &s->bvh[b->left], *r = &s->bvh[b->right];
-            double la = tmin, lb = best, ra = tmin, rb = best;
-            int lhit = ray_box(l->box, &ray, &la, &lb);
-            int rhit = ray_box(r->box, &ray, &ra, &rb);
-            if (lhit && rhit && la > ra) {
-                stack[sp] = b->left;
-                entry[sp++] = la;
-                stack[sp] = b->right;
-                entry[sp++] = ra;
-            } else {
-                if (rhit) {
-                    stack[sp] = b->right;
-                    entry[sp++] = ra;
-                }
-                if (lhit) {
-                    stack[sp] = b->left;
-                    entry[sp++] = la;
-                }
-            }
+            sp = search_push(&q, b, stack, entry, sp);
         }
     }
-#undef RT_TAKE
-    return found;
+    return q.found;
 }
 
 int rt_scene_intersect(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, rt_hit *hit)

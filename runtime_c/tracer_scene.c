@@ -131,44 +131,34 @@ static int new_node(rt_scene *s)
     return s->nnodes++;
 }
 
-int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, int nparams, const double *m,
-                      int material)
+/* Why a leaf's arguments cannot make a leaf, or NULL. */
+static const char *leaf_refusal(const rt_scene *s, const ig_shape *shape, const double *params, int nparams,
+                                const double *m, int material)
 {
-    rt_node *n;
-    int i, k;
+    int i;
     if (!shape)
-        return fail(s, "no shape");
+        return "no shape";
     if (nparams != shape->nparams)
-        return fail(s, "wrong number of shape parameters");
+        return "wrong number of shape parameters";
     if (material < 0 || material >= s->nmaterials)
-        return fail(s, "leaf without a valid material");
+        return "leaf without a valid material";
     for (i = 0; i < 12; ++i)
         if (!isfinite(m[i]))
-            return fail(s, "transform is not finite");
+            return "transform is not finite";
     for (i = 0; i < nparams; ++i)
         if (!isfinite(params[i]))
-            return fail(s, "shape parameter is not finite");
-    k = new_node(s);
-    if (k < 0)
-        return k;
-    n = &s->nodes[k];
-    n->kind = RT_LEAF;
-    n->left = n->right = -1;
-    n->material = material;
-    n->shape = shape;
-    n->params = malloc((size_t)(nparams > 0 ? nparams : 1) * sizeof(double));
-    if (!n->params) {
-        s->nnodes--;
-        return fail(s, "out of memory");
-    }
-    if (nparams > 0)
-        memcpy(n->params, params, (size_t)nparams * sizeof(double));
+            return "shape parameter is not finite";
+    return NULL;
+}
+
+/* The leaf's transform, set and checked: its inverse (0 when it is singular), its linear part's Frobenius norm,
+ * whether it is the identity. */
+static int leaf_transform(rt_node *n, const double *m)
+{
+    int i;
     memcpy(n->m, m, sizeof n->m);
-    if (!ig_affine_invert(n->m, n->minv)) {
-        free(n->params);
-        s->nnodes--;
-        return fail(s, "transform is singular");
-    }
+    if (!ig_affine_invert(n->m, n->minv))
+        return 0;
     n->mnorm = 0.0;
     for (i = 0; i < 12; ++i)
         if (i % 4 != 3)
@@ -178,6 +168,14 @@ int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, 
     for (i = 0; i < 12; ++i)
         if (m[i] != ((i == 0 || i == 5 || i == 10) ? 1.0 : 0.0))
             n->identity = 0;
+    return 1;
+}
+
+/* The leaf's object box (open on an axis bounds() leaves alone, everywhere when the shape is not bounded), its
+ * prepared solve, and the half-size of its finite axes. */
+static void leaf_object_box(rt_node *n, const ig_shape *shape)
+{
+    int i;
     for (i = 0; i < 3; ++i) { /* what shape.c starts from too: an axis bounds() leaves alone is open */
         n->obox[i] = -INFINITY;
         n->obox[i + 3] = INFINITY;
@@ -194,6 +192,37 @@ int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, 
             n->obox[i] = -INFINITY;
             n->obox[i + 3] = INFINITY;
         }
+}
+
+int rt_scene_add_leaf(rt_scene *s, const ig_shape *shape, const double *params, int nparams, const double *m,
+                      int material)
+{
+    const char *why = leaf_refusal(s, shape, params, nparams, m, material);
+    rt_node *n;
+    int k;
+    if (why)
+        return fail(s, why);
+    k = new_node(s);
+    if (k < 0)
+        return k;
+    n = &s->nodes[k];
+    n->kind = RT_LEAF;
+    n->left = n->right = -1;
+    n->material = material;
+    n->shape = shape;
+    n->params = malloc((size_t)(nparams > 0 ? nparams : 1) * sizeof(double));
+    if (!n->params) {
+        s->nnodes--;
+        return fail(s, "out of memory");
+    }
+    if (nparams > 0)
+        memcpy(n->params, params, (size_t)nparams * sizeof(double));
+    if (!leaf_transform(n, m)) {
+        free(n->params);
+        s->nnodes--;
+        return fail(s, "transform is singular");
+    }
+    leaf_object_box(n, shape);
     return k;
 }
 

@@ -203,6 +203,61 @@ def slots(client: Any) -> int:
         raise SchedulerLost(type(err).__name__) from None
 
 
+class _Window:
+    """The tasks of one `ordered` run submitted and not yet yielded, and what it knows of the workers: how many
+    threads they have (looked up again at most every `poll` seconds) and how many looks in a row found none."""
+
+    def __init__(self, client: Any, jobs: Iterable[tuple[Any, tuple]], poll: float, say) -> None:
+        self.client, self.todo, self.poll, self.say = client, iter(jobs), poll, say
+        self.pending: deque = deque()
+        self.more = True
+        self.threads, self.looked = slots(client), time.monotonic()
+        self.idle = 1 if self.threads == 0 else 0  # looks in a row that found no worker
+
+    def look(self) -> None:
+        if time.monotonic() - self.looked < self.poll:
+            return
+        if self.client.status != "running":  # reconnecting, or closed: the scheduler is gone
+            raise SchedulerLost(self.client.status)
+        self.threads, self.looked = slots(self.client), time.monotonic()
+        self.idle = self.idle + 1 if self.threads == 0 else 0
+        if self.idle == 2 and self.say is not None:  # twice in a row: a closing cluster (workers first) says nothing
+            self.say("waiting for Dask workers: none is connected to the scheduler")
+
+    def fill(self, size: int, submit: Callable[[Any, tuple], Any]) -> None:
+        """Submit jobs until `size` are pending or none is left."""
+        while self.more and len(self.pending) < size:
+            job = next(self.todo, None)
+            if job is None:
+                self.more = False
+                return
+            self.pending.append((job[0], submit(*job)))
+
+
+def _first_result(win: _Window) -> tuple[bool, Any]:
+    """Wait up to `poll` for the oldest pending task: (True, its result), or (False, None) when it is not done
+    yet. Its own error is raised; a lost worker or scheduler in one line."""
+    from distributed import KilledWorker
+    from distributed.client import FutureCancelledError
+
+    index, fut = win.pending[0]
+    was_done = fut.done()
+    try:
+        return True, fut.result(timeout=None if was_done else win.poll)
+    except TimeoutError:
+        if was_done:  # the task's own error
+            raise
+        return False, None  # the wait's: not done yet (or done just now: the next call returns at once)
+    except KilledWorker:  # every retry lost its worker: one line, not Dask's traceback
+        raise UserError(
+            "render", f"task {tag_of(index)} lost its worker more often than the scheduler allows"
+        ) from None
+    except FutureCancelledError as err:
+        if err.reason == "scheduler-connection-lost" or win.client.status != "running":
+            raise SchedulerLost(err.reason) from None
+        raise
+
+
 def ordered(
     client: Any,
     fn: Callable[..., Any],
@@ -220,66 +275,29 @@ def ordered(
     least `per_thread`), or a fixed `window` of them when given (the benchmark's). The workers are looked up
     again at most every `poll` seconds while results come in or are awaited; `say` is told when there are
     none. A lost scheduler raises SchedulerLost."""
-    from distributed import KilledWorker
-    from distributed.client import FutureCancelledError
-
     run = secrets.token_hex(4)
-    todo = iter(jobs)
-    pending: deque = deque()
-    more = True
-    idle = 0  # looks in a row that found no worker
 
-    def look() -> None:
-        nonlocal threads, looked, idle
-        if time.monotonic() - looked < poll:
-            return
-        if client.status != "running":  # reconnecting, or closed: the scheduler is gone
-            raise SchedulerLost(client.status)
-        threads, looked = slots(client), time.monotonic()
-        idle = idle + 1 if threads == 0 else 0
-        if idle == 2 and say is not None:  # twice in a row: a closing cluster (workers first) does not say it
-            say("waiting for Dask workers: none is connected to the scheduler")
+    def submit(index: Any, args: tuple) -> Any:
+        return client.submit(fn, *args, key=f"{name}-{run}-{tag_of(index)}", retries=retries, pure=False)
 
+    win = _Window(client, jobs, poll, say)
     try:
-        threads, looked = slots(client), time.monotonic()
-        idle = 1 if threads == 0 else 0
         while True:
-            while more and len(pending) < (window or per_thread * max(1, threads)):
-                job = next(todo, None)
-                if job is None:
-                    more = False
-                    break
-                index, args = job
-                fut = client.submit(fn, *args, key=f"{name}-{run}-{tag_of(index)}", retries=retries, pure=False)
-                pending.append((index, fut))
-            if not pending:
+            win.fill(window or per_thread * max(1, win.threads), submit)
+            if not win.pending:
                 return
-            index, fut = pending[0]
-            was_done = fut.done()
-            try:
-                result = fut.result(timeout=None if was_done else poll)
-            except TimeoutError:
-                if was_done:  # the task's own error
-                    raise
-                look()  # the wait's: not done yet (or done just now: the next call returns at once)
-                continue
-            except KilledWorker:  # every retry lost its worker: one line, not Dask's traceback
-                raise UserError(
-                    "render", f"task {tag_of(index)} lost its worker more often than the scheduler allows"
-                ) from None
-            except FutureCancelledError as err:
-                if err.reason == "scheduler-connection-lost" or client.status != "running":
-                    raise SchedulerLost(err.reason) from None
-                raise
-            pending.popleft()
-            fut.release()
-            look()
-            yield index, result
+            done, result = _first_result(win)
+            if done:
+                index, fut = win.pending.popleft()
+                fut.release()
+            win.look()
+            if done:
+                yield index, result
     except SchedulerLost:
-        pending.clear()  # gone with the scheduler: nothing to cancel
+        win.pending.clear()  # gone with the scheduler: nothing to cancel
         raise
     finally:
-        for _, fut in pending:
+        for _, fut in win.pending:
             fut.cancel()
 
 

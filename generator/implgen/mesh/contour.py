@@ -47,21 +47,31 @@ def _face_bits(lib, clips, grid: Grid, cell_idx: np.ndarray, config: np.ndarray)
     return bits
 
 
-def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
-    clock = [time.perf_counter()]
-    inside, g = grid_flags(lib, clips, grid)
-    clock.append(time.perf_counter())
-    shape = inside.shape
-    strides = np.array([shape[1] * shape[2], shape[2], 1])
+@dataclass
+class _Cells:
+    """The active cells (neither all inside nor all outside) and their sheets."""
+
+    flat: np.ndarray  # each cell's lower corner, flat among the grid's vertices
+    conf: np.ndarray  # its corners' inside flags, 8 bits
+    key: np.ndarray  # conf and the face bits: the row of cells.cell_table
+    sheets: np.ndarray  # (C, 12) int8: the sheet of each edge in its cell, -1 where not active
+    count: np.ndarray  # sheets per cell
+    base: np.ndarray  # each cell's first vertex
+
+    @property
+    def nverts(self) -> int:
+        return int(self.count.sum())
+
+
+def _check_outer_layer(inside: np.ndarray) -> None:
     if inside[0].any() or inside[-1].any() or inside[:, 0].any() or inside[:, -1].any():
         raise AssertionError("the grid's outer layer must lie outside every clip")
     if inside[:, :, 0].any() or inside[:, :, -1].any():
         raise AssertionError("the grid's outer layer must lie outside every clip")
-    cross: list[Crossings] = [axis_crossings(lib, clips, grid, a, inside, g) for a in range(3)]
-    clock.append(time.perf_counter())
-    lib.check()  # the budget, between phases (budget.py)
 
-    # cells: corner flags -> config; active ones get their sheets
+
+def _active_cells(lib: ShapeLib, clips: list[Clip], grid: Grid, inside: np.ndarray, strides: np.ndarray) -> _Cells:
+    """Corner flags -> config; the active cells get their sheets."""
     ins = inside.view(np.uint8)
     n0, n1, n2 = grid.n
     config = np.zeros((n0, n1, n2), dtype=np.uint8)
@@ -70,24 +80,25 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     cflat = np.flatnonzero((config != 0) & (config != 255))  # in the cells' own (n0, n1, n2) numbering
     cidx = np.stack(np.unravel_index(cflat, grid.n), axis=1)
     conf = config.reshape(-1)[cflat].astype(np.int64)
-    cflat = cidx @ strides  # now the flat index of each cell's lower corner among the grid's vertices
     key = conf | _face_bits(lib, clips, grid, cidx, conf) << 8
     row, table, nsheets = cells.cell_table(key)
-    sheets = table[row]  # (C, 12) int8: the sheet of each edge in its cell, -1 where not active
     count = nsheets[row]
-    base = np.cumsum(count) - count  # each cell's first vertex
-    nverts = int(count.sum())
+    return _Cells(
+        flat=cidx @ strides, conf=conf, key=key, sheets=table[row], count=count, base=np.cumsum(count) - count
+    )
 
-    clock.append(time.perf_counter())
-    lib.check()  # the budget, between phases (budget.py)
-    # every sheet's crossings -> QEF point (one C loop over the cells) -> onto the surface
-    nv = int(np.prod(shape))
+
+def _dual_vertices(lib: ShapeLib, clips: list[Clip], grid: Grid, cross: list[Crossings], cs: _Cells, strides, clock):
+    """Every sheet's crossings -> QEF point (one C loop over the cells) -> onto the surface: (vertices, which of
+    them fell back to their sheet's crossing nearest the QEF point, where Newton strayed near a node or a thin
+    neck: a crossing lies on the surface exactly). The QEF's end goes on the clock."""
+    nv = int(np.prod(grid.shape))
     keys = np.concatenate([a * nv + c.edges for a, c in enumerate(cross)])
     cp = np.concatenate([c.points for c in cross])
     cn = np.concatenate([c.normals for c in cross])
     cpiece = np.concatenate([c.piece for c in cross])
     qef, mask, nearest = lib.sheet_points(
-        cflat, sheets, base, strides, nv, keys, cp, cn, cpiece, grid.origin, grid.h, CREASE, DROP, nverts
+        cs.flat, cs.sheets, cs.base, strides, nv, keys, cp, cn, cpiece, grid.origin, grid.h, CREASE, DROP, cs.nverts
     )
     clock.append(time.perf_counter())
     lib.check()  # the budget, between phases (budget.py)
@@ -98,14 +109,15 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         mask[redo] |= extra[redo]
         verts[redo], projected[redo] = project(lib, clips, verts[redo], mask[redo], grid.h, grid.size)
     failed = ~projected
-    if failed.any():  # Newton strayed (near a node, a thin neck): the sheet's crossing nearest the QEF point,
-        verts[failed] = cp[nearest[failed]]  # which lies on the surface exactly
+    if failed.any():
+        verts[failed] = cp[nearest[failed]]
+    return verts, failed
 
-    clock.append(time.perf_counter())
-    lib.check()  # the budget, between phases (budget.py)
-    # one quad per active edge, from the sheets of its four cells
-    rowof = np.full(int(np.prod(shape)), -1, dtype=np.int64)
-    rowof[cflat] = np.arange(len(cflat))
+
+def _quads(grid: Grid, cross: list[Crossings], cs: _Cells, inside: np.ndarray, strides) -> tuple[Quads, np.ndarray]:
+    """One quad per active edge, from the sheets of its four cells; and each grid vertex's active cell row."""
+    rowof = np.full(int(np.prod(grid.shape)), -1, dtype=np.int64)
+    rowof[cs.flat] = np.arange(len(cs.flat))
     parts = []
     for a in range(3):
         b, c = (a + 1) % 3, (a + 2) % 3
@@ -115,24 +127,46 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
         for q, (db, dc) in enumerate(AROUND):
             r = rowof[edges - db * strides[b] - dc * strides[c]]
             u, v = (db, dc) if lo_ax == b else (dc, db)  # the edge's offsets inside that cell
-            quad[:, q] = base[r] + sheets[r, 4 * a + u + 2 * v]
+            quad[:, q] = cs.base[r] + cs.sheets[r, 4 * a + u + 2 * v]
         flip = ~inside.reshape(-1)[edges]  # outside below: the outside is toward -a
         parts.append((quad, np.full(edges.size, a), edges, flip, cross[a].points, cross[a].piece))
-    quads = Quads(*(np.concatenate([p[i] for p in parts]) for i in range(6)))
-    near_amb = np.repeat(cells.AMBIGUOUS[conf] != 0, count)  # sheets of cells with an ambiguous face
-    verts, faces, split = triangulate(quads, verts, near_amb, inside, grid, lib, clips, AROUND, rowof, key)
-    clock.append(time.perf_counter())
+    return Quads(*(np.concatenate([p[i] for p in parts]) for i in range(6))), rowof
+
+
+def _stats(clock: list[float], grid: Grid, cross: list[Crossings], cs: _Cells, failed, split) -> dict:
     phases = ("signs", "crossings", "sheets", "qef", "projection", "faces")
-    stats = {
+    return {
         "seconds": {k: round(b - a, 4) for k, a, b in zip(phases, clock, clock[1:])},
         "cells": list(grid.n),
         "active_edges": int(sum(c.edges.size for c in cross)),
         "fallback_crossings": int(sum(c.fallback for c in cross)),
-        "multi_sheet_cells": int((count > 1).sum()),
+        "multi_sheet_cells": int((cs.count > 1).sum()),
         "vertices_at_a_crossing": int(failed.sum()),
         "hidden_crossing_edges": int(sum(c.hidden for c in cross)),
         "split_sides": split,
     }
+
+
+def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
+    """The phases in order, the budget checked between them; each phase's seconds in the stats."""
+    clock = [time.perf_counter()]
+    inside, g = grid_flags(lib, clips, grid)
+    clock.append(time.perf_counter())
+    _check_outer_layer(inside)
+    strides = np.array([inside.shape[1] * inside.shape[2], inside.shape[2], 1])
+    cross: list[Crossings] = [axis_crossings(lib, clips, grid, a, inside, g) for a in range(3)]
+    clock.append(time.perf_counter())
+    lib.check()  # the budget, between phases (budget.py)
+    cs = _active_cells(lib, clips, grid, inside, strides)
+    clock.append(time.perf_counter())
+    lib.check()
+    verts, failed = _dual_vertices(lib, clips, grid, cross, cs, strides, clock)
+    clock.append(time.perf_counter())
+    lib.check()
+    quads, rowof = _quads(grid, cross, cs, inside, strides)
+    near_amb = np.repeat(cells.AMBIGUOUS[cs.conf] != 0, cs.count)  # sheets of cells with an ambiguous face
+    verts, faces, split = triangulate(quads, verts, near_amb, inside, grid, lib, clips, AROUND, rowof, cs.key)
+    clock.append(time.perf_counter())
     cell = np.full(len(verts), -1, dtype=np.int64)
-    cell[:nverts] = np.repeat(cflat, count)
-    return Mesh(vertices=verts, faces=faces, grid=grid, stats=stats, cell=cell)
+    cell[: cs.nverts] = np.repeat(cs.flat, cs.count)
+    return Mesh(vertices=verts, faces=faces, grid=grid, stats=_stats(clock, grid, cross, cs, failed, split), cell=cell)
