@@ -165,73 +165,88 @@ def _bad(r: Row) -> int:
     return r.score.missed + r.score.phantom
 
 
-def targets(rows: list[Row]) -> list[str]:
-    """The issue's three targets (plus the error bound), then first-root mode, each evaluated on these rows."""
-    by = {(r.case, r.method): r for r in rows}
-    out = []
-    solver_rows = [r for r in rows if r.method != "numpy.roots"]
-    bad = [(r.case, r.method) for r in solver_rows if _bad(r)]
+def _no_missed_roots(rows: list[Row]) -> str:
+    bad = [(r.case, r.method) for r in rows if r.method != "numpy.roots" and _bad(r)]
     auto_bad = [k for k in bad if k[1] in ("auto", "auto" + FIRST)]
-    out.append(
+    return (
         f"- No missed/phantom simple roots: auto {'MET' if not auto_bad else 'NOT MET ' + str(auto_bad)}; "
         f"all methods with any: {bad if bad else 'none'}."
     )
+
+
+def _error_bound(rows: list[Row]) -> str:
     worst = max((_worst(r) for r in rows if r.method in ("auto", "auto" + FIRST)), default=0.0)
-    out.append(
+    return (
         f"- Rel. error <= 1e-12 on well-conditioned roots (auto, all sets, both modes): max {worst:.1e} "
         f"{'MET' if worst <= 1e-12 else 'NOT MET'}."
     )
-    for case in ("torus rays", "torus rays (no exact grazing)"):
-        if (case, "auto") not in by:
-            continue
-        auto = by[(case, "auto")]
-        closed = [by[(case, m)] for m in ("closed_plain", "closed") if (case, m) in by]
-        if not closed:
-            continue
-        fastest = min(closed, key=lambda r: r.median_ns)
-        ratio = auto.median_ns / fastest.median_ns
-        ea, ef = _worst(auto), _worst(fastest)
-        better = (ea < ef) or (_bad(auto) < _bad(fastest))
-        out.append(
-            f"- auto within 2x the fastest closed-form quartic ({fastest.method}) on {case}: "
-            f"{auto.median_ns:.0f} vs {fastest.median_ns:.0f} ns = {ratio:.2f}x, max error {ea:.1e} vs "
-            f"{ef:.1e}, missed+phantom {_bad(auto)} vs {_bad(fastest)}: "
-            f"{'MET' if ratio <= 2 and better else 'NOT MET'}."
-        )
-    if (HIGH_RAYS, "bracket") in by and (HIGH_RAYS, "sturm") in by:
-        b, st = by[(HIGH_RAYS, "bracket")], by[(HIGH_RAYS, "sturm")]
-        ratio = st.median_ns / b.median_ns
-        out.append(
-            f"- Bracketing >= 3x faster than Sturm on degree 6-12 ray polynomials ({HIGH_RAYS}: the "
-            f"example shapes reach degree 10): {b.median_ns:.0f} vs {st.median_ns:.0f} ns = {ratio:.1f}x, "
-            f"max error {_worst(b):.1e} vs {_worst(st):.1e}: {'MET' if ratio >= 3 else 'NOT MET'}."
-        )
+
+
+def _against_closed_form(by: dict, case: str) -> str | None:
+    """auto against the fastest closed-form quartic on one torus ray set, or None when either is missing."""
+    closed = [by[(case, m)] for m in ("closed_plain", "closed") if (case, m) in by]
+    if (case, "auto") not in by or not closed:
+        return None
+    auto = by[(case, "auto")]
+    fastest = min(closed, key=lambda r: r.median_ns)
+    ratio = auto.median_ns / fastest.median_ns
+    ea, ef = _worst(auto), _worst(fastest)
+    better = (ea < ef) or (_bad(auto) < _bad(fastest))
+    return (
+        f"- auto within 2x the fastest closed-form quartic ({fastest.method}) on {case}: "
+        f"{auto.median_ns:.0f} vs {fastest.median_ns:.0f} ns = {ratio:.2f}x, max error {ea:.1e} vs "
+        f"{ef:.1e}, missed+phantom {_bad(auto)} vs {_bad(fastest)}: "
+        f"{'MET' if ratio <= 2 and better else 'NOT MET'}."
+    )
+
+
+def _bracketing_against_sturm(by: dict) -> str | None:
+    if (HIGH_RAYS, "bracket") not in by or (HIGH_RAYS, "sturm") not in by:
+        return None
+    b, st = by[(HIGH_RAYS, "bracket")], by[(HIGH_RAYS, "sturm")]
+    ratio = st.median_ns / b.median_ns
+    return (
+        f"- Bracketing >= 3x faster than Sturm on degree 6-12 ray polynomials ({HIGH_RAYS}: the "
+        f"example shapes reach degree 10): {b.median_ns:.0f} vs {st.median_ns:.0f} ns = {ratio:.1f}x, "
+        f"max error {_worst(b):.1e} vs {_worst(st):.1e}: {'MET' if ratio >= 3 else 'NOT MET'}."
+    )
+
+
+def _first_root_mode(rows: list[Row], by: dict) -> str | None:
     firsts = [r for r in rows if r.method == "auto" + FIRST and (r.case, "auto") in by]
-    if firsts:
-        ray_cases = [r for r in firsts if "rays" in r.case]
-        speed = ", ".join(f"{r.case} {by[(r.case, 'auto')].median_ns / r.median_ns:.2f}x" for r in ray_cases)
-        first_bad = [(r.case, r.method) for r in solver_rows if r.method.endswith(FIRST) and _bad(r)]
-        # where a render spends its solver time: tori and the high-degree shapes
-        key = [r for r in ray_cases if r.case in ("torus rays (no exact grazing)", HIGH_RAYS)]
-        faster = all(r.median_ns < by[(r.case, "auto")].median_ns for r in key)
-        line = (
-            f"- First-root mode (ig_first_root, what the tracer calls; a report line, not an issue target): "
-            f"auto (first root) against auto (all roots), median speed-up: {speed}"
-        )
-        if ("torus rays (no exact grazing)", "closed_plain") in by:
-            case = "torus rays (no exact grazing)"
-            f, cp = by[(case, "auto" + FIRST)], by[(case, "closed_plain")]
-            line += (
-                f"; on {case} {f.median_ns:.0f} ns against {cp.median_ns:.0f} for closed_plain (all roots) "
-                f"= {f.median_ns / cp.median_ns:.2f}x"
-            )
+    if not firsts:
+        return None
+    ray_cases = [r for r in firsts if "rays" in r.case]
+    speed = ", ".join(f"{r.case} {by[(r.case, 'auto')].median_ns / r.median_ns:.2f}x" for r in ray_cases)
+    first_bad = [(r.case, r.method) for r in rows if r.method.endswith(FIRST) and _bad(r)]
+    # where a render spends its solver time: tori and the high-degree shapes
+    key = [r for r in ray_cases if r.case in ("torus rays (no exact grazing)", HIGH_RAYS)]
+    faster = all(r.median_ns < by[(r.case, "auto")].median_ns for r in key)
+    line = (
+        f"- First-root mode (ig_first_root, what the tracer calls; a report line, not an issue target): "
+        f"auto (first root) against auto (all roots), median speed-up: {speed}"
+    )
+    if ("torus rays (no exact grazing)", "closed_plain") in by:
+        case = "torus rays (no exact grazing)"
+        f, cp = by[(case, "auto" + FIRST)], by[(case, "closed_plain")]
         line += (
-            f"; missed/phantom first roots: {first_bad if first_bad else 'none'}. Faster than all roots on "
-            f"torus rays (no exact grazing) and {HIGH_RAYS}, with no missed/phantom first root on any set: "
-            f"{'MET' if faster and not first_bad else 'NOT MET'}."
+            f"; on {case} {f.median_ns:.0f} ns against {cp.median_ns:.0f} for closed_plain (all roots) "
+            f"= {f.median_ns / cp.median_ns:.2f}x"
         )
-        out.append(line)
-    return out
+    return line + (
+        f"; missed/phantom first roots: {first_bad if first_bad else 'none'}. Faster than all roots on "
+        f"torus rays (no exact grazing) and {HIGH_RAYS}, with no missed/phantom first root on any set: "
+        f"{'MET' if faster and not first_bad else 'NOT MET'}."
+    )
+
+
+def targets(rows: list[Row]) -> list[str]:
+    """The report's three targets (plus the error bound), then first-root mode, each evaluated on these rows."""
+    by = {(r.case, r.method): r for r in rows}
+    lines = [_no_missed_roots(rows), _error_bound(rows)]
+    lines += [_against_closed_form(by, c) for c in ("torus rays", "torus rays (no exact grazing)")]
+    lines += [_bracketing_against_sturm(by), _first_root_mode(rows, by)]
+    return [line for line in lines if line is not None]
 
 
 def table(rows: list[Row], sets: list[CaseSet], timed: int, nref: int, seconds: float) -> str:

@@ -134,6 +134,57 @@ class Rays:
     params: list
 
 
+def _aim_box(bs: BenchShape, own: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """The box the rays are aimed at: the shape's own where finite, else its CSG parent's, else [-1, 1]^3."""
+    aim = np.array([-1.0, -1.0, -1.0, 1.0, 1.0, 1.0])
+    if bs.outer is not None:
+        aim = np.asarray(bs.outer, dtype=float)
+    if own is not None:
+        aim = np.where(np.isfinite(own), own, aim)
+    return aim[:3], aim[3:]
+
+
+def _sample_rays(bs: BenchShape, prm: dict, rng: np.random.Generator, box, m: int, grazing: bool):
+    """m rays at random points of the box: (o, d, kind, t_tangent). kind 0 from far (1e4 units), 1 from near (3-6
+    box radii), 2 exactly tangent to the surface (with grazing and a tangent-point sampler), 3 from inside."""
+    lo_b, hi_b = box
+    radius = 0.5 * np.linalg.norm(hi_b - lo_b)
+    target = lo_b + rng.random((m, 3)) * (hi_b - lo_b)
+    u = _unit(rng.normal(size=(m, 3)))
+    kind = rng.integers(0, 4, size=m)
+    if not (grazing and bs.graze):
+        kind[kind == 2] = 1
+    dist = np.where(kind == 0, 1e4, radius * (3 + 3 * rng.random(m)))
+    o = target - dist[:, None] * u
+    inside = kind == 3
+    o[inside] = lo_b + rng.random((int(inside.sum()), 3)) * (hi_b - lo_b)
+    graze = kind == 2
+    k = int(graze.sum())
+    if k:
+        pts, nrm = bs.graze(prm, rng, k)
+        tang = _unit(np.cross(nrm, rng.normal(size=(k, 3))))
+        o[graze] = pts - (radius * (3 + 3 * rng.random(k)))[:, None] * tang
+        u[graze] = tang
+    scale = 0.5 + 1.5 * rng.random(m)
+    t_tan = np.full(m, np.nan)
+    if k:
+        t_tan[graze] = np.linalg.norm(pts - o[graze], axis=1) / scale[graze]
+    return o, u * scale[:, None], kind, t_tan
+
+
+def _clip_rays(bs: BenchShape, own: np.ndarray | None, o: np.ndarray, d: np.ndarray):
+    """(t0, t1, valid): the rays clipped to the shape's box (an unbounded shape: to its CSG parent's, or [0, inf))."""
+    m = len(o)
+    t0, t1 = np.zeros(m), np.full(m, np.inf)
+    valid = np.ones(m, dtype=bool)
+    if own is None and bs.outer is not None:
+        t0, t1, valid = raycast._clip(np.asarray(bs.outer, dtype=float), o, d, t0, t1)
+    if own is not None:
+        t0, t1, v2 = raycast._clip(own, o, d, t0, t1)
+        valid &= v2
+    return t0, t1, valid
+
+
 def ray_polys(
     name: str, count: int, rng: np.random.Generator, grazing: bool = True, shapes_dir: str | Path | None = None
 ) -> Rays:
@@ -150,61 +201,17 @@ def ray_polys(
         prm = {**defaults, **given}
         own = module.bounds(**prm)
         own = None if own is None else np.asarray(own, dtype=float)
-        aim = np.array([-1.0, -1.0, -1.0, 1.0, 1.0, 1.0])
-        if bs.outer is not None:
-            aim = np.asarray(bs.outer, dtype=float)
-        if own is not None:
-            aim = np.where(np.isfinite(own), own, aim)
-        lo_b, hi_b = aim[:3], aim[3:]
-        radius = 0.5 * np.linalg.norm(hi_b - lo_b)
-        m = per * 2
-        target = lo_b + rng.random((m, 3)) * (hi_b - lo_b)
-        u = _unit(rng.normal(size=(m, 3)))
-        kind = rng.integers(0, 4, size=m)
-        if not (grazing and bs.graze):
-            kind[kind == 2] = 1
-        dist = np.where(kind == 0, 1e4, radius * (3 + 3 * rng.random(m)))
-        o = target - dist[:, None] * u
-        inside = kind == 3
-        o[inside] = lo_b + rng.random((int(inside.sum()), 3)) * (hi_b - lo_b)
-        graze = kind == 2
-        k = int(graze.sum())
-        if k:
-            pts, nrm = bs.graze(prm, rng, k)
-            tang = _unit(np.cross(nrm, rng.normal(size=(k, 3))))
-            o[graze] = pts - (radius * (3 + 3 * rng.random(k)))[:, None] * tang
-            u[graze] = tang
-        scale = 0.5 + 1.5 * rng.random(m)
-        d = u * scale[:, None]
-        t_tan = np.full(m, np.nan)
-        if k:
-            t_tan[graze] = np.linalg.norm(pts - o[graze], axis=1) / scale[graze]
-        t0, t1 = np.zeros(m), np.full(m, np.inf)
-        valid = np.ones(m, dtype=bool)
-        if own is None and bs.outer is not None:
-            t0, t1, valid = raycast._clip(np.asarray(bs.outer, dtype=float), o, d, t0, t1)
-        if own is not None:
-            t0, t1, v2 = raycast._clip(own, o, d, t0, t1)
-            valid &= v2
+        o, d, kind, t_tan = _sample_rays(bs, prm, rng, _aim_box(bs, own), per * 2, grazing)
+        t0, t1, valid = _clip_rays(bs, own, o, d)
         keep = np.nonzero(valid)[0][:per]
         o, d, t0, t1, kind, t_tan = o[keep], d[keep], t0[keep], t1[keep], kind[keep], t_tan[keep]
         ts = raycast._shift_point(own, o, d, t0, t1)
         c = np.asarray(module.coeffs(o + ts[:, None] * d, d, **prm), dtype=float).reshape(len(keep), -1)
         parts.append(Rays(c, t0 - ts, t1 - ts, kind, o, d, ts, t_tan, [given] * len(keep)))
-    cat = lambda f: np.concatenate([getattr(p, f) for p in parts])  # noqa: E731
     perm = rng.permutation(sum(len(p.lo) for p in parts))[:count]
     params = [q for p in parts for q in p.params]
-    return Rays(
-        cat("c")[perm],
-        cat("lo")[perm],
-        cat("hi")[perm],
-        cat("kind")[perm],
-        cat("o")[perm],
-        cat("d")[perm],
-        cat("ts")[perm],
-        cat("t_tangent")[perm],
-        [params[i] for i in perm],
-    )
+    fields = ("c", "lo", "hi", "kind", "o", "d", "ts", "t_tangent")
+    return Rays(*(np.concatenate([getattr(p, f) for p in parts])[perm] for f in fields), [params[i] for i in perm])
 
 
 def _pad(c: np.ndarray, n: int) -> np.ndarray:
