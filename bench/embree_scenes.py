@@ -129,7 +129,7 @@ def exact_judge(scene: Scene) -> ExactJudge:
     """The exact judge (implgen.roots.exactray.ExactJudge) of the scene's objects, in order, the ground square
     last: each object's f(o + t d) over Q, the float ray and the double matrix taken exactly, clipped to its
     padded box exactly, roots located by Descartes and bisection."""
-    from implgen.codegen.spec import load_spec
+    from implgen.spec.entry import load_spec
 
     objects = []
     for o in scene.objects:

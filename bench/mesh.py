@@ -28,12 +28,12 @@ from skimage.measure import marching_cubes
 from implgen.bench.machine import describe as machine
 from implgen.bench.machine import load_average, write_results
 from implgen.codegen.emit import generate
-from implgen.codegen.speccache import load_spec
 from implgen.mesh.contour import contour
 from implgen.mesh.crossings import boundary_value_gradient
 from implgen.mesh.pipeline import closed_and_euler
 from implgen.mesh.region import make_grid, parse_clip
 from implgen.mesh.shapelib import ShapeLib
+from implgen.spec.entry import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 GRIDS = (4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128)
@@ -98,7 +98,7 @@ def timed(fn, *args):
 
 
 def run_surface(label, path, clip_text, euler, runs, cells, folder):
-    spec = load_spec(ROOT / path)
+    spec = load_spec(ROOT / path, cache=True)
     lib = ShapeLib(spec, list(spec.params.values()))
     module = python_module(spec, folder)
     user = parse_clip(clip_text) if clip_text else []

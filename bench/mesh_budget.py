@@ -30,13 +30,13 @@ import numpy as np
 
 from implgen.bench.machine import describe as machine
 from implgen.bench.machine import load_average, write_results
-from implgen.codegen.speccache import load_spec
 from implgen.mesh import budget
 from implgen.mesh.budget import OverBudget
 from implgen.mesh.pipeline import mesh_spec
 from implgen.mesh.region import make_grid, parse_clip
 from implgen.mesh.singular import find_singular
 from implgen.mesh.write import mesh_bytes, vertex_normals
+from implgen.spec.entry import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 SURFACES = (
@@ -98,7 +98,7 @@ def main(argv: list[str]) -> int:
     args = ap.parse_args(argv)
     rows, runs, ratios = [], [], []
     for label, path, clip in SURFACES:
-        spec = load_spec(ROOT / path)
+        spec = load_spec(ROOT / path, cache=True)
         clips = parse_clip(clip) if clip else []
         measure(spec, clips, 8)  # the library built, trimesh imported, the caches filled: not measured
         for cells in args.cells:
@@ -126,11 +126,13 @@ def main(argv: list[str]) -> int:
     sing_rows = []
     for label, path, clip in SURFACES:
         if label in SINGULAR_SURFACES:
-            seconds, mb, count, complete = singular_cost(load_spec(ROOT / path), parse_clip(clip) if clip else [])
+            seconds, mb, count, complete = singular_cost(
+                load_spec(ROOT / path, cache=True), parse_clip(clip) if clip else []
+            )
             row = f"| {label} | {seconds:.1f} | {mb:.0f} | {count} | {'yes' if complete else 'no'} |"
             print(row, flush=True)
             sing_rows.append(row)
-    spec = load_spec(ROOT / OVERRUN_SPEC)
+    spec = load_spec(ROOT / OVERRUN_SPEC, cache=True)
     late = []
     for seconds in OVERRUN_BUDGETS:
         after, phase = overrun(spec, seconds)

@@ -25,11 +25,11 @@ import numpy as np
 
 from implgen.bench.machine import describe as machine
 from implgen.bench.machine import write_results
-from implgen.codegen.speccache import load_spec
 from implgen.mesh.contour import contour
 from implgen.mesh.crossings import grid_flags, inside_flags, line_points
 from implgen.mesh.pipeline import closed_and_euler
 from implgen.mesh.region import make_grid
+from implgen.spec.entry import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 # (label, spec, known Euler characteristic, grids: the sign-based method's smallest right one and below)
@@ -170,7 +170,7 @@ def main() -> int:
         "|---|---|---|---|---|---|",
     ]
     for label, path, known, grids in CASES:
-        spec = load_spec(ROOT / path)
+        spec = load_spec(ROOT / path, cache=True)
         lib = ShapeLib(spec, list(spec.params.values()))
         for n in grids:
             grid, clips = make_grid(spec.box(), [], n, path)

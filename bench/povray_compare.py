@@ -218,8 +218,8 @@ def build_degree_cost(n: int, rt: Path, tmp: Path):
     from implgen.bench.gen import dense_equation
     from implgen.codegen.derive import derive
     from implgen.codegen.emit import generate
-    from implgen.codegen.spec import parse_spec
     from implgen.compile import clib as cbuild
+    from implgen.spec.entry import parse_spec
 
     k = n // 2
     name = f"dense{n}"

@@ -1,4 +1,4 @@
-"""Render every gallery surface (implgen.codegen.gallery) small into docs/gallery/surfaces/, and a contact sheet.
+"""Render every gallery surface (implgen.spec.gallery) small into docs/gallery/surfaces/, and a contact sheet.
 
     .venv/bin/python bench/surfaces.py [-o DIR] [--size 240x180] [--spp 4] [--threads N]
 
@@ -19,10 +19,10 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from implgen.bench.machine import describe as machine
-from implgen.codegen import gallery
 from implgen.imagefile import to_uint8, write_png
 from implgen.scene.preview import preview_scene
 from implgen.scene.render import render
+from implgen.spec import gallery
 
 COLUMNS = 6
 LABEL = 18  # pixels under each picture for its title

@@ -41,7 +41,7 @@ from websockets.sync.client import connect
 
 from implgen.bench.machine import describe as machine
 from implgen.bench.machine import write_results
-from implgen.codegen.spec import load_spec
+from implgen.spec.entry import load_spec
 from implgen.view.dump import spec_mapping
 from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_ONE, MAX_RENDERS_PER_SECOND
 

@@ -10,11 +10,11 @@ import numpy as np
 
 from conftest import RUNTIME, compile_c, run_c
 from implgen import abi, resources
-from implgen.codegen.spec import MAX_DEGREE
 from implgen.roots.solvers import METHODS
 from implgen.scene.load import MAX_CSG_DEPTH, MAX_DEPTH, MAX_SPP
 from implgen.scene.model import Material
 from implgen.scene.tracer import OPS, RtHit
+from implgen.spec.parse import MAX_DEGREE
 
 
 def _probe(tmp_path, body: list[str]) -> dict[str, int]:

@@ -21,12 +21,13 @@ from hypothesis import strategies as st
 from conftest import RUNTIME, SHAPE_FILES, compile_c, load_python_shape
 from implgen.codegen import escape
 from implgen.codegen.emit import generate
-from implgen.codegen.grammar import format_expression, parse_expression
-from implgen.codegen.names import reserved_shape_name
-from implgen.codegen.spec import VARIABLES, exact_polynomial, load_spec, param_symbol, parse_spec
 from implgen.compile.clib import WARNING_FLAGS, compiler
 from implgen.errors import UserError
 from implgen.outputs import write_text_files
+from implgen.spec.entry import load_spec, parse_spec
+from implgen.spec.grammar import format_expression, parse_expression
+from implgen.spec.names import reserved_shape_name
+from implgen.spec.parse import VARIABLES, exact_polynomial, param_symbol
 
 ROOT = Path(__file__).resolve().parent.parent
 NASTY = [

@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from implgen.codegen.spec import load_spec, param_symbol, parse_spec
 from implgen.roots.exactray import ExactJudge, Placed
+from implgen.spec.entry import load_spec, parse_spec
+from implgen.spec.parse import param_symbol
 
 ROOT = Path(__file__).resolve().parent.parent
 EPS = 2.0**-30

@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 
 from conftest import SHAPE_FILES, load_python_shape
-from implgen.codegen.spec import load_spec
 from implgen.errors import UserError
 from implgen.roots.cases import CASE_SETS, hard_set
 from implgen.roots.reference import Score, reference, score_one
 from implgen.roots.solvers import METHODS, first_root, first_root_batch, real_roots, real_roots_batch
+from implgen.spec.entry import load_spec
 
 SET_NAMES = [cs.name for cs in CASE_SETS]
 N_LIST = 2000  # polynomials per set compared with real_roots

@@ -43,9 +43,10 @@ from fuzz_strategies import (
 )
 from implgen.animation.frames import load_frames
 from implgen.cli import main
-from implgen.codegen.grammar import ParseError, format_expression, parse_expression, split_equation
-from implgen.codegen.spec import VARIABLES, exact_polynomial, load_spec, param_symbol
 from implgen.errors import UserError
+from implgen.spec.entry import load_spec
+from implgen.spec.grammar import ParseError, format_expression, parse_expression, split_equation
+from implgen.spec.parse import VARIABLES, exact_polynomial, param_symbol
 
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS = Path(__file__).resolve().parent / "fuzz_corpus"

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from implgen.codegen.gallery import entry
-from implgen.codegen.spec import X, Y, Z
+from implgen.spec.gallery import entry
+from implgen.spec.parse import X, Y, Z
 from surface_nodes import real_nodes
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import CDIR, GENERATED, SHAPE_NAMES, CShapes, compile_c, run_c, runtime_solver_sources
-from implgen.codegen.spec import load_spec
+from implgen.spec.entry import load_spec
 
 
 @pytest.fixture(scope="module")

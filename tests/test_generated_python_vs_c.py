@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from conftest import SHAPE_NAMES, CShapes, load_python_shape, random_rays
-from implgen.codegen.spec import load_spec
 from implgen.roots import raycast
 from implgen.roots.cases import find_shapes_dir
+from implgen.spec.entry import load_spec
 
 
 @pytest.fixture(scope="module")

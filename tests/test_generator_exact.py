@@ -11,7 +11,8 @@ import sympy
 
 from conftest import GENERATED, SHAPE_FILES, SHAPE_NAMES, CShapes, load_python_shape, random_rays
 from implgen.codegen.emit import generate
-from implgen.codegen.spec import X, Y, Z, load_spec, param_symbol
+from implgen.spec.entry import load_spec
+from implgen.spec.parse import X, Y, Z, param_symbol
 
 EXACT_RAYS = 12
 

@@ -10,8 +10,9 @@ import sympy
 
 from conftest import CShapes, load_python_shape
 from implgen.codegen.emit import generate
-from implgen.codegen.spec import X, Y, Z, param_symbol, parse_spec
 from implgen.outputs import write_text_files
+from implgen.spec.entry import parse_spec
+from implgen.spec.parse import X, Y, Z, param_symbol
 
 NASTY = [
     "c",

@@ -18,8 +18,8 @@ import pytest
 from conftest import SHAPES_DIR
 from implgen.bench import glslcases, glslcheck
 from implgen.codegen.glslprogram import program
-from implgen.codegen.spec import load_spec, parse_spec
 from implgen.roots import exactray
+from implgen.spec.entry import load_spec, parse_spec
 
 pytestmark = pytest.mark.needs_program("chromium", "chromedriver")
 SIZE = (96, 72)

@@ -11,7 +11,8 @@ from conftest import SHAPES_DIR
 from implgen.bench.glslcases import chmutov
 from implgen.codegen import chebform
 from implgen.codegen.emit import generate
-from implgen.codegen.spec import X, Y, Z, load_spec, parse_spec
+from implgen.spec.entry import load_spec, parse_spec
+from implgen.spec.parse import X, Y, Z
 
 
 def _rebuilt(form: chebform.ChebForm) -> sympy.Expr:

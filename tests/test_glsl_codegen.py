@@ -16,8 +16,8 @@ from conftest import SHAPES_DIR
 from implgen.codegen import escape, glsl
 from implgen.codegen.command import main as generate_command
 from implgen.codegen.emit import generate
-from implgen.codegen.spec import load_spec, parse_spec
 from implgen.errors import UserError
+from implgen.spec.entry import load_spec, parse_spec
 
 
 def test_lang_glsl_writes_the_shader_alone(tmp_path):

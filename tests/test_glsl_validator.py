@@ -14,7 +14,7 @@ from conftest import GENERATED, SHAPE_NAMES
 from implgen.bench.glslcases import chmutov
 from implgen.codegen.emit import generate
 from implgen.codegen.glslprogram import program
-from implgen.codegen.spec import parse_spec
+from implgen.spec.entry import parse_spec
 
 pytestmark = pytest.mark.needs_program("glslangValidator")
 

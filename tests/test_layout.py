@@ -19,19 +19,20 @@ MAX_LINES = 400
 # named here (errors, validate, yamlfile, outputs, abi, resources, cachedir, ...) are the ground floor.
 FLOORS = {
     "ground": 0,
-    "codegen": 1,
-    "compile": 2,
-    "roots": 3,
-    "raycast": 3,  # the path generated Python imports: an alias of roots.raycast
-    "scene": 4,
-    "animation": 5,
-    "view": 6,
-    "export": 6,
-    "share": 6,
-    "mesh": 6,
-    "bench": 6,
-    "demo": 6,
-    "cli": 7,
+    "spec": 1,
+    "codegen": 2,
+    "compile": 3,
+    "roots": 4,
+    "raycast": 4,  # the path generated Python imports: an alias of roots.raycast
+    "scene": 5,
+    "animation": 6,
+    "view": 7,
+    "export": 7,
+    "share": 7,
+    "mesh": 7,
+    "bench": 7,
+    "demo": 7,
+    "cli": 8,
 }
 
 

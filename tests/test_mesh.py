@@ -18,9 +18,9 @@ import pytest
 import sympy
 import trimesh
 
-from implgen.codegen.speccache import load_spec, parse_spec
 from implgen.mesh.pipeline import closed_and_euler, mesh_spec, signed_volume, singular_in_solid
 from implgen.mesh.region import make_grid, parse_clip
+from implgen.spec.entry import load_spec, parse_spec
 
 ROOT = Path(__file__).resolve().parent.parent
 EX = ROOT / "examples"
@@ -44,7 +44,7 @@ CASES = {
 @cache
 def meshed(name: str):
     path, cells, clip, _ = CASES[name]
-    spec = load_spec(EX / path)
+    spec = load_spec(EX / path, cache=True)
     return spec, mesh_spec(spec, {}, cells, parse_clip(clip) if clip else [], singular=False)
 
 
@@ -140,7 +140,7 @@ def test_grazing_grid_line():
     none, the radius being the tangent one only to rounding), never two, and the mesh stays a closed sphere."""
     data = {"name": "ball", "equation": "x^2 + y^2 + z^2 - r^2", "params": {"r": 1.0}}
     data["bounds"] = {a: [-1.3, 1.3] for a in "xyz"}
-    spec = parse_spec(data, "<test>")
+    spec = parse_spec(data, "<test>", cache=True)
     grid, _ = make_grid(spec.box(), [], 16, "<test>")
     ys, zs = grid.coords(1), grid.coords(2)
     j, k = int(np.argmin(np.abs(ys - 0.5))), int(np.argmin(np.abs(zs - 0.6)))
@@ -177,7 +177,7 @@ def test_singular_points_against_the_literature(path, box, count, f_tol):
     (|p| < 3). Barth's sextic: 65 nodes in projective space, 15 of them at infinity, so 50 affine ones, all
     within |p| < 1.8. (Its spec gives phi as a double, so its nodes are nodes only to that double's rounding:
     |f| ~ 1e-15 at the critical points.)"""
-    spec = load_spec(EX / path)
+    spec = load_spec(EX / path, cache=True)
     result = mesh_spec(spec, {}, 8, parse_clip(f"box:{box}"), singular=True)
     pts = result.singular.points
     assert result.singular.complete and len(pts) == count
@@ -193,7 +193,7 @@ def test_singular_points_against_the_literature(path, box, count, f_tol):
 def test_mesh_passes_through_the_nodes():
     """With the singular search on, the vertices of each node's cell sit on the node: Cayley's cubic in a ball
     of 2 has a vertex at each of its 4 nodes, and stays a closed manifold."""
-    spec = load_spec(EX / "mesh/cayley.yaml")
+    spec = load_spec(EX / "mesh/cayley.yaml", cache=True)
     result = mesh_spec(spec, {}, 24, parse_clip("sphere:2"), singular=True)
     v, f = result.mesh.vertices, result.mesh.faces
     for node in result.singular.points:
@@ -209,7 +209,7 @@ def test_the_piriform_cusp():
     """The piriform's cusp at the origin (f = x^4 - x^3 + y^2 + z^2: f_x = x^2 (4x - 3) touches zero without
     changing sign) is found and the mesh is a closed sphere; at 48 cells the mesh passes through the cusp (at 32
     the cusp's cell holds no vertex to move onto it)."""
-    spec = load_spec(EX / "shapes/piriform.yaml")
+    spec = load_spec(EX / "shapes/piriform.yaml", cache=True)
     for cells in (32, 48):
         result = mesh_spec(spec, {}, cells, [], singular=True)
         pts = result.singular.points

@@ -13,13 +13,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from implgen.codegen.speccache import load_spec
 from implgen.errors import UserError
 from implgen.mesh import budget, pipeline, shapelib
 from implgen.mesh.budget import OverBudget, Stopped
 from implgen.mesh.pipeline import mesh_spec
 from implgen.mesh.region import parse_clip
 from implgen.mesh.write import mesh_bytes, vertex_normals
+from implgen.spec.entry import load_spec
 from implgen_proc import implgen
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -33,7 +33,7 @@ LATE = 6.0
 
 @pytest.fixture(scope="module")
 def heavy():
-    spec = load_spec(HEAVY)
+    spec = load_spec(HEAVY, cache=True)
     mesh_spec(spec, {}, 4, [], singular=False)  # its library built and cached: the budget is the mesh's own
     return spec
 
@@ -54,7 +54,7 @@ def test_a_tiny_budget_stops_a_heavy_mesh_soon_after_its_deadline(heavy) -> None
 def test_a_past_deadline_stops_before_the_shape_is_built(monkeypatch) -> None:
     monkeypatch.setattr(pipeline, "ShapeLib", lambda *a: pytest.fail("built after the deadline"))
     with pytest.raises(OverBudget, match="building the shape"):
-        mesh_spec(load_spec(TORUS), {}, 16, [], deadline=time.monotonic() - 1)
+        mesh_spec(load_spec(TORUS, cache=True), {}, 16, [], deadline=time.monotonic() - 1)
 
 
 def test_the_message_names_the_budget_given_not_what_is_left_of_it(monkeypatch) -> None:
@@ -73,23 +73,23 @@ def test_the_message_names_the_budget_given_not_what_is_left_of_it(monkeypatch) 
     with pytest.raises(OverBudget, match="of 0.05 s at 192 cells"):
         late.check()
     with pytest.raises(OverBudget, match="of 0.05 s at 16 cells"):  # mesh_spec passes it on
-        mesh_spec(load_spec(TORUS), {}, 16, [], deadline=now[0] - 1, seconds=0.05)
+        mesh_spec(load_spec(TORUS, cache=True), {}, 16, [], deadline=now[0] - 1, seconds=0.05)
 
 
 def test_bad_cells_name_the_option_given() -> None:
     for name in ("--cells", "cells"):
         with pytest.raises(UserError) as info:
-            mesh_spec(load_spec(TORUS), {}, 3, [], cells_name=name)
+            mesh_spec(load_spec(TORUS, cache=True), {}, 3, [], cells_name=name)
         assert info.value.source == name
     with pytest.raises(UserError) as info:
-        mesh_spec(load_spec(TORUS), {}, 3, [])
+        mesh_spec(load_spec(TORUS, cache=True), {}, 3, [])
     assert info.value.source == "--cells"
 
 
 def test_a_generous_budget_gives_the_same_mesh_slice_by_slice(monkeypatch) -> None:
     """With a budget every batch call runs in slices; made tiny here (a few rays, points or grid slabs each) so
     that every call is cut many times, the mesh is the same to the last bit, singular points included."""
-    spec = load_spec(ROOT / "examples/mesh/cayley.yaml")
+    spec = load_spec(ROOT / "examples/mesh/cayley.yaml", cache=True)
     clips = parse_clip("sphere:2")
     free = mesh_spec(spec, {}, 24, clips)
     calls = []
@@ -124,7 +124,7 @@ def test_a_stop_from_another_thread_ends_the_mesh(heavy) -> None:
 def test_cells_are_checked_before_any_work(monkeypatch, cells) -> None:
     monkeypatch.setattr(pipeline, "ShapeLib", lambda *a: pytest.fail("built before the cells were checked"))
     with pytest.raises(UserError, match=r"expected a whole number of cells in \[4, 256\]"):
-        mesh_spec(load_spec(TORUS), {}, cells, [])
+        mesh_spec(load_spec(TORUS, cache=True), {}, cells, [])
     with pytest.raises(UserError, match="cells"):
         budget.estimate_bytes([-1, -1, -1, 1, 1, 1], 4, [], cells, "test")
 
@@ -140,7 +140,7 @@ MEMORY_CASES = [
 def test_the_memory_estimate_is_above_the_peak(path, clip, cells) -> None:
     """What Save mesh does (the pipeline, the normals, the STL's bytes), traced by tracemalloc, against the estimate
     made before any work; the estimate grows as cells^2 to cells^3."""
-    spec = load_spec(path)
+    spec = load_spec(path, cache=True)
     clips = parse_clip(clip) if clip else []
 
     def run(n: int) -> int:

@@ -8,8 +8,9 @@ import pytest
 import sympy
 
 from conftest import SHAPE_FILES, SHAPE_NAMES
-from implgen.codegen.spec import X, Y, Z, load_spec, param_symbol
 from implgen.export.povray import polynomial_object, polynomial_terms
+from implgen.spec.entry import load_spec
+from implgen.spec.parse import X, Y, Z, param_symbol
 
 
 @pytest.mark.parametrize("path", SHAPE_FILES, ids=SHAPE_NAMES)

@@ -11,7 +11,6 @@ import pytest
 
 from conftest import SHAPES_DIR
 from implgen.bench.solvers import FIRST, FIRST_METHODS, HIGH_METHODS, METHODS, main
-from implgen.codegen import gallery
 from implgen.roots.cases import (
     BENCH_SHAPES,
     CASE_SETS,
@@ -33,6 +32,7 @@ from implgen.roots.solvers import (
     first_root_batch,
     real_roots_batch,
 )
+from implgen.spec import gallery
 
 RAY_SETS = [cs.name for cs in CASE_SETS if "rays" in cs.name]
 HIGH_SETS = [cs.name for cs in HIGH_CASE_SETS]

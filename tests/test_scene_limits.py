@@ -362,7 +362,7 @@ def test_union_operands_count_as_objects():
 def test_python_syntax_warnings_are_syntax_errors_and_print_nothing(text, recwarn):
     """Python warns about `1and` (a number run into a keyword); the warning is the syntax error it is, one
     message, and nothing else is printed or warned."""
-    from implgen.codegen.spec import parse_spec
+    from implgen.spec.entry import parse_spec
 
     with pytest.raises(UserError, match="equation: syntax error|not a polynomial"):
         parse_spec({"name": "s", "equation": text}, "<t>")
@@ -376,7 +376,7 @@ def test_param_values_that_overflow_a_coefficient_are_refused():
     """Each param is within range, but a^40 with a = 1e9 is 1e360: refused with the key named. The test is on
     the exact terms (log2 |c| + sum e log2 |p|), so a = 1e9 to the 30th power (2^897) passes, and a zero param
     makes its terms vanish."""
-    from implgen.codegen.spec import parse_spec
+    from implgen.spec.entry import parse_spec
 
     spec = parse_spec({"name": "p", "equation": "x^2 + y^2 + z^2 - a^30 - b^40", "params": {"a": 1, "b": 1}}, "<t>")
     spec.check_values({"a": 1e9, "b": 0.0}, "<t>", "objects[0].params")
@@ -387,7 +387,7 @@ def test_param_values_that_overflow_a_coefficient_are_refused():
 
 
 def test_param_values_must_keep_the_bounds_a_box():
-    from implgen.codegen.spec import load_spec
+    from implgen.spec.entry import load_spec
 
     torus = load_spec(ROOT / "examples" / "shapes" / "torus_y.yaml")
     torus.check_values({"a": 2.0, "b": 0.5}, "<t>", "k")

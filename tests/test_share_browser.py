@@ -26,7 +26,7 @@ from conftest import SHAPES_DIR
 from implgen.cli import main
 from implgen.codegen.emit import generate
 from implgen.codegen.glslprogram import program
-from implgen.codegen.spec import load_spec, parse_spec
+from implgen.spec.entry import load_spec, parse_spec
 
 pytestmark = pytest.mark.needs_program("chromium", "chromedriver")
 SIZE = (160, 120)

@@ -21,8 +21,8 @@ from conftest import ROOT, SHAPES_DIR
 from implgen.cli import main
 from implgen.codegen.emit import generate
 from implgen.codegen.glslprogram import HEADERS, runtime_text
-from implgen.codegen.spec import load_spec
 from implgen.share.page import script_json
+from implgen.spec.entry import load_spec
 
 SCENES_DIR = ROOT / "examples" / "scenes"
 HOSTILE = (

@@ -1,4 +1,4 @@
-"""The parsed-spec cache (codegen/speccache.py): a cached scene loads and renders without SymPy, gives the same
+"""The parsed-spec cache (spec/cache.py): a cached scene loads and renders without SymPy, gives the same
 values and pictures as a full parse, refuses bad specs exactly as before, and survives any damaged entry."""
 
 from __future__ import annotations
@@ -12,13 +12,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from implgen.codegen import speccache
-from implgen.codegen.spec import load_spec
-from implgen.codegen.spec import parse_spec as parse_full
 from implgen.errors import UserError
 from implgen.scene import build
 from implgen.scene.load import parse_scene
 from implgen.scene.render import render
+from implgen.spec import cache as speccache
+from implgen.spec.entry import load_spec
+from implgen.spec.entry import parse_spec as parse_full
 
 ROOT = Path(__file__).resolve().parent.parent
 SHAPES = ROOT / "examples" / "shapes"
@@ -53,11 +53,11 @@ def entries(cache: Path) -> list[Path]:
 
 def test_second_load_is_cached_and_equal_to_a_full_parse(cache: Path) -> None:
     first = parse_scene(scene_with([TORUS, INLINE]), "s.yaml")
-    assert all(not leaf.spec.from_cache for leaf in first.leaves())
+    assert all(not leaf.spec.symbolic_part.deferred for leaf in first.leaves())
     assert len(entries(cache)) == 2
     second = parse_scene(scene_with([TORUS, INLINE]), "s.yaml")
     for a, b in zip(first.leaves(), second.leaves()):
-        assert b.spec.from_cache
+        assert b.spec.symbolic_part.deferred
         full = a.spec
         assert (b.spec.name, b.spec.equation, b.spec.degree, b.spec.description) == (
             full.name,
@@ -82,9 +82,9 @@ def test_second_load_is_cached_and_equal_to_a_full_parse(cache: Path) -> None:
 
 def test_a_spec_file_and_the_same_content_share_one_entry(cache: Path) -> None:
     path = SHAPES / "heart.yaml"
-    speccache.load_spec(path)
-    cached = speccache.load_spec(path)
-    assert cached.from_cache and cached.source == str(path)
+    load_spec(path, cache=True)
+    cached = load_spec(path, cache=True)
+    assert cached.symbolic_part.deferred and cached.source == str(path)
     full = load_spec(path)
     assert cached.spec_key == full.spec_key and cached.equation == full.equation
 
@@ -92,20 +92,20 @@ def test_a_spec_file_and_the_same_content_share_one_entry(cache: Path) -> None:
 def test_content_types_are_part_of_the_key(cache: Path) -> None:
     base = {"name": "ball", "equation": "x^2 + y^2 + z^2 - r^2"}
     for value in (1, 1.0, "1"):
-        speccache.parse_spec({**base, "params": {"r": value}}, "<a>")
+        speccache.parse_cached({**base, "params": {"r": value}}, "<a>")
     assert len(entries(cache)) == 3
     for value in (1, 1.0, "1"):
-        got = speccache.parse_spec({**base, "params": {"r": value}}, "<a>")
+        got = speccache.parse_cached({**base, "params": {"r": value}}, "<a>")
         want = parse_full({**base, "params": {"r": value}}, "<a>")
-        assert got.from_cache
+        assert got.symbolic_part.deferred
         assert got.params == want.params and type(got.params["r"]) is type(want.params["r"])
 
 
 def test_a_new_implgen_misses(cache: Path, monkeypatch) -> None:
-    speccache.parse_spec({"name": "plane", "equation": "y"}, "<a>")
-    assert speccache.parse_spec({"name": "plane", "equation": "y"}, "<a>").from_cache
+    speccache.parse_cached({"name": "plane", "equation": "y"}, "<a>")
+    assert speccache.parse_cached({"name": "plane", "equation": "y"}, "<a>").symbolic_part.deferred
     monkeypatch.setattr(speccache, "implgen_fingerprint", lambda: "another implgen")
-    assert not speccache.parse_spec({"name": "plane", "equation": "y"}, "<a>").from_cache
+    assert not speccache.parse_cached({"name": "plane", "equation": "y"}, "<a>").symbolic_part.deferred
 
 
 BAD_SPECS = [
@@ -127,7 +127,7 @@ def test_bad_specs_are_refused_as_before_and_never_cached(cache: Path, bad: dict
         parse_full(bad, "<x>")
     for _ in range(2):
         with pytest.raises(UserError) as got:
-            speccache.parse_spec(bad, "<x>")
+            speccache.parse_cached(bad, "<x>")
         assert str(got.value) == str(want.value)
     assert entries(cache) == []
 
@@ -214,13 +214,13 @@ def test_a_damaged_entry_is_a_miss_and_the_picture_is_unchanged(cache: Path, how
     data = scene_with([TORUS])
     reference = render(parse_scene(data, "s.yaml"))  # full parse; writes the entry
     (entry,) = entries(cache)
-    assert parse_scene(data, "s.yaml").leaves()[0].spec.from_cache
+    assert parse_scene(data, "s.yaml").leaves()[0].spec.symbolic_part.deferred
     _damage(entry, how)
     again = parse_scene(data, "s.yaml")
-    assert not again.leaves()[0].spec.from_cache  # not trusted: parsed in full
+    assert not again.leaves()[0].spec.symbolic_part.deferred  # not trusted: parsed in full
     assert np.array_equal(render(again), reference)
     if how != "folder":  # written again (a fifo is replaced), and good
-        assert parse_scene(data, "s.yaml").leaves()[0].spec.from_cache
+        assert parse_scene(data, "s.yaml").leaves()[0].spec.symbolic_part.deferred
 
 
 def test_a_read_only_cache_still_loads(cache: Path) -> None:
@@ -230,7 +230,7 @@ def test_a_read_only_cache_still_loads(cache: Path) -> None:
         if os.access(cache / "spec", os.W_OK):  # root ignores the mode
             pytest.skip("cannot make a read-only folder as this user")
         for _ in range(2):
-            assert not speccache.parse_spec({"name": "plane", "equation": "y"}, "<a>").from_cache
+            assert not speccache.parse_cached({"name": "plane", "equation": "y"}, "<a>").symbolic_part.deferred
     finally:
         (cache / "spec").chmod(0o700)
 
@@ -282,9 +282,9 @@ POWER = {
     ],
 )
 def test_a_cached_spec_checks_overrides_as_the_full_spec_does(cache: Path, values: dict) -> None:
-    full = speccache.parse_spec(POWER, "p.yaml")
-    cached = speccache.parse_spec(POWER, "p.yaml")
-    assert not full.from_cache and cached.from_cache
+    full = speccache.parse_cached(POWER, "p.yaml")
+    cached = speccache.parse_cached(POWER, "p.yaml")
+    assert not full.symbolic_part.deferred and cached.symbolic_part.deferred
 
     def outcome(spec):
         try:

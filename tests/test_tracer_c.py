@@ -57,7 +57,7 @@ def test_a_band_of_rows_is_exactly_those_rows_of_the_image(tmp_path: Path) -> No
 
 def shape_table(path: Path, names: list[str]) -> Path:
     """A glue file listing the example shapes with their default params (from the specs)."""
-    from implgen.codegen.spec import load_spec
+    from implgen.spec.entry import load_spec
 
     lines = ['#include "shape.h"']
     lines += [f'#include "{n}.h"' for n in names]

@@ -16,13 +16,13 @@ from starlette.testclient import TestClient
 
 from conftest import ROOT
 from implgen.cli import main as cli_main
-from implgen.codegen.spec import parse_spec
 from implgen.errors import UserError
 from implgen.imagefile import to_uint8
 from implgen.scene import build
 from implgen.scene.load import parse_scene
 from implgen.scene.render import render
 from implgen.scene.tracer import CScene
+from implgen.spec.entry import parse_spec
 from implgen.view import frames as view_frames
 from implgen.view import session as session_mod
 from implgen.view.command import document_factory
@@ -604,7 +604,7 @@ def test_export_page_of_a_gallery_shape_keeps_its_slider_range(client) -> None:
 
 
 def test_the_gallery_list_is_served_as_plain_json(client) -> None:
-    from implgen.codegen import gallery
+    from implgen.spec import gallery
 
     listing = client.get("/gallery.json").json()
     assert [g["name"] for g in listing] == [e.name for e in gallery.entries()] and len(listing) >= 20

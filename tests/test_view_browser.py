@@ -20,9 +20,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from implgen.codegen.spec import parse_spec
 from implgen.imagefile import to_uint8
 from implgen.scene.render import render
+from implgen.spec.entry import parse_spec
 from implgen.view import protocol
 from implgen.view.command import bind, document_factory, serve
 

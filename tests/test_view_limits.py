@@ -274,7 +274,7 @@ def test_parses_are_cached_by_text_and_params(monkeypatch) -> None:
     """Two pages sending the same equation parse it once (an LRU over the text, the params and the bounds)."""
     import asyncio
 
-    from implgen.codegen.spec import parse_spec
+    from implgen.spec.entry import parse_spec
     from implgen.view import protocol
     from implgen.view.document import STARTER, Document
     from implgen.view.session import Session

@@ -24,9 +24,9 @@ import yaml
 from starlette.testclient import TestClient
 
 from conftest import ROOT
-from implgen.codegen.speccache import load_spec
 from implgen.mesh.budget import Stopped
 from implgen.mesh.pipeline import mesh_spec
+from implgen.spec.entry import load_spec
 from implgen.view import meshsave
 from implgen.view.command import document_factory
 from implgen.view.server import create_app
@@ -89,7 +89,7 @@ def mesh_processes() -> list[int]:
 
 @pytest.fixture(scope="module")
 def heavy_built():
-    mesh_spec(load_spec(HEAVY), {}, 4, [], singular=False)  # built and cached: a budget is the mesh's own
+    mesh_spec(load_spec(HEAVY, cache=True), {}, 4, [], singular=False)  # built and cached: a budget is the mesh's own
 
 
 def test_the_starter_torus_as_a_closed_stl_with_its_volume() -> None:

@@ -24,10 +24,10 @@ from starlette.testclient import TestClient
 from websockets.sync.client import connect
 
 from conftest import ROOT
-from implgen.codegen.speccache import load_spec
 from implgen.mesh.budget import Stopped
 from implgen.mesh.job import MeshJob
 from implgen.mesh.pipeline import mesh_spec
+from implgen.spec.entry import load_spec
 from implgen.view import meshsave
 from implgen.view.command import document_factory
 from implgen.view.server import create_app
@@ -41,7 +41,7 @@ GUARD = 60  # seconds: a hang guard, not a timing
 
 @pytest.fixture(scope="module")
 def heavy_built():
-    mesh_spec(load_spec(HEAVY), {}, 4, [], singular=False)  # built and cached for the server's children too
+    mesh_spec(load_spec(HEAVY, cache=True), {}, 4, [], singular=False)  # built and cached for the server's children too
 
 
 def _start_mesh(ws, srv: subprocess.Popen) -> int:
@@ -122,7 +122,7 @@ def test_a_mesh_cancelled_while_it_waits_in_the_save_pool_never_starts(monkeypat
     monkeypatch.setattr(meshsave.subprocess, "Popen", lambda *a, **k: pytest.fail("a process started"))
     stop = threading.Event()
     stop.set()
-    job = MeshJob(load_spec(TORUS), {}, [], None, 16)
+    job = MeshJob(load_spec(TORUS, cache=True), {}, [], None, 16)
     with pytest.raises(Stopped):
         meshsave.run(job, 10.0, stop, lambda: pytest.fail("said to be running"))
 
@@ -140,7 +140,10 @@ def test_the_budget_counts_from_when_the_pool_starts_the_mesh(monkeypatch) -> No
     starts = []
     t0 = time.monotonic()
     data, line = meshsave.run(
-        MeshJob(load_spec(TORUS), {}, [], None, 16), 30.0, threading.Event(), lambda: starts.append(time.monotonic())
+        MeshJob(load_spec(TORUS, cache=True), {}, [], None, 16),
+        30.0,
+        threading.Event(),
+        lambda: starts.append(time.monotonic()),
     )
     assert line.startswith("saved torus_z.stl: ") and data
     (job, deadline, seconds), = sent  # fmt: skip
@@ -148,7 +151,7 @@ def test_the_budget_counts_from_when_the_pool_starts_the_mesh(monkeypatch) -> No
 
 
 def test_a_bug_in_the_mesh_process_is_its_kind_on_the_page_and_its_traceback_in_the_log(monkeypatch, caplog):
-    bad = MeshJob(load_spec(TORUS), {}, [], np.zeros((2, 2)), 16)  # a 2 x 2 "transform": place() fails
+    bad = MeshJob(load_spec(TORUS, cache=True), {}, [], np.zeros((2, 2)), 16)  # a 2 x 2 "transform": place() fails
     with pytest.raises(meshsave.ChildBug) as info:
         meshsave.run(bad, 30.0, threading.Event(), lambda: None)
     assert info.value.kind == "ValueError"
@@ -176,7 +179,7 @@ def test_the_mesh_process_imports_nothing_of_the_viewer() -> None:
 
 def test_a_mesh_process_killed_from_outside_is_one_line(heavy_built) -> None:
     """The system's OOM killer, say: the page hears how the process ended, in one line."""
-    job = MeshJob(load_spec(HEAVY), {}, [], None, 128)
+    job = MeshJob(load_spec(HEAVY, cache=True), {}, [], None, 128)
     out: list = []
 
     def mesh() -> None:

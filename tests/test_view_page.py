@@ -435,7 +435,7 @@ def test_the_gallery_picks_a_famous_surface_with_its_source(fresh_server, driver
     its name, a slider over the spec's own range and its source, and draws it."""
     from selenium.webdriver.support.ui import Select
 
-    from implgen.codegen import gallery
+    from implgen.spec import gallery
 
     seq = open_page(driver, fresh_server)
     picker = Select(driver.find_element("id", "gallery"))

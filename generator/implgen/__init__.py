@@ -17,9 +17,9 @@ from typing import Any
 __version__ = "0.1.0"
 
 _API: dict[str, str] = {
-    "Spec": "implgen.codegen.spec",
-    "load_spec": "implgen.codegen.spec",
-    "parse_spec": "implgen.codegen.spec",
+    "Spec": "implgen.spec.model",
+    "load_spec": "implgen.spec.entry",
+    "parse_spec": "implgen.spec.entry",
     "derive": "implgen.codegen.derive",
     "generate": "implgen.codegen.emit",
     "real_roots": "implgen.roots.solvers",

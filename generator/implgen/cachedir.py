@@ -1,7 +1,7 @@
 """The build cache folder: where it is, whether it may be trusted, its sealed entries, and its size bound.
 
 Where: `$IMPLGEN_CACHE`, else `$XDG_CACHE_HOME/implgen`, else `~/.cache/implgen`. On the ground floor because
-two rooms keep entries there: the spec cache (codegen/speccache.py: parsed specs) and the compile room
+two rooms keep entries there: the spec cache (spec/cache.py: parsed specs) and the compile room
 (compile/: generated C, objects, libraries).
 
 The cache holds shared libraries that implgen loads into its own process, so it is code, and the rule is:

@@ -13,11 +13,11 @@ import numpy as np
 from implgen.args import ArgumentParser
 from implgen.codegen.derive import derive
 from implgen.codegen.emit import derivation_ops, generate
-from implgen.codegen.spec import load_spec
 from implgen.compile.clib import WARNING_FLAGS, build_shared
 from implgen.errors import UserError
 from implgen.outputs import write_text_files
 from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, runtime_dir, runtime_sources
+from implgen.spec.entry import load_spec
 
 SHOWCASE = Path("examples/scenes/glassware.yaml")
 

@@ -21,9 +21,10 @@ from implgen.args import ArgumentParser
 from implgen.bench.machine import describe, load_average, write_results
 from implgen.codegen.derive import derive, exact_ray_coefficients
 from implgen.codegen.emit import derivation_ops, generate
-from implgen.codegen.spec import MAX_DEGREE, parse_spec
 from implgen.errors import UserError
 from implgen.outputs import check_output_file
+from implgen.spec.entry import parse_spec
+from implgen.spec.parse import MAX_DEGREE
 
 DEGREES = (2, 4, 6, 8, 12, 16, 20, 24)
 

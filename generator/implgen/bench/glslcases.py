@@ -16,7 +16,7 @@ import numpy as np
 from numpy.polynomial import chebyshev
 
 from implgen.bench.glslcheck import Case, camera_rays, make_case, sphere_interval
-from implgen.codegen.spec import load_spec, parse_spec
+from implgen.spec.entry import load_spec, parse_spec
 
 VIEW = np.array([0.55, 0.45, 0.7]) / np.linalg.norm([0.55, 0.45, 0.7])
 CLIP_RADIUS = 2.0  # the clip sphere around the origin for shapes without a box on every axis

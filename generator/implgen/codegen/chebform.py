@@ -23,7 +23,7 @@ from math import comb
 import numpy as np
 import sympy
 
-from implgen.codegen.spec import X, Y, Z
+from implgen.spec.parse import X, Y, Z
 
 GAIN = 16.0  # the Chebyshev tree must lower the median error bound by this factor to be chosen
 SAMPLES = 2048

@@ -14,9 +14,9 @@ from pathlib import Path
 
 from implgen.args import ArgumentParser
 from implgen.codegen.emit import LANGS, generate
-from implgen.codegen.spec import load_spec
 from implgen.errors import UserError
 from implgen.outputs import check_output_folder, write_text_files
+from implgen.spec.entry import load_spec
 
 EXAMPLES = (
     ("the torus as C (torus_z.h, torus_z.c) into out/", "implgen examples/shapes/torus_z.yaml --lang c -o out"),

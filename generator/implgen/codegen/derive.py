@@ -20,7 +20,7 @@ import sympy
 from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
-from implgen.codegen.spec import AXES, Spec, X, Y, Z
+from implgen.spec.parse import AXES, Spec, X, Y, Z
 
 # Names used inside generated code. User params are always prefixed `k_` (see spec.param_symbol), and cse
 # temporaries are `w0, w1, ...`, so none of these can collide with a user's name.

@@ -17,9 +17,9 @@ from sympy.codegen.rewriting import optimize
 from implgen import __version__
 from implgen.codegen.backends import BACKENDS, EXPAND_POW, ConstantRangeError
 from implgen.codegen.derive import DIRECTION, ORIGIN, POINT, Block, Derivation, derive
-from implgen.codegen.spec import Spec
 from implgen.codegen.templating import environment
 from implgen.errors import UserError
+from implgen.spec.parse import Spec
 
 LANGS = tuple(BACKENDS)
 

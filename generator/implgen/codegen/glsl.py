@@ -23,8 +23,8 @@ from sympy.printing.precedence import PRECEDENCE
 
 from implgen.codegen.chebform import ChebForm, better_form
 from implgen.codegen.derive import Derivation
-from implgen.codegen.spec import X, Y, Z
 from implgen.errors import UserError
+from implgen.spec.parse import X, Y, Z
 
 _F32_MAX = Fraction(float(np.finfo(np.float32).max))
 _MIN_NORMAL = Fraction(2) ** -126  # GPUs may flush anything smaller to zero

@@ -3,7 +3,7 @@ runtime_c and link.
 
 Caches, all under cachedir.cache_dir() (`$IMPLGEN_CACHE`, else `$XDG_CACHE_HOME/implgen`, else
 `~/.cache/implgen`; created 0700 and refused unless it is ours alone -- cachedir's notes):
-  spec/<key>.json a parsed spec, keyed by its content (codegen/speccache.py): what the build needs of it;
+  spec/<key>.json a parsed spec, keyed by its content (spec/cache.py): what the build needs of it;
   gen/<key>/      generated .c/.h of one shape, each sealed; the key (speccache.spec_key) hashes the spec's
                   content (equation, params, bounds, folded values, name) and implgen's own generator + template
                   sources, so editing a spec or upgrading implgen regenerates, and nothing else does;
@@ -26,8 +26,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from implgen import cachedir
-from implgen.codegen.fingerprint import implgen_fingerprint
-from implgen.codegen.specmodel import Spec
 from implgen.compile import clib
 from implgen.errors import UserError
 from implgen.resources import (
@@ -38,6 +36,8 @@ from implgen.resources import (
     runtime_dir,
     runtime_sources,
 )
+from implgen.spec.fingerprint import implgen_fingerprint
+from implgen.spec.model import Spec
 
 
 @dataclass(frozen=True)

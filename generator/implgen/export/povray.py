@@ -13,7 +13,7 @@ from fractions import Fraction
 import sympy
 
 from implgen.abi import grown_box
-from implgen.codegen.spec import Spec, exact_polynomial, param_symbol
+from implgen.spec.parse import Spec, exact_polynomial, param_symbol
 
 POVRAY_MAX_ORDER = 35  # POV-Ray 3.7's limit for `polynomial`
 

@@ -17,13 +17,13 @@ import numpy as np
 
 from implgen import validate
 from implgen.args import ArgumentParser
-from implgen.codegen.paramvalues import named_items
 from implgen.errors import UserError
 from implgen.mesh.budget import MAX_CELLS, MIN_CELLS
 from implgen.mesh.pipeline import Result, closed_and_euler, mesh_spec, signed_volume, singular_in_solid
 from implgen.mesh.region import parse_clip
 from implgen.mesh.write import FORMATS, place, vertex_normals, write_mesh
 from implgen.outputs import atomic_write, check_output_file
+from implgen.spec.paramvalues import named_items
 from implgen.yamlfile import read_yaml
 
 DEFAULT_CELLS = 64
@@ -88,9 +88,9 @@ def _shape(path: Path, obj: str | None):
         return leaf.spec, dict(leaf.params), np.asarray(leaf.matrix, dtype=np.float64)
     if obj is not None:
         raise UserError(f"--object {obj}", f"{path} is a spec, not a scene")
-    from implgen.codegen.speccache import load_spec
+    from implgen.spec.entry import load_spec
 
-    return load_spec(path), {}, None
+    return load_spec(path, cache=True), {}, None
 
 
 def report(result: Result, label: str, values: dict[str, float], verts: np.ndarray, faces: np.ndarray) -> dict:

@@ -25,11 +25,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from implgen.codegen.spec import Spec
 from implgen.errors import UserError
 from implgen.mesh.pipeline import closed_and_euler, mesh_spec
 from implgen.mesh.region import Clip
 from implgen.mesh.write import mesh_bytes, place, vertex_normals
+from implgen.spec.parse import Spec
 
 SOURCE = "save_mesh"
 LENGTH = struct.Struct("<Q")  # the byte count before each pickle on the pipes

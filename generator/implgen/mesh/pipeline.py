@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from implgen.codegen.specmodel import Spec
 from implgen.errors import UserError
 from implgen.mesh.budget import Budget, check_cells
 from implgen.mesh.contour import Mesh, contour
@@ -20,6 +19,7 @@ from implgen.mesh.crossings import clip_values
 from implgen.mesh.region import Clip, make_grid
 from implgen.mesh.shapelib import ShapeLib
 from implgen.mesh.singular import Singular, find_singular
+from implgen.spec.model import Spec
 
 
 @dataclass

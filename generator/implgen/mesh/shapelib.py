@@ -13,10 +13,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from implgen import abi
-from implgen.codegen.specmodel import Spec
 from implgen.compile import clib
 from implgen.compile.library import ShapeEntry, build_library
 from implgen.mesh.budget import Budget
+from implgen.spec.model import Spec
 
 MAX_DEGREE = abi.value("IG_MAX_DEGREE")
 AUTO = abi.value("IG_ROOTS_AUTO")

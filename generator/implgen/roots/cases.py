@@ -39,7 +39,7 @@ def find_shapes_dir(folder: str | Path | None = None) -> Path:
 def _shape_module(path: str, mtime: float) -> tuple[ModuleType, dict]:
     """The generated Python module of one spec (generated in memory, not written anywhere) and its params."""
     from implgen.codegen.emit import generate
-    from implgen.codegen.spec import load_spec
+    from implgen.spec.entry import load_spec
 
     spec = load_spec(path)
     text = generate(spec, ("python",))[f"{spec.name}.py"]

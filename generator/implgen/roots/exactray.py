@@ -19,8 +19,8 @@ from fractions import Fraction
 import numpy as np
 
 from implgen.abi import grown_box
-from implgen.codegen.spec import exact_polynomial, param_symbol
 from implgen.roots.descartes import has_root
+from implgen.spec.parse import exact_polynomial, param_symbol
 
 Terms = list[tuple[tuple[int, int, int], Fraction]]  # ((i, j, k), c): c x^i y^j z^k
 

@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from implgen import abi
-from implgen.codegen.specmodel import Spec
 from implgen.scene.keys import Animation
+from implgen.spec.model import Spec
 
 
 @dataclass
@@ -61,7 +61,7 @@ class Clip:
 
 @dataclass
 class Leaf:
-    spec: Spec  # its symbolic part deferred when the spec's content was parsed before (codegen/speccache.py)
+    spec: Spec  # its symbolic part deferred when the spec's content was parsed before (spec/cache.py)
     params: dict[str, float]  # every param of the spec, in its declared order
     matrix: np.ndarray  # 3x4 object -> world
     material: Material | None

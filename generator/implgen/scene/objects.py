@@ -11,7 +11,6 @@ from typing import Any
 import numpy as np
 
 from implgen import validate
-from implgen.codegen.speccache import load_spec, parse_spec  # codegen.spec's, cached by content
 from implgen.errors import UserError
 from implgen.scene import keys
 from implgen.scene import transform as tf
@@ -19,6 +18,7 @@ from implgen.scene.materials import material_ref
 from implgen.scene.model import CLIP_KINDS, Clip, Csg, Leaf, Material, Node
 from implgen.scene.model import depth as node_depth
 from implgen.scene.reader import Reader, given
+from implgen.spec.entry import load_spec, parse_spec
 
 MAX_CSG_NESTING = 32  # CSG operations nested inside each other, as written in the scene
 MAX_CSG_CHILDREN = 1024  # objects in one CSG list (a list becomes a balanced binary tree)
@@ -69,7 +69,7 @@ def _leaf(ctx: Reader, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
         if path not in ctx.spec_cache:
             ctx.count_shape(f"{key}.shape")
             try:
-                ctx.spec_cache[path] = load_spec(path)
+                ctx.spec_cache[path] = load_spec(path, cache=True)
             except UserError as err:  # the spec file's own message, after the scene's key that names it
                 raise ctx.fail(f"{key}.shape", str(err)) from None
         spec = ctx.spec_cache[path]
@@ -85,7 +85,7 @@ def _leaf(ctx: Reader, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
             mapping["params"], overrides = keys.inline_params(ctx, f"{key}.params", raw["params"])
         memo_key = f"{ctx.inline_count}:{mapping!r}"  # the same inline shape on every frame
         if memo_key not in ctx.inline_specs:
-            ctx.inline_specs[memo_key] = parse_spec(mapping, f"{ctx.source}: {key}")
+            ctx.inline_specs[memo_key] = parse_spec(mapping, f"{ctx.source}: {key}", cache=True)
         spec = ctx.inline_specs[memo_key]
     if not isinstance(overrides, dict):
         raise ctx.fail(f"{key}.params", "expected a mapping name -> number")

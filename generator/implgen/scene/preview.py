@@ -2,7 +2,7 @@
 
 The camera looks at the spec's box from above and to the side, far enough for the box's bounding sphere to fill
 the view; two lights move with it. The outside (f > 0) is gold, the inside blue, as in the viewer. The spec
-needs a whole, finite box: an open one is framed first (implgen.codegen.gallery's Entry.load_framed gives one).
+needs a whole, finite box: an open one is framed first (implgen.spec.gallery's Entry.load_framed gives one).
 """
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
-from implgen.codegen.specmodel import Spec
 from implgen.scene.model import Camera, Leaf, Light, Material, Scene
+from implgen.spec.model import Spec
 
 OUTSIDE = (0.95, 0.75, 0.3)
 INSIDE = (0.35, 0.55, 0.95)

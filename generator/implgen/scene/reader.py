@@ -9,9 +9,9 @@ from pathlib import Path
 from typing import Any
 
 from implgen import validate
-from implgen.codegen.specmodel import Spec
 from implgen.errors import UserError
 from implgen.scene import keys
+from implgen.spec.model import Spec
 
 MAX_SHAPES = 256  # distinct shapes (spec files and inline equations) in one scene
 COLOR_MAX = 100.0  # colour components; lengths and positions use validate.MAX_COORDINATE

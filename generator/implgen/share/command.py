@@ -14,12 +14,12 @@ from pathlib import Path
 
 from implgen import validate
 from implgen.args import ArgumentParser
-from implgen.codegen.paramvalues import named_items
-from implgen.codegen.spec import parse_spec
-from implgen.codegen.specmodel import Spec
 from implgen.errors import UserError
 from implgen.outputs import atomic_write, check_output_file
 from implgen.share.page import CLIPS, Look, Slider, framing, render_page, slider
+from implgen.spec.entry import parse_spec
+from implgen.spec.model import Spec
+from implgen.spec.paramvalues import named_items
 from implgen.yamlfile import read_yaml
 
 SUFFIXES = (".html", ".htm")

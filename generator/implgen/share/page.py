@@ -29,7 +29,7 @@ import jinja2
 from implgen import __version__
 from implgen.codegen.emit import generate
 from implgen.codegen.glslprogram import HEADERS, runtime_text
-from implgen.codegen.specmodel import Spec
+from implgen.spec.model import Spec
 
 STATIC = Path(__file__).resolve().parent / "static"
 SCRIPTS = ("surface.js", "orbit.js", "page.js")  # in this order: page.js uses the other two

@@ -19,8 +19,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from implgen.args import ArgumentParser
-from implgen.codegen.spec import parse_spec
 from implgen.errors import UserError
+from implgen.spec.entry import parse_spec
 from implgen.view.document import STARTER, Document
 from implgen.view.work import Limits
 from implgen.yamlfile import read_yaml

@@ -12,9 +12,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from implgen.codegen.spec import Spec, parse_spec
 from implgen.scene.model import Camera, Clip, Csg, Leaf, Light, Material, Node, Scene
 from implgen.share.page import MATERIAL  # the shape's material, both sides: the shared page's too
+from implgen.spec.entry import parse_spec
+from implgen.spec.parse import Spec
 
 CLIPS = ("none", "sphere", "box")
 LIGHTS = ("studio", "headlight", "top", "scene")

@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 import yaml
 
-from implgen.codegen.grammar import format_expression
-from implgen.codegen.spec import Spec, param_symbol
 from implgen.scene.model import Leaf, Material, Node, Scene
+from implgen.spec.grammar import format_expression
+from implgen.spec.parse import Spec, param_symbol
 
 
 def _num(v: float) -> float | int:

@@ -13,10 +13,10 @@ import math
 
 import numpy as np
 
-from implgen.codegen.spec import Spec
 from implgen.scene.build import BuildResult
 from implgen.scene.model import Clip, Leaf, Material, Scene
 from implgen.scene.tracer import CScene
+from implgen.spec.parse import Spec
 
 PROBE = 10.0  # radius of the ball the probe looks in
 RAYS = 384  # probe rays; half aimed near the origin, half spread over the ball

@@ -1,4 +1,4 @@
-"""The page's gallery picker: every gallery spec (implgen.codegen.gallery) as the JSON the page reads from
+"""The page's gallery picker: every gallery spec (implgen.spec.gallery) as the JSON the page reads from
 /gallery.json -- title, the line on what it is, its source, and the spec's own equation, params, ranges and
 bounds, which the page sends back as an ordinary `shape` message (parsed and checked like typed text).
 
@@ -13,8 +13,8 @@ import logging
 import math
 from typing import Any
 
-from implgen.codegen import gallery
 from implgen.errors import UserError
+from implgen.spec import gallery
 
 log = logging.getLogger("implgen.view")
 

@@ -36,10 +36,11 @@ from dataclasses import dataclass
 from typing import Any
 
 from implgen import validate
-from implgen.codegen.grammar import format_expression
-from implgen.codegen.spec import Spec, param_symbol, parse_spec
 from implgen.errors import UserError
 from implgen.mesh.budget import MAX_CELLS, MIN_CELLS
+from implgen.spec.entry import parse_spec
+from implgen.spec.grammar import format_expression
+from implgen.spec.parse import Spec, param_symbol
 from implgen.view.document import CLIPS, LIGHTS, Options, Orbit
 
 MAX_MESSAGE = 64 * 1024  # bytes of one message from the page

@@ -16,7 +16,6 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import sympy
@@ -24,13 +23,12 @@ from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
 from implgen import abi, validate
-from implgen.codegen import paramvalues
-from implgen.codegen.fingerprint import code_key
-from implgen.codegen.grammar import ParseError, check_terms, format_expression, parse_expression, split_equation
-from implgen.codegen.names import check_identifier, check_shape_name
-from implgen.codegen.specmodel import Spec
 from implgen.errors import UserError
-from implgen.yamlfile import read_yaml
+from implgen.spec import paramvalues
+from implgen.spec.fingerprint import code_key
+from implgen.spec.grammar import ParseError, check_terms, format_expression, parse_expression, split_equation
+from implgen.spec.model import Spec
+from implgen.spec.names import check_identifier, check_shape_name
 
 MAX_DEGREE = abi.value("IG_MAX_DEGREE")  # the solvers' limit, read from runtime_c/roots.h
 MAX_PARAMS = 64
@@ -56,7 +54,7 @@ def param_symbol(name: str) -> sympy.Symbol:
 
 @dataclass(frozen=True)
 class SymbolicForm:
-    """The SymPy side of a `Spec` (codegen/specmodel.py): the expression and the symbolic bounds."""
+    """The SymPy side of a `Spec` (spec/model.py): the expression and the symbolic bounds."""
 
     f: sympy.Expr  # lhs - rhs, structure as written; x, y, z and k_* symbols
     bounds: dict[str, tuple[sympy.Expr, sympy.Expr]] | None  # axis -> (lo, hi) in k_* symbols
@@ -126,12 +124,6 @@ def make_spec(
         ranges=dict(ranges or {}),
     )
     return spec
-
-
-def load_spec(path: str | Path) -> Spec:
-    """Load and validate a spec file."""
-    path = Path(path)
-    return parse_spec(read_yaml(path), str(path))
 
 
 def _parse_params(source: str, raw: Any) -> dict[str, float]:
@@ -232,8 +224,9 @@ def _parse_bounds(source: str, raw: Any, params: dict[str, float]) -> dict[str, 
     return bounds
 
 
-def parse_spec(data: Any, source: str = "<spec>") -> Spec:
-    """Validate an already-loaded mapping (a spec file, or an inline shape in a scene)."""
+def parse_full(data: Any, source: str = "<spec>") -> Spec:
+    """Validate an already-loaded mapping (a spec file, or an inline shape in a scene), in full with SymPy. Callers
+    come through spec/entry.py's parse_spec."""
     if not isinstance(data, dict) or not any(k in KEYS for k in data):
         # Possibly not meant as a spec at all (a scene's `shape:` naming some other file): say what was
         # expected, and echo nothing of the file.

@@ -11,10 +11,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from implgen.codegen.speccache import parse_spec
-from implgen.codegen.specmodel import Spec
 from implgen.errors import UserError
 from implgen.resources import gallery_dir
+from implgen.spec.entry import parse_spec
+from implgen.spec.model import Spec
 from implgen.yamlfile import read_yaml
 
 FRAME_RADIUS = 2.0  # an open axis of a gallery spec, in a picture: [-2, 2]
@@ -44,8 +44,8 @@ class Entry:
         return {"name": self.name, "title": self.title, "description": self.description, "reference": self.reference}
 
     def load(self) -> Spec:
-        """The checked `Spec`, through the spec cache (codegen/speccache.py: a second load needs no SymPy)."""
-        return parse_spec(self.data, self.source)
+        """The checked `Spec`, through the spec cache (spec/cache.py: a second load needs no SymPy)."""
+        return parse_spec(self.data, self.source, cache=True)
 
     def load_framed(self, radius: float = FRAME_RADIUS) -> Spec:
         """The `Spec` with a whole box: an axis the spec leaves open (Barth's sextic runs off to infinity) is
@@ -54,7 +54,7 @@ class Entry:
         if isinstance(bounds, dict) and all(a in bounds for a in "xyz"):
             return self.load()
         framed = {a: bounds.get(a, [-radius, radius]) for a in "xyz"} if isinstance(bounds, dict) else bounds
-        return parse_spec({**self.data, "bounds": framed}, self.source)
+        return parse_spec({**self.data, "bounds": framed}, self.source, cache=True)
 
 
 def _text(data: dict, key: str) -> str:

@@ -5,7 +5,7 @@ of f in x, y, z stays within 2^MAX_COEFF_BITS (a param within range can still be
 overflows: a^40 with a = 1e9), and the bounds stay an ordered box within the coordinate range. Both need only
 plain data taken from the parsed spec once: the terms of f as (log2 |coefficient|, param exponents), and the
 bounds as small expression trees in the params. Those are JSON-friendly, so the spec cache
-(scene/speccache.py) keeps them and a cached scene is checked exactly as a freshly parsed one, by this code.
+(spec/cache.py) keeps them and a cached scene is checked exactly as a freshly parsed one, by this code.
 
 A bounds tree is one of ["n", float], ["p", param name], ["+", tree, ...], ["*", tree, ...] or
 ["^", tree, whole exponent].

@@ -1,11 +1,11 @@
 """Validated shape specs cached by content, so a scene whose shapes are unchanged loads without SymPy.
 
-Parsing a spec (codegen/spec.py) needs SymPy, whose import alone takes a few hundred milliseconds, yet the
+Parsing a spec (spec/parse.py) needs SymPy, whose import alone takes a few hundred milliseconds, yet the
 render of a scene whose shapes were built before needs only what the build and the tracer read: the name,
 the params and their defaults, the degree and the key of the generated code (`Spec.spec_key`). After a full
 parse those are written to `spec/<key>.json` in the build cache (cache_dir(), beside `gen/`), keyed by
 the spec's content -- the mapping read from the YAML, every value with its type -- and implgen's own
-fingerprint (codegen/fingerprint.py). The next load of the same content reads them back as a `Spec` whose
+fingerprint (spec/fingerprint.py). The next load of the same content reads them back as a `Spec` whose
 symbolic part is deferred.
 
 Only a spec that parsed is ever written, so a cache keyed by content holds valid specs only: an invalid one
@@ -31,12 +31,11 @@ from pathlib import Path
 from typing import Any
 
 from implgen import abi, cachedir
-from implgen.codegen import paramvalues
-from implgen.codegen.fingerprint import implgen_fingerprint
-from implgen.codegen.names import check_identifier, check_shape_name
-from implgen.codegen.specmodel import Spec, Symbolic
 from implgen.errors import UserError
-from implgen.yamlfile import read_yaml
+from implgen.spec import paramvalues
+from implgen.spec.fingerprint import implgen_fingerprint
+from implgen.spec.model import Spec, Symbolic
+from implgen.spec.names import check_identifier, check_shape_name
 
 FORMAT = 3
 MAX_ENTRY_BYTES = 8 << 20  # an entry holds the printed equation of a spec file of at most 1 MiB
@@ -93,14 +92,9 @@ def _cached_spec(entry: dict, content: str, source: str) -> Spec:
     )
 
 
-def load_spec(path: str | Path) -> Spec:
-    """codegen.spec.load_spec through the cache: the same reading, the same errors, the same values."""
-    path = Path(path)
-    return parse_spec(read_yaml(path), str(path))
-
-
-def parse_spec(data: Any, source: str = "<spec>") -> Spec:
-    """codegen.spec.parse_spec through the cache: the symbolic part is deferred when this content parsed before."""
+def parse_cached(data: Any, source: str = "<spec>") -> Spec:
+    """spec/parse.py's parse_full through the cache: the same errors and the same values, the symbolic part
+    deferred when this content parsed before. Callers come through spec/entry.py's parse_spec(cache=True)."""
     content = _canonical(data)
     if content is None:
         return _parse(data, source)
@@ -115,7 +109,7 @@ def parse_spec(data: Any, source: str = "<spec>") -> Spec:
 
 
 def _parse(data: Any, source: str) -> Spec:
-    from implgen.codegen.spec import parse_spec as parse_full
+    from implgen.spec.parse import parse_full
 
     return parse_full(data, source)
 

@@ -1,10 +1,10 @@
 """The one `Spec` type: a validated shape, without SymPy.
 
 A spec has two parts. What a scene's build and render read -- the name, the params and their defaults, the
-degree, the printed equation, the box and the checks of param values (from plain data: codegen/paramvalues.py),
+degree, the printed equation, the box and the checks of param values (from plain data: spec/paramvalues.py),
 and the key of its generated code -- is held as plain values. Its expression (`f`, the symbolic `bounds`,
-`specialise`) is the symbolic part, built by codegen/spec.py: at once when the spec was parsed, or on first use
-when it was read back from the spec cache (codegen/speccache.py). So a scene whose shapes were built before
+`specialise`) is the symbolic part, built by spec/parse.py: at once when the spec was parsed, or on first use
+when it was read back from the spec cache (spec/cache.py). So a scene whose shapes were built before
 renders without importing SymPy, and every caller holds the same type either way.
 """
 
@@ -15,11 +15,11 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
-from implgen.codegen import paramvalues
+from implgen.spec import paramvalues
 
 
 class Symbolic(Protocol):
-    """The SymPy side of a spec (codegen/spec.py's SymbolicForm)."""
+    """The SymPy side of a spec (spec/parse.py's SymbolicForm)."""
 
     f: Any  # lhs - rhs as a SymPy expression in x, y, z and the k_* param symbols
     bounds: dict[str, tuple[Any, Any]] | None  # axis -> (lo, hi) in the k_* symbols
@@ -119,11 +119,6 @@ class Spec:
     def specialise(self, values: Mapping[str, float], name: str | None = None) -> Spec:
         """The same shape with the given params folded into the equation as constants."""
         return self.symbolic.specialise(self, values, name)
-
-    @property
-    def from_cache(self) -> bool:
-        """Whether this spec was read back from the spec cache (its symbolic part parsed on first use)."""
-        return self.symbolic_part.deferred
 
     @property
     def symbolic_loaded(self) -> bool:

@@ -1,8 +1,8 @@
 """What generated code depends on besides the spec: implgen's own generator sources and templates.
 
 Both keys built from it live here, below the modules that use them: the key of a spec's generated code
-(`code_key`, which codegen/spec.py gives every parsed spec) and the spec cache's entry key
-(codegen/speccache.py). Editing a spec or upgrading implgen changes them; nothing else does.
+(`code_key`, which spec/parse.py gives every parsed spec) and the spec cache's entry key
+(spec/cache.py). Editing a spec or upgrading implgen changes them; nothing else does.
 """
 
 from __future__ import annotations
