@@ -15,6 +15,8 @@ import pytest
 from starlette.testclient import TestClient
 
 from conftest import ROOT
+from implgen.bench.glslcases import chmutov
+from implgen.codegen import chebform
 from implgen.codegen.emit import generate
 from implgen.codegen.glslprogram import HEADERS, runtime_text
 from implgen.scene.load import load_scene
@@ -23,6 +25,7 @@ from implgen.view.command import document_factory
 from implgen.view.document import LIGHT_PRESETS, Document
 from implgen.view.server import create_app
 from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_ONE
+from implgen.view.work import Limits
 from test_view_api import picture, render_msg, reply
 
 SCENES = ROOT / "examples" / "scenes"
@@ -111,9 +114,9 @@ def test_a_slow_glsl_does_not_hold_the_renders_behind_it(client, monkeypatch) ->
     gate = threading.Event()
     real = gpu.program_message
 
-    def held(doc):
+    def held(*args):
         gate.wait(30)
-        return real(doc)
+        return real(*args)
 
     monkeypatch.setattr(gpu, "program_message", held)
     with client.websocket_connect("/ws") as ws:
@@ -132,6 +135,75 @@ def test_a_slow_glsl_does_not_hold_the_renders_behind_it(client, monkeypatch) ->
             if msg.get("text") is not None:
                 texts.append(json.loads(msg["text"]))
         assert texts[-1]["shape_id"] == hello["shape_id"] == 0 and texts[-1]["name"] == "torus"
+
+
+GUARD = 30  # seconds: a hang guard, not a timing
+BOX = {a: [-2, 2] for a in "xyz"}  # a spec without params in a finite box: its GLSL tries the Chebyshev form
+
+
+def test_a_glsl_derivation_does_not_hold_another_page_s_new_equation(client, monkeypatch) -> None:
+    """Issue 31: one page's GLSL (a degree-24 Chebyshev form took 38 s) held the shared parse thread, and another
+    page's trivial equation waited 73-87 s for it. Now the GLSL has a pool of its own: with page A's Chebyshev
+    step held, page B's new equation is answered (before: only once A's derivation had ended)."""
+    entered, gate, released = threading.Event(), threading.Event(), threading.Event()
+    real = chebform.chebyshev_form
+
+    def held(f, bounds):
+        entered.set()
+        gate.wait(GUARD)
+        released.set()
+        return real(f, bounds)
+
+    monkeypatch.setattr(chebform, "chebyshev_form", held)
+    with client.websocket_connect("/ws") as a, client.websocket_connect("/ws") as b:
+        reply(a), reply(b)
+        a.send_text(json.dumps({"type": "shape", "equation": "x^2 + y^2 + z^2 - 1", "params": {}, "bounds": BOX}))
+        assert reply(a)["type"] == "shape"
+        a.send_text(json.dumps({"type": "glsl"}))
+        assert entered.wait(GUARD)
+        b.send_text(json.dumps({"type": "shape", "equation": "x^2 + y^2 - z^2 - 1/4", "params": {}}))
+        answer = reply(b)
+        answered_while_held = not released.is_set()
+        gate.set()
+        glsl = reply(a)
+    assert answer["type"] == "shape" and answer["equation"] == "x^2 + y^2 - z^2 - 1/4", answer
+    assert answered_while_held, "page B's new equation waited for page A's GLSL derivation"
+    assert glsl["type"] == "glsl" and "Evaluated in the tree as written (not expanded)." in glsl["shape"]
+
+
+def _expanded_chmutov(ws) -> None:
+    """The page's shape: Chmutov's degree-12 surface typed expanded in its box, whose GLSL the Chebyshev form
+    evaluates (tests/test_glsl_chebform.py)."""
+    spec = chmutov(12, nested=False)
+    bounds = {a: [float(lo), float(hi)] for a, (lo, hi) in spec.bounds.items()}
+    ws.send_text(json.dumps({"type": "shape", "equation": spec.equation, "params": {}, "bounds": bounds}))
+    assert reply(ws)["type"] == "shape"
+
+
+def test_past_the_glsl_budget_the_shader_evaluates_the_tree_and_the_page_is_told() -> None:
+    """The GPU preview's GLSL and Export page under a GLSL budget too small for the Chebyshev form: f's tree as
+    written, and a note for the page naming the budget; under the default budget, the Chebyshev form."""
+    app = create_app(document_factory(None), threads=2, limits=Limits(glsl_budget=0.01))
+    with TestClient(app) as c, c.websocket_connect("/ws") as ws:
+        reply(ws)
+        _expanded_chmutov(ws)
+        ws.send_text(json.dumps({"type": "glsl"}))
+        glsl = reply(ws)
+        ws.send_text(json.dumps({"type": "export_page"}))
+        page = reply(ws)
+    assert "Evaluated in the tree as written (not expanded): the Chebyshev basis" in glsl["shape"]
+    assert "within the 0.01 s GLSL budget (IMPLGEN_VIEW_GLSL_BUDGET)" in glsl["note"], glsl.get("note")
+    assert "Evaluated in the tree as written (not expanded): the Chebyshev basis" in page["text"]
+    assert page["note"].startswith("the exported page's shader: the GLSL evaluates f as written"), page["note"]
+    with TestClient(create_app(document_factory(None), threads=2)) as c, c.websocket_connect("/ws") as ws:
+        reply(ws)
+        _expanded_chmutov(ws)
+        ws.send_text(json.dumps({"type": "glsl"}))
+        glsl = reply(ws)
+        ws.send_text(json.dumps({"type": "export_page"}))
+        page = reply(ws)
+    assert "Evaluated in the Chebyshev basis of the box" in glsl["shape"] and "note" not in glsl
+    assert "Evaluated in the Chebyshev basis of the box" in page["text"] and "note" not in page
 
 
 def test_the_page_s_scripts_are_the_shared_page_s_files(client) -> None:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import base64
 import io
+import os
 import shutil
 import time
 
@@ -18,6 +19,7 @@ import pytest
 import yaml
 from PIL import Image
 
+from implgen.bench.glslcases import chmutov
 from implgen.bench.webgl import FLAGS
 from implgen.imagefile import to_uint8
 from implgen.scene.render import render
@@ -360,3 +362,22 @@ def test_a_csg_scene_is_the_server_s(tmp_path, driver) -> None:
         kinds = drag(d, during=lambda d: view_state(d))
         assert [k for k in kinds if k["kind"] == "coarse"] and all(k["gl_frames"] == 0 for k in kinds)
         assert png(d, "view").std() > 5  # a picture, drawn by the server
+
+
+def test_past_the_glsl_budget_the_page_says_the_gpu_draws_the_tree(tmp_path, driver) -> None:
+    """Issue 31: the GLSL derivation and Export page have a budget (IMPLGEN_VIEW_GLSL_BUDGET); past it the shader
+    evaluates f's tree as written, and the page says so beside the GPU preview and after Export page. Chmutov's
+    degree-12 surface typed expanded in its box, whose Chebyshev form needs more than 0.01 s."""
+    spec = chmutov(12, nested=False)
+    bounds = {a: [float(lo), float(hi)] for a, (lo, hi) in spec.bounds.items()}
+    path = tmp_path / "power.yaml"
+    path.write_text(yaml.safe_dump({"name": "power", "equation": spec.equation, "bounds": bounds}))
+    d = driver
+    with view_process(str(path), env={**os.environ, "IMPLGEN_VIEW_GLSL_BUDGET": "0.01"}) as url:
+        open_page(d, url)
+        until(d, lambda d: view_state(d)["path"] == "gpu", "the GPU preview did not start")
+        note = view_state(d)["note"]
+        assert "the GLSL evaluates f as written" in note and "0.01 s GLSL budget" in note, note
+        d.find_element("id", "export-page").click()
+        message = "return document.getElementById('message').textContent"
+        until(d, lambda d: js(d, message).startswith("the exported page's shader: "), "Export page said nothing")

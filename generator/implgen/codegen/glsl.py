@@ -21,7 +21,7 @@ import sympy
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from implgen.codegen.chebform import ChebForm, better_form
+from implgen.codegen.chebform import ChebForm, OverBudget, better_form
 from implgen.codegen.derive import Derivation
 from implgen.errors import UserError
 from implgen.spec.parse import X, Y, Z
@@ -259,10 +259,17 @@ def glsl_extra(derivation: Derivation) -> dict:
         )
     uniform = f"{spec.name}_params"
     params = {s: f"{uniform}[{i}]" for i, s in enumerate(spec.param_symbols)}
-    form = None if params else better_form(spec.f, spec.bounds)
+    form, cut = None, False
+    if not params:
+        try:
+            form = better_form(spec.f, spec.bounds)
+        except OverBudget:  # the viewer's GLSL budget ran out (chebform.budget): the tree, always at hand
+            cut = True
     if form is None:
         lines, result = affine_code(spec.f, params)
         basis = "the tree as written (not expanded)"
+        if cut:
+            basis += ": the Chebyshev basis of the box was not tried to the end within the time budget"
     else:
         lines, result = chebyshev_affine_code(form)
         basis = "the Chebyshev basis of the box, which float evaluates far better than the tree as written"

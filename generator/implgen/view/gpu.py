@@ -8,6 +8,9 @@ material (`hello_part`); then, after every accepted shape, a `glsl` message (`pr
 generated GLSL, or why the server draws every frame. Everything sent is generated from the parsed spec; no
 text the user typed is in it but through the GLSL printer.
 
+The derivation runs on the viewer's glsl pool, beside the parse pool, under the GLSL budget (view/work.py):
+past the budget the GLSL evaluates f's tree as written and the message's `note` says so.
+
 The GLSL page main draws one shape, inside the viewer's clip (cut open or as a cut solid), with the viewer's
 lights, material and shadows. A scene file (CSG, glass, mirrors, several objects, transforms, its own lights)
 is the server's: the message says which of these it has.
@@ -16,9 +19,12 @@ is the server's: the message says which of these it has.
 from __future__ import annotations
 
 import logging
+import threading
 
+from implgen.codegen import chebform
 from implgen.codegen.emit import generate
 from implgen.codegen.glslprogram import HEADERS, runtime_text
+from implgen.codegen.spec import Spec
 from implgen.errors import UserError
 from implgen.scene.model import Csg, Leaf, Node
 from implgen.share.page import MATERIAL
@@ -68,18 +74,40 @@ def server_only(doc: Document) -> str | None:
     return f"a scene file ({what}): the GLSL page draws one shape alone"
 
 
-def program_message(doc: Document) -> dict:
-    """The `glsl` message for the document's current shape (on the parse pool: the derivation is SymPy)."""
+def budget_note(held: chebform.Budget) -> str | None:
+    """What the page says when a GLSL derivation's budget ran out before its Chebyshev step ended, else None."""
+    if not held.cut:
+        return None
+    if held.seconds is None or (held.stop is not None and held.stop.is_set()):
+        return "the GLSL evaluates f as written: its Chebyshev form was stopped"
+    return (
+        f"the GLSL evaluates f as written: its Chebyshev form was not done within the {held.seconds:g} s GLSL "
+        "budget (IMPLGEN_VIEW_GLSL_BUDGET)"
+    )
+
+
+def shape_glsl(spec: Spec, budget: float | None = None, stop: threading.Event | None = None) -> tuple[str, str | None]:
+    """(the shape's generated GLSL, the page's note or None): with `budget` seconds (None: as long as it takes), a
+    Chebyshev step past them or past `stop` is cut and the GLSL evaluates f's tree as written."""
+    with chebform.budget(budget, stop) as held:
+        shape = generate(spec, ("glsl",))[f"{spec.name}.glsl"]
+    return shape, budget_note(held)
+
+
+def program_message(doc: Document, budget: float | None = None, stop: threading.Event | None = None) -> dict:
+    """The `glsl` message for the document's current shape (on the glsl pool, Work.derive_glsl: the derivation is
+    SymPy), its Chebyshev step within `budget` seconds (None: unbounded); a `note` says when that cut it."""
     spec = doc.spec
     reason = server_only(doc)
     if reason is None:
         try:
-            shape = generate(spec, ("glsl",))[f"{spec.name}.glsl"]
+            shape, note = shape_glsl(spec, budget, stop)
         except UserError as err:
             reason = f"the GLSL target cannot draw this shape: {err.message}"
         except Exception:  # a bug in the GLSL backend: the server's path still draws; the log says why
             log.exception("GLSL generation failed")
             reason = "the GLSL target failed on this shape"
         else:
-            return {"type": "glsl", "name": spec.name, "shape": shape, "params": list(spec.params)}
+            msg = {"type": "glsl", "name": spec.name, "shape": shape, "params": list(spec.params)}
+            return {**msg, "note": note} if note else msg
     return {"type": "glsl", "name": spec.name, "reason": reason}

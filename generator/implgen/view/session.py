@@ -127,8 +127,8 @@ class Session:
             elif kind in ("pick", "object"):
                 await self._pick(data)
             elif kind == "export_page":
-                name, html = await self.work.call(self.work.parse, sharepage.page_text, replace(self.doc))
-                await self.send({"type": "page", "name": name, "text": html})
+                name, html, note = await self.work.derive_glsl(sharepage.page_text, replace(self.doc))
+                await self.send({"type": "page", "name": name, "text": html, **({"note": note} if note else {})})
             elif kind == "glsl":  # the GPU preview asks for the current shape's GLSL: derived (SymPy) in a task of
                 if self._glsl is not None:  # its own, so the renders behind it are read meanwhile; a newer ask wins
                     self._glsl.cancel()
@@ -338,7 +338,7 @@ class Session:
     async def _send_glsl(self, doc: Document, shape_id: int) -> None:
         """The `glsl` message of `doc`'s shape, numbered as that shape was (never a newer shape's number)."""
         try:
-            msg = await self.work.call(self.work.parse, gpu.program_message, doc)
+            msg = await self.work.derive_glsl(gpu.program_message, doc)
             await self.send({**msg, "shape_id": shape_id})
         except UserError as err:
             await self.send(protocol.error_for(err))

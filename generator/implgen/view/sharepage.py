@@ -7,18 +7,27 @@ A clip the shared page cannot draw (a scene file's own) falls back to its sphere
 
 from __future__ import annotations
 
+import threading
 from dataclasses import asdict
 
+from implgen.codegen import chebform
 from implgen.share.page import CLIPS, Look, render_page, slider
+from implgen.view import gpu
 from implgen.view.document import Document
 
 
-def page_text(doc: Document) -> tuple[str, str]:
-    """(file name, the page's HTML) for the document's current view."""
+def page_text(
+    doc: Document, budget: float | None = None, stop: threading.Event | None = None
+) -> tuple[str, str, str | None]:
+    """(file name, the page's HTML, a note for the viewer's page or None) for the document's current view; its GLSL
+    derived under `budget` seconds (None: unbounded) as the GPU preview's is (gpu.shape_glsl)."""
     spec, o = doc.spec, doc.options
     sliders = [slider(name, float(doc.values.get(name, default)), spec.ranges) for name, default in spec.params.items()]
     clip = o.clip if o.clip in CLIPS else "sphere"
     look = Look(clip=clip, clip_size=o.clip_size, cut=o.cut, outside=o.color, inside=o.inside, background=o.background)
     orbit = asdict(doc.orbit)
     orbit["target"] = list(orbit["target"])
-    return f"{spec.name}.html", render_page(spec, sliders, look, f"implgen view: {spec.name}", orbit)
+    with chebform.budget(budget, stop) as held:
+        html = render_page(spec, sliders, look, f"implgen view: {spec.name}", orbit)
+    note = gpu.budget_note(held)
+    return f"{spec.name}.html", html, f"the exported page's shader: {note}" if note else None

@@ -9,6 +9,8 @@ C render, one memory bound for all saves.
             reserved when it is asked for and refused beyond the bound
     mesh    Save mesh: one at a time, each thread waiting for its mesh's own process; a pool of its own, so a
             Save PNG never waits behind a mesh
+    glsl    the GPU preview's GLSL and Export page (SymPy): one at a time, beside the parse pool, so a new
+            equation never waits behind a GLSL derivation; each under the GLSL budget (`derive_glsl`)
 
 A C render (a live frame or a save) runs under a `Ticket`: the page cancels it when a newer request comes or when
 it closes, and a timer on the event loop cancels it when its time budget is spent (rt_render_cancel: the C threads
@@ -17,6 +19,11 @@ effect between rows only, so a render whose single row would outlast its budget 
 the page's previous render, times the row's samples) is refused before it starts. The threads are daemons and
 `Work.shutdown` cancels every render, so Ctrl-C never waits for one: a parse or a build still running ends with
 the process.
+
+A GLSL derivation (gpu.py, sharepage.py) runs under `derive_glsl`: its Chebyshev step (codegen/chebform.py, the one
+part whose time the spec limits do not bound) checks the GLSL budget and a stop between its small steps, and past
+them the shader evaluates f's tree as written, which the page is told. A cancelled caller (a newer request, the
+page closed) sets the stop.
 
 A mesh (meshsave.py) is not a C render: it runs `stoppable`, its own time budget and stop checked by the mesh
 pipeline between slices of its work (implgen.mesh.budget); a cancelled caller, or `shutdown`, sets the stop.
@@ -56,6 +63,7 @@ class Limits:
     render_budget: float = 20.0  # seconds of one live frame's C render
     save_budget: float = 300.0  # seconds of one save's C render
     mesh_budget: float = 120.0  # seconds of one Save mesh
+    glsl_budget: float = 10.0  # seconds of a GLSL derivation (GPU preview, Export page): then f's tree as written
     save_memory: float = 2048.0  # MB reserved by all saves, running or waiting
     idle: float = 600.0  # seconds a page may send nothing before it is closed
     ping: float = 20.0  # seconds between WebSocket pings, and for the answer: a vanished peer is closed
@@ -63,6 +71,7 @@ class Limits:
     render_threads: int = 4
     save_threads: int = 1
     mesh_threads: int = 1
+    glsl_threads: int = 1
 
     @staticmethod
     def from_env(env: Mapping[str, str] = os.environ) -> Limits:
@@ -220,6 +229,7 @@ class Work:
         self.render = Pool("render", self.limits.render_threads)
         self.save = Pool("save", self.limits.save_threads)
         self.mesh = Pool("mesh", self.limits.mesh_threads)
+        self.glsl = Pool("glsl", self.limits.glsl_threads)
         self._lock = threading.Lock()
         self._tickets: set[Ticket] = set()
         self._stops: set[threading.Event] = set()  # the meshes running or waiting (stoppable)
@@ -280,6 +290,12 @@ class Work:
         finally:
             with self._lock:
                 self._stops.discard(stop)
+
+    async def derive_glsl(self, fn: Callable, *args) -> Any:
+        """fn(*args, budget, stop) on the glsl pool: a GLSL derivation, `budget` the GLSL budget in seconds (from
+        when the pool starts it), `stop` set when the caller is cancelled (`stoppable`)."""
+        stop = threading.Event()
+        return await self.stoppable(self.glsl, stop, fn, *args, self.limits.glsl_budget, stop)
 
     async def _shielded(self, work: Future, on_cancel: Callable[[], None]) -> Any:
         """The pool's result for `work`, which a cancel of the caller does not cut short: the caller's cancel calls
@@ -344,5 +360,5 @@ class Work:
                 fut.cancel()
             except RuntimeError:  # its loop has ended
                 pass
-        for pool in (self.parse, self.render, self.save, self.mesh):
+        for pool in (self.parse, self.render, self.save, self.mesh, self.glsl):
             pool.shutdown(wait=False, cancel_futures=True)

@@ -367,6 +367,7 @@
       download(new Blob([msg.text], { type: "application/yaml" }), `${$("shape-name").value.replace(/[^A-Za-z0-9_]/g, "") || "scene"}.yaml`);
     } else if (msg.type === "page") {
       download(new Blob([msg.text], { type: "text/html" }), msg.name);
+      if (typeof msg.note === "string") showMessage(msg.note, false); // its shader cut by the GLSL budget
     } else if (msg.type === "c") {
       $("code").textContent = msg.text;
       $("code-dialog").showModal();

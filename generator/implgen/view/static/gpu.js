@@ -23,7 +23,7 @@ const ImplgenGpu = (() => {
     stage.insertBefore(overlay, view.nextSibling);
     stage.insertBefore(glCanvas, view.nextSibling);
     const g = {
-      renderer: null, progressive: null, failure: "", reason: "", software: false, runtime: null,
+      renderer: null, progressive: null, failure: "", reason: "", software: false, runtime: null, basis: "",
       shape: null, shapeId: -1, programId: -1, view: null, key: "", frames: 0, compared: null,
     };
     // which path draws, said on the page (and in #view's data-path, for tests)
@@ -35,7 +35,9 @@ const ImplgenGpu = (() => {
           : "GPU preview off";
       } else if (g.reason) why = g.reason;
       else if (!active()) why = "waiting for the shape's GLSL";
-      note.textContent = active() ? `drawing: the GPU while the view moves (${g.renderer.info()[1]}), the server at rest`
+      // the server's note on the shape's GLSL (its Chebyshev form cut by the GLSL budget) while the GPU draws it
+      const basis = g.basis ? `; ${g.basis}` : "";
+      note.textContent = active() ? `drawing: the GPU while the view moves (${g.renderer.info()[1]}), the server at rest${basis}`
         : `drawing: the server (${why})`;
       view.dataset.path = active() ? "gpu" : "server";
     }
@@ -80,6 +82,7 @@ const ImplgenGpu = (() => {
       g.view = null;
       g.key = ""; // the next view is drawn, even one equal to the last shape's
       g.reason = "";
+      g.basis = "";
       stop();
       ask();
       say();
@@ -89,6 +92,7 @@ const ImplgenGpu = (() => {
     function program(msg) {
       if (msg.shape_id !== g.shapeId || !g.renderer || !g.runtime) return;
       g.reason = "";
+      g.basis = typeof msg.note === "string" ? msg.note : "";
       if (msg.reason) {
         g.reason = msg.reason;
       } else {
