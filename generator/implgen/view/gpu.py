@@ -18,6 +18,7 @@ from __future__ import annotations
 import logging
 
 from implgen.codegen.emit import generate
+from implgen.codegen.glsl import glsl_name
 from implgen.codegen.glslprogram import HEADERS, runtime_text
 from implgen.errors import UserError
 from implgen.scene.model import Csg, Leaf, Node
@@ -81,5 +82,6 @@ def program_message(doc: Document) -> dict:
             log.exception("GLSL generation failed")
             reason = "the GLSL target failed on this shape"
         else:
-            return {"type": "glsl", "name": spec.name, "shape": shape, "params": list(spec.params)}
+            prefix = glsl_name(spec.name)  # of the shape's GLSL identifiers
+            return {"type": "glsl", "name": spec.name, "glsl_name": prefix, "shape": shape, "params": list(spec.params)}
     return {"type": "glsl", "name": spec.name, "reason": reason}

@@ -93,7 +93,7 @@ const ImplgenGpu = (() => {
         g.reason = msg.reason;
       } else {
         const log = g.renderer.setEquationProgram({
-          name: msg.name, shape: msg.shape, runtime: g.runtime.runtime, header: g.runtime.header,
+          name: msg.glsl_name, shape: msg.shape, runtime: g.runtime.runtime, header: g.runtime.header,
           params: msg.params.length,
         });
         if (log) {
