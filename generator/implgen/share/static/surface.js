@@ -20,7 +20,7 @@ const IgSurface = (() => {
   const NAME = /^(?!gl_|webgl_)[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)*$/i;
   const SHAPE_FUNCTIONS = ["value", "gradient", "normal", "bounds", "raa", "hit"]; // glslprogram.SHAPE_FUNCTIONS
   const VERTEX = "#version 300 es\nin vec2 p;\nvoid main() { gl_Position = vec4(p, 0.0, 1.0); }\n";
-  const CLIPS = { none: 0, sphere: 1, box: 2 };
+  const CLIPS = Object.freeze(Object.assign(Object.create(null), { none: 0, sphere: 1, box: 2 })); // no prototype
   const MAX_LIGHTS = 4;
   const LIGHT = [-0.6, 0.8, 1.0]; // the default key light: towards it, in the camera's right, up and back
 
