@@ -17,7 +17,8 @@ import pytest
 
 from conftest import SHAPES_DIR
 from implgen.bench import glslcases, glslcheck
-from implgen.codegen.glslprogram import program
+from implgen.codegen.glsl import glsl_name
+from implgen.codegen.glslprogram import program, shape_defines
 from implgen.roots import exactray
 from implgen.spec.entry import load_spec, parse_spec
 
@@ -102,7 +103,7 @@ def test_grazing_rays(gl):
 
 
 def test_affine_forms_enclose_f(gl, rng):
-    """NAME_raa over random segments of random sizes: at points of the segment (its ends included), f evaluated
+    """The shape's _raa over random segments of random sizes: at points of the segment (its ends included), f evaluated
     exactly (rationals) lies within the form's centre + slope * e +- radius; and a point (slope 0) too."""
     shapes = [load_spec(p) for p in sorted(SHAPES_DIR.glob("*.yaml"))]
     shapes += [glslcases.chmutov(24, True), glslcases.chmutov(16, False)]
@@ -116,7 +117,7 @@ void main()
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec4 m = texelFetch(ig_test_orig, px, 0);
     vec4 s = texelFetch(ig_test_dir, px, 0);
-    ig_test_out = vec4(NAME_raa(vec3(m.x, s.x, 0.0), vec3(m.y, s.y, 0.0), vec3(m.z, s.z, 0.0)), 0.0);
+    ig_test_out = vec4(IG_SHAPE_RAA(vec3(m.x, s.x, 0.0), vec3(m.y, s.y, 0.0), vec3(m.z, s.z, 0.0)), 0.0);
 }
 """
     for spec in shapes:
@@ -129,8 +130,9 @@ void main()
         slope[: h // 2] = 0.0  # points: the radius is then rounding alone
         pad = np.zeros((h, w, 1), np.float32)
         params = {k: float(np.float32(v)) for k, v in spec.params.items()}
-        uniforms = {f"{spec.name}_params": list(params.values())} if params else {}
-        frag = program([glslcheck.glsl_text(spec)], main.replace("NAME", spec.name))
+        prefix = glsl_name(spec.name)
+        uniforms = {f"{prefix}_params": list(params.values())} if params else {}
+        frag = program([glslcheck.glsl_text(spec)], main, defines=shape_defines(prefix))
         out, _ = gl.run(frag, (w, h), uniforms, np.concatenate([m, pad], -1), np.concatenate([slope, pad], -1))
         terms = exactray.exact_terms(spec, params)
         for r, c in np.ndindex(h, w):

@@ -1,6 +1,6 @@
 """The GLSL backend without a browser: what `implgen --lang glsl` writes, what reaches the file's comments, the
-names GLSL refuses, and the constants of the affine code (each float with a bound that encloses the exact
-rational)."""
+names GLSL reserves (spelled another way, one-to-one), and the constants of the affine code (each float with a
+bound that encloses the exact rational)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,6 @@ from conftest import SHAPES_DIR
 from implgen.codegen import escape, glsl
 from implgen.codegen.command import main as generate_command
 from implgen.codegen.emit import generate
-from implgen.errors import UserError
 from implgen.spec.entry import load_spec, parse_spec
 
 
@@ -63,18 +62,64 @@ def test_hostile_file_name_stays_a_comment(tmp_path):
     assert "U+0022" in text.splitlines()[0]
 
 
-@pytest.mark.parametrize("name", ["gl_ball", "webgl_x", "my__shape"])
-def test_names_glsl_reserves_are_refused_for_glsl_only(tmp_path, capsys, name):
-    spec = parse_spec({"name": name, "equation": "x^2 + y^2 + z^2 - 1"}, "<t>")
-    assert set(generate(spec, ("c",))) == {f"{name}.h", f"{name}.c"}
-    with pytest.raises(UserError, match="reserved there"):
-        generate(spec, ("glsl",))
-    path = tmp_path / "s.yaml"
-    path.write_text(f"name: {name}\nequation: x^2 + y^2 + z^2 - 1\n")
-    from implgen.cli import main
+# A name as names.py takes it: these are the ones GLSL would not take as they are.
+GLSL_AWKWARD = ["gl_ball", "GL_ball", "webgl_x", "my__shape", "ball_", "a___b_"]
+IDENTIFIER = st.from_regex(r"[A-Za-z][A-Za-z0-9_]{0,63}", fullmatch=True)
+RESERVED = re.compile(r"__|^gl_|^webgl_|^_webgl_")
 
-    assert main([str(path), "--lang", "glsl", "-o", str(tmp_path / "out")]) == 2
-    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+def _unspelled(text: str) -> str:
+    """glsl.py's spelling undone, independently: each _u read back as _."""
+    assert re.fullmatch(r"[A-Za-z0-9]*(_u[A-Za-z0-9]*)*", text), text
+    return "_".join(part[1:] if i else part for i, part in enumerate(text.split("_")))
+
+
+@settings(max_examples=500, deadline=None)
+@given(IDENTIFIER)
+def test_a_name_makes_identifiers_glsl_takes_one_to_one(name):
+    """glsl_name: the name itself when GLSL takes <name>_hit, else ig_shape_ and the name read back from it;
+    param_local: k_<name>, else k0_ ... _u read back likewise, and never a shape's own identifier."""
+    prefix, local = glsl.glsl_name(name), glsl.param_local(name)
+    for ident in [local] + [f"{prefix}_{s}" for s in glsl.SUFFIXES]:
+        assert not RESERVED.search(ident) and re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", ident), ident
+    if RESERVED.search(f"{name}_hit") or name.lower().startswith(("gl_", "webgl_")):
+        assert prefix.startswith("ig_shape_") and _unspelled(prefix[len("ig_shape_") :]) == name
+    else:
+        assert prefix == name
+    if local.startswith("k0_"):
+        assert local.endswith("_u") and _unspelled(local[3:-2]) == name
+    else:
+        assert local == f"k_{name}" and "__" not in name
+    assert local.rsplit("_", 1)[1] not in glsl.SUFFIXES  # no <any prefix>_<suffix>: a local hides none
+
+
+@pytest.mark.parametrize("name", GLSL_AWKWARD)
+def test_names_glsl_reserves_are_spelled_for_glsl(name):
+    """Each generated identifier is one GLSL takes: none holds __ or starts gl_ or webgl_; the C is unchanged."""
+    spec = parse_spec(
+        {
+            "name": name,
+            "equation": "x^2 + y^2 + z^2 - a__b*params + value_",
+            "params": {"a__b": 1, "params": 1, "value_": 0},
+        },
+        "<t>",
+    )
+    assert set(generate(spec, ("c",))) == {f"{name}.h", f"{name}.c"}
+    text = generate(spec, ("glsl",))[f"{name}.glsl"]
+    code = "\n".join(line.split("//")[0] for line in text.splitlines())
+    idents = set(re.findall(r"\b[A-Za-z_][A-Za-z0-9_]*", code))
+    assert not [i for i in idents if RESERVED.search(i)]
+    prefix = glsl.glsl_name(name)
+    assert prefix != name and f"int {prefix}_hit(vec3 o" in text and f"uniform float {prefix}_params[3];" in text
+    assert f"its GLSL identifiers start {prefix}" in text
+
+
+def test_a_param_never_hides_the_shape_s_own_identifiers():
+    """Shape `k`, param `params`: the local k_params would hide the uniform k_params in GLSL."""
+    spec = parse_spec({"name": "k", "equation": "x^2 + y^2 + z^2 - params*b", "params": {"params": 1, "b": 1}}, "<t>")
+    text = generate(spec, ("glsl",))["k.glsl"]
+    declared = re.findall(r"^\s+float (\w+) = k_params\[(\d)\];", text, re.M)
+    assert declared and {d for d, _ in declared} == {"k0_params_u", "k_b"}
 
 
 RATIONALS = [

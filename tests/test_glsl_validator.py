@@ -5,7 +5,6 @@ offer."""
 
 from __future__ import annotations
 
-import subprocess
 from pathlib import Path
 
 import pytest
@@ -13,8 +12,10 @@ import pytest
 from conftest import GENERATED, SHAPE_NAMES
 from implgen.bench.glslcases import chmutov
 from implgen.codegen.emit import generate
-from implgen.codegen.glslprogram import program
+from implgen.codegen.glsl import glsl_name
+from implgen.codegen.glslprogram import program, shape_defines
 from implgen.spec.entry import parse_spec
+from page_shader import glslang_problems
 
 pytestmark = pytest.mark.needs_program("glslangValidator")
 
@@ -33,27 +34,27 @@ void main()
     bool in_box = ig_clip_box(cam.eye, d, vec3(-2.0), vec3(2.0), t0, t1);
     float t;
     vec3 n;
-    int status = NAME_hit(cam.eye, d, t0, t1, t, n);
+    int status = IG_SHAPE_HIT(cam.eye, d, t0, t1, t, n);
     vec3 lo, hi;
-    bool bounded = NAME_bounds(lo, hi);
+    bool bounded = IG_SHAPE_BOUNDS(lo, hi);
     vec3 p = cam.eye + t * d;
-    vec3 f = NAME_raa(vec3(p.x, 0.1, 1e-6), vec3(p.y, 0.0, 0.0), vec3(p.z, -0.1, 0.0));
-    vec3 rgb = ig_shade(ig_material_default(), NAME_normal(p), d, vec3(1.0, 2.0, 1.0));
+    vec3 f = IG_SHAPE_RAA(vec3(p.x, 0.1, 1e-6), vec3(p.y, 0.0, 0.0), vec3(p.z, -0.1, 0.0));
+    vec3 rgb = ig_shade(ig_material_default(), IG_SHAPE_NORMAL(p), d, vec3(1.0, 2.0, 1.0));
     if ((status & IG_UNSURE) != 0) {
         rgb = ig_mark_unsure(rgb, pixel);
     }
-    float v = NAME_value(p) + NAME_gradient(p).x + f.x + float(ig_ray_steps);
+    float v = IG_SHAPE_VALUE(p) + IG_SHAPE_GRADIENT(p).x + f.x + float(ig_ray_steps);
     colour = vec4(rgb, (in_sphere && in_box && bounded) ? v + lo.x + hi.y : 0.0);
 }
 """
 
 
 def _validate(tmp_path: Path, name: str, shape: str) -> None:
+    """Errors and warnings alike fail (glslangValidator only warns about identifiers that hold __)."""
     for target in ("es", "450"):
-        source = tmp_path / f"{name}_{target}.frag"
-        source.write_text(program([shape], MAIN.replace("NAME", name), target))
-        proc = subprocess.run(["glslangValidator", str(source)], capture_output=True, text=True)
-        assert proc.returncode == 0, f"{name} as {target}:\n{proc.stdout}{proc.stderr}"
+        text = program([shape], MAIN, target, shape_defines(glsl_name(name)))
+        problems = glslang_problems(text, tmp_path / f"{name}_{target}.frag")
+        assert not problems, f"{name} as {target}:\n{problems}"
 
 
 @pytest.mark.parametrize("name", SHAPE_NAMES)
@@ -79,3 +80,20 @@ def test_awkward_constants_and_params_compile(tmp_path):
         "<test>",
     )
     _validate(tmp_path, "awkward", generate(spec, ("glsl",))["awkward.glsl"])
+
+
+@pytest.mark.parametrize("name", ["ball_", "a__b", "gl_ball", "webgl_ball", "k", "MAX_LIGHTS"])
+def test_names_glsl_reserves_or_that_hide_the_shape_s_compile(tmp_path, name):
+    """Names whose identifiers GLSL reserves (spelled another way: codegen/glsl.py glsl_name, param_local), and
+    params whose locals would hide the shape's own identifiers (shape k: k_params, k_value), all in use."""
+    params = {"params": 1.0, "value": 0.5, "a__b": 2.0, "c_": 0.25, "gl_x": 1.0, "x_hit": 0.0}
+    spec = parse_spec(
+        {
+            "name": name,
+            "equation": "x^2 + y^2 + z^2 - params*value + a__b*c_ - gl_x + x_hit*z",
+            "params": params,
+            "bounds": {"x": ["-params - a__b", "value + c_"], "z": ["-gl_x - x_hit", 2]},
+        },
+        "<test>",
+    )
+    _validate(tmp_path, name, generate(spec, ("glsl",))[f"{name}.glsl"])

@@ -20,12 +20,16 @@ import time
 
 import numpy as np
 import pytest
+import yaml
 from PIL import Image
 
+import needs_program
+import page_shader
 from conftest import SHAPES_DIR
 from implgen.cli import main
 from implgen.codegen.emit import generate
-from implgen.codegen.glslprogram import program
+from implgen.codegen.glsl import glsl_name
+from implgen.codegen.glslprogram import program, shape_defines
 from implgen.spec.entry import load_spec, parse_spec
 
 pytestmark = pytest.mark.needs_program("chromium", "chromedriver")
@@ -53,12 +57,12 @@ void main()
     vec3 d = ig_camera_dir(cam, pixel, size);
     float t0 = 0.0, t1 = ig_inf(), t;
     vec3 n;
-    int status = ig_clip_sphere(cam.eye, d, vec3(0.0), clip_r, t0, t1) ? NAME_hit(cam.eye, d, t0, t1, t, n) : 0;
+    int status = ig_clip_sphere(cam.eye, d, vec3(0.0), clip_r, t0, t1) ? IG_SHAPE_HIT(cam.eye, d, t0, t1, t, n) : 0;
     vec3 to_light = light.x * cam.u + light.y * cam.v + light.z * cam.w;
-    vec3 rgb = (status & IG_HIT) != 0 ? ig_shade(IgMaterial(outside, inside, MATERIAL), n, d, to_light) : bg;
+    vec3 rgb = (status & IG_HIT) != 0 ? ig_shade(IgMaterial(outside, inside, IG_TEST_MATERIAL), n, d, to_light) : bg;
     ig_test_out = vec4(clamp(rgb, 0.0, 1.0), float(status));
 }
-""".replace("MATERIAL", MATERIAL)
+"""
 
 
 @pytest.fixture(scope="module")
@@ -93,9 +97,20 @@ def open_page(gl, path, size=SIZE):
         time.sleep(0.05)
     err = d.execute_script("return window.implgenShare.error || '';")
     assert not err, err
+    check_shader(d, path)
     d.execute_script("implgenShare.fixSize(arguments[0], arguments[1]);", *size)
     wait_idle(d)
     return d
+
+
+def check_shader(d, path) -> None:
+    """The fragment shader the page compiled is the one tests/page_shader.py reads from a page (which
+    tests/test_share_command.py checks), and glslangValidator passes it, warnings included."""
+    fragment = d.execute_script("return implgenShare.renderer.fragment;")
+    assert fragment == page_shader.page_fragment(d, path.read_text(encoding="utf-8"))
+    if not needs_program.missing(("glslangValidator",)):
+        problems = page_shader.glslang_problems(fragment, path.with_suffix(".frag"))
+        assert not problems, problems
 
 
 def canvas(d) -> np.ndarray:
@@ -151,9 +166,11 @@ def reference(gl, spec, state: dict, size=SIZE) -> np.ndarray:
         "bg": state["colours"]["background"],
         "light": LIGHT,
     }
+    prefix = glsl_name(spec.name)
     if spec.params:
-        uniforms[f"{spec.name}_params"] = state["params"]
-    frag = program([generate(spec, ("glsl",))[f"{spec.name}.glsl"]], REFERENCE_MAIN.replace("NAME", spec.name))
+        uniforms[f"{prefix}_params"] = state["params"]
+    defines = {**shape_defines(prefix), "IG_TEST_MATERIAL": MATERIAL}
+    frag = program([generate(spec, ("glsl",))[f"{spec.name}.glsl"]], REFERENCE_MAIN, defines=defines)
     gl.harness()
     out, _ = gl.run(frag, size, uniforms)
     return out
@@ -226,6 +243,38 @@ def test_a_slider_moves_the_picture(gl, tmp_path):
     bg = np.round(np.asarray(state["colours"]["background"]) * 255)
     hit_before = (np.abs(before[..., :3].astype(int) - bg) > 2).any(-1)
     assert r["page_hit"].sum() > 1.3 * hit_before.sum()
+
+
+def test_names_of_javascript_s_and_glsl_s_own_draw(gl, tmp_path):
+    """A shape called ball_ (its GLSL functions would be ball__hit, reserved) with params named as
+    Object.prototype's members and one with __: the page compiles (open_page checks its shader), draws the
+    reference's picture, and the slider of `constructor` moves it."""
+    params = {"constructor": 1.0, "toString": 0.81, "valueOf": 0.5, "hasOwnProperty": 0.2, "a__b": 0.1}
+    spec_path = tmp_path / "ball_.yaml"
+    equation = "x^2 + y^2 + z^2 - constructor*toString + valueOf*hasOwnProperty - a__b"
+    box = {axis: [-1.5, 1.5] for axis in "xyz"}
+    spec_path.write_text(
+        yaml.safe_dump({"name": "ball_", "equation": equation, "params": params, "bounds": box}, sort_keys=False)
+    )
+    spec = load_spec(spec_path)
+    d = open_page(gl, make_page(tmp_path, spec_path))
+    labels = d.execute_script("return [...document.querySelectorAll('input[data-param]')].map((s) => s.ariaLabel);")
+    assert labels == list(params)
+    state = page_state(d)
+    assert state["params"] == list(params.values())
+    r = compare(canvas(d), reference(gl, spec, state), state["colours"]["background"])
+    before = r["page_hit"].sum()
+    assert before > 0.05 * r["page_hit"].size
+    d = open_page(gl, spec_path.with_suffix(".html"))
+    d.execute_script(
+        "const s = document.querySelector('input[data-param=\"0\"]'); s.value = '1.5';"
+        "s.dispatchEvent(new Event('input')); s.dispatchEvent(new Event('change'));"
+    )
+    wait_idle(d)
+    state = page_state(d)
+    assert state["params"][0] == 1.5
+    r = compare(canvas(d), reference(gl, spec, state), state["colours"]["background"])
+    assert r["page_hit"].sum() > 1.2 * before
 
 
 def test_drag_turns_the_wheel_zooms_and_the_keys_turn(gl, tmp_path):

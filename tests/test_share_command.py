@@ -16,10 +16,14 @@ import re
 from html.parser import HTMLParser
 
 import pytest
+import yaml
 
+import needs_program
+import page_shader
 from conftest import ROOT, SHAPES_DIR
 from implgen.cli import main
 from implgen.codegen.emit import generate
+from implgen.codegen.glsl import glsl_name
 from implgen.codegen.glslprogram import HEADERS, runtime_text
 from implgen.share.page import script_json
 from implgen.spec.entry import load_spec
@@ -58,6 +62,30 @@ def share(tmp_path, *args: str, capsys=None) -> tuple[int, str]:
     code = main(["share", *args])
     err = capsys.readouterr().err if capsys else ""
     return code, err
+
+
+@pytest.fixture(scope="module")
+def browser():
+    """Headless Chromium that runs the pages' own surface.js (started by the first test that needs it)."""
+    lazy = page_shader.LazyChromium()
+    yield lazy
+    lazy.quit()
+
+
+@pytest.fixture(autouse=True)
+def every_page_s_shader_compiles(tmp_path, tmp_path_factory, browser):
+    """After each test: every page it wrote has a fragment shader (as the page's JavaScript puts it together)
+    that glslangValidator passes, warnings included. Where Chromium or glslangValidator is missing this is left
+    out; the tests that write pages for this check say they need them (and fail under IMPLGEN_REQUIRE_ALL)."""
+    yield
+    pages = page_shader.shared_pages(tmp_path)
+    if not pages or needs_program.missing(("glslangValidator", "chromium", "chromedriver")):
+        return
+    folder = tmp_path_factory.mktemp("frag")
+    for page in pages:
+        fragment = page_shader.page_fragment(browser(), page.read_text(encoding="utf-8"))
+        problems = page_shader.glslang_problems(fragment, folder / "page.frag")
+        assert not problems, f"{page.name}:\n{problems}"
 
 
 def parse_page(path):
@@ -218,15 +246,12 @@ BAD = [
     (["{torus}", "--object", "torus_y", "-o", "{tmp}/page.html"], "is a shape spec, not a scene"),
     (["{scene}", "-o", "{tmp}/page.html"], "--object NAME"),
     (["{scene}", "--object", "cube", "-o", "{tmp}/page.html"], "no shape of that name"),
-    (["{tmp}/in/webgl_ball.yaml", "-o", "{tmp}/page.html"], "cannot name GLSL functions"),
 ]
 
 
 @pytest.mark.parametrize("argv,message", BAD, ids=[" ".join(a[1:])[:50] for a, _ in BAD])
 def test_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, argv, message):
     values = {"torus": str(SHAPES_DIR / "torus_y.yaml"), "scene": str(SCENES_DIR / "torus_shadow.yaml")}
-    (tmp_path / "in").mkdir()
-    (tmp_path / "in" / "webgl_ball.yaml").write_text("name: webgl_ball\nequation: x^2 + y^2 + z^2 - 1\n")
     argv = [a.format(tmp=tmp_path, **values) for a in argv]
     before = sorted(tmp_path.rglob("*"))
     code = main(["share", *argv])
@@ -236,32 +261,42 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, argv, messag
     assert sorted(tmp_path.rglob("*")) == before
 
 
-def _page_fragment(html: str) -> tuple[str, str]:
-    """The fragment shader a page compiles, assembled as surface.js's fragmentSource does: the header, the
-    runtime and the shape from the JSON block, the main from surface.js's MAIN (SHAPE and MAX_LIGHTS replaced)."""
-    p = Elements()
-    p.feed(html)
-    data = page_data(p)
-    surface = p.raw["script"][1]
-    main_src = re.search(r"const MAIN = `(.*?)`;", surface, re.S).group(1)
-    lights = re.search(r"const MAX_LIGHTS = (\d+);", surface).group(1)
-    assert data["header"] == HEADERS["es"]  # the one source of the GLSL ES header
-    main_src = main_src.replace("SHAPE", data["name"]).replace("MAX_LIGHTS", lights)
-    return data["name"], data["header"] + data["runtime"] + "\n" + data["shape"] + "\n" + main_src
-
-
-@pytest.mark.needs_program("glslangValidator")
+@pytest.mark.needs_program("glslangValidator", "chromium", "chromedriver")
 @pytest.mark.parametrize("spec_path", sorted(SHAPES_DIR.glob("*.yaml")), ids=lambda p: p.stem)
 def test_every_example_page_shader_compiles_as_es300(tmp_path, capsys, spec_path):
     """What the page compiles, for every example shape, through Khronos' reference compiler (the browser tests
-    compile a few shapes in Chromium; this covers them all)."""
-    import subprocess
-
+    compile a few shapes in Chromium; this covers them all). The check itself is every_page_s_shader_compiles."""
     out = tmp_path / "page.html"
     assert share(tmp_path, str(spec_path), "-o", str(out), capsys=capsys)[0] == 0
-    name, fragment = _page_fragment(out.read_text(encoding="utf-8"))
-    assert name == spec_path.stem
-    source = tmp_path / "page.frag"
-    source.write_text(fragment)
-    proc = subprocess.run(["glslangValidator", str(source)], capture_output=True, text=True)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
+    data = page_data(parse_page(out)[1])
+    assert data["glsl_name"] == spec_path.stem and data["header"] == HEADERS["es"]  # the header's one source
+
+
+# Names that make GLSL identifiers GLSL reserves (__, gl_, webgl_), that a page's text once held in its own
+# (MAX_LIGHTS, SHAPE), that would hide the shape's own identifiers (shape k, param params), and JavaScript's own.
+AWKWARD_NAMES = {
+    "ball_": {"a__b": 1.0, "value_": 0.0},
+    "MAX_LIGHTS_ball": {"MAX_LIGHTS": 1.0},
+    "SHAPE_ball": {"SHAPE_hit": 1.0},
+    "k": {"params": 1.0, "b": 1.0},
+    "gl_ball": {"constructor": 1.0, "toString": 1.0, "valueOf": 0.0, "hasOwnProperty": 0.0},
+    "webgl_ball": {"gl_x": 1.0},
+}
+
+
+@pytest.mark.needs_program("glslangValidator", "chromium", "chromedriver")
+@pytest.mark.parametrize("name", AWKWARD_NAMES)
+def test_a_page_for_names_glsl_or_the_page_would_misread(tmp_path, capsys, name):
+    """Exit 0 and a page whose shader compiles (every_page_s_shader_compiles); the C backend takes these names
+    too. The page's shape functions are the spelled ones (codegen/glsl.py glsl_name)."""
+    params = AWKWARD_NAMES[name]
+    terms = " + ".join(f"{p}*{p}" for p in params)
+    spec = tmp_path / "awkward.yaml"
+    spec.write_text(
+        yaml.safe_dump({"name": name, "equation": f"x^2 + y^2 + z^2 - 1 + {terms}", "params": params}, sort_keys=False)
+    )
+    out = tmp_path / "page.html"
+    assert share(tmp_path, str(spec), "-o", str(out), capsys=capsys)[0] == 0
+    data = page_data(parse_page(out)[1])
+    assert data["name"] == name and data["glsl_name"] == glsl_name(name)
+    assert f"int {data['glsl_name']}_hit(" in data["shape"]

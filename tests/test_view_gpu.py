@@ -50,6 +50,7 @@ def test_the_hello_and_the_glsl_of_each_shape(client) -> None:
         assert first == {
             "type": "glsl",
             "name": "torus",
+            "glsl_name": "torus",  # the prefix of its GLSL identifiers: the name, where GLSL takes it
             "shape": generate(doc.spec, ("glsl",))["torus.glsl"],
             "params": ["a", "b"],
             "shape_id": 0,
@@ -58,9 +59,16 @@ def test_the_hello_and_the_glsl_of_each_shape(client) -> None:
         shape = reply(ws)
         ws.send_text(json.dumps({"type": "glsl"}))
         second = reply(ws)
+        ws.send_text(json.dumps({"type": "shape", "equation": "x^2 + y^2 + z^2 - 1", "name": "ball_"}))
+        reply(ws)
+        ws.send_text(json.dumps({"type": "glsl"}))
+        third = reply(ws)
     assert shape["shape_id"] == second["shape_id"] == 1
     assert second["params"] == ["r"] and second["name"] == shape["name"]
     assert "f(x, y, z) = -r^2 + x^2 + y^2 + z^2" in second["shape"] and second["shape"] != first["shape"]
+    # ball__hit would be reserved in GLSL: the page gets the prefix the shape's GLSL uses (codegen/glsl.py)
+    assert third["name"] == "ball_" and third["glsl_name"] == "ig_shape_ball_u"
+    assert "int ig_shape_ball_u_hit(vec3 o" in third["shape"]
 
 
 def test_a_scene_file_is_drawn_by_the_server_and_says_why(tmp_path) -> None:

@@ -13,6 +13,8 @@ import io
 import os
 import shutil
 import time
+from pathlib import Path
+from urllib.parse import urlencode
 
 import numpy as np
 import pytest
@@ -56,6 +58,16 @@ CSG_SCENE = {
     "lights": [{"position": [3, 5, 5], "color": [1, 1, 1]}],
     "objects": [{"difference": [{"equation": "x^2 + y^2 + z^2 - 1"}, {"equation": "x^2 + (y - 0.8)^2 + z^2 - 0.36"}]}],
 }
+
+
+# A shape called MAX_LIGHTS_ball (the page's main once had MAX_LIGHTS replaced in it) whose params are named as
+# Object.prototype's members (issue 31): its file is in the fuzz corpus.
+PROTOTYPE_SPEC = Path(__file__).resolve().parent / "fuzz_corpus" / "object-prototype-param-names.yaml"
+PROTOTYPE_NAMES = ["constructor", "toString", "valueOf", "hasOwnProperty"]
+CATCH_ERRORS = "window.pageErrors = []; addEventListener('error', (e) => window.pageErrors.push(String(e.message)));"
+SLIDERS = (
+    "return [...document.querySelectorAll('input[type=range][data-name]')].map((s) => [s.dataset.name, +s.value]);"
+)
 
 
 @pytest.fixture(scope="module")
@@ -381,3 +393,40 @@ def test_past_the_glsl_budget_the_page_says_the_gpu_draws_the_tree(tmp_path, dri
         d.find_element("id", "export-page").click()
         message = "return document.getElementById('message').textContent"
         until(d, lambda d: js(d, message).startswith("the exported page's shader: "), "Export page said nothing")
+
+
+def test_params_named_as_object_prototype_s_members(driver) -> None:
+    """constructor, toString, valueOf and hasOwnProperty as params, from a spec file and from a share link whose
+    values name __proto__ too: a slider for each, the server's picture, the GPU's (its shader compiles, and the
+    constructor slider sets its uniform), no script error; the link's value reaches its slider."""
+    d = driver
+    with view_process(str(PROTOTYPE_SPEC)) as url:
+        open_page(d, url, script=CATCH_ERRORS)
+        assert js(d, SLIDERS) == [[n, v] for n, v in zip(PROTOTYPE_NAMES, [1.0, 1.0, 0.5, 0.5])]
+        picture = png(d, "view")
+        assert (np.abs(picture - picture[0, 0]).max(axis=2) > 8).mean() > 0.05  # the ball, not the background
+        until(d, lambda d: view_state(d)["path"] == "gpu", "the GPU preview did not start")
+        drawn = view_state(d)["gl_frames"]
+        js(
+            d,
+            "const s = document.querySelector('input[type=range][data-name=constructor]');"
+            "s.value = 1.3; s.dispatchEvent(new Event('input'));",
+        )
+        until(d, lambda d: abs(js(d, "return implgenGpu.renderer().params[0]") - 1.3) < 1e-6, "no uniform set")
+        until(d, lambda d: view_state(d)["gl_frames"] > drawn, "the GPU drew nothing")
+        assert js(d, "return window.pageErrors") == []
+
+        values = "constructor:1.2,toString:1,valueOf:0.5,hasOwnProperty:0.5,__proto__:3"
+        params = ", ".join(f"{n} = {v}" for n, v in zip(PROTOTYPE_NAMES, [1, 1, 0.5, 0.5]))
+        eq = "x^2 + y^2 + z^2 - constructor*toString + valueOf*hasOwnProperty"
+        link = {"v": "1", "eq": eq, "name": "MAX_LIGHTS_ball", "params": params, "values": values}
+        d.get("about:blank")
+        open_page(d, f"{url}#{urlencode(link)}", script=CATCH_ERRORS)
+        until(d, lambda d: js(d, "return window.implgenState().values.constructor") == 1.2, "the link's value")
+        decoded = "return Object.keys(implgenLink.decode(arguments[0]).view.values)"
+        assert js(d, decoded, "#" + urlencode(link)) == [*PROTOTYPE_NAMES, "__proto__"]  # a key like any other
+        shown = dict(js(d, SLIDERS))
+        assert sorted(shown) == sorted(PROTOTYPE_NAMES) and shown["constructor"] == 1.2
+        assert js(d, "return document.getElementById('message').textContent") == ""
+        until(d, lambda d: view_state(d)["path"] == "gpu", "the GPU preview did not start from the link")
+        assert js(d, "return window.pageErrors") == []

@@ -17,7 +17,8 @@ from types import ModuleType
 import numpy as np
 
 from implgen.codegen.emit import generate
-from implgen.codegen.glslprogram import program
+from implgen.codegen.glsl import glsl_name
+from implgen.codegen.glslprogram import program, shape_defines
 from implgen.roots import exactray
 from implgen.scene.camera import camera_rays as scene_camera_rays
 from implgen.scene.model import Camera
@@ -36,7 +37,7 @@ void main()
     vec4 d = texelFetch(ig_test_dir, px, 0);
     float t;
     vec3 n;
-    int status = NAME_hit(o.xyz, d.xyz, o.w, d.w, t, n);
+    int status = IG_SHAPE_HIT(o.xyz, d.xyz, o.w, d.w, t, n);
     ig_test_out = vec4(float(status), t, float(ig_ray_steps), length(n));
 }
 """
@@ -97,10 +98,11 @@ def glsl_text(spec) -> str:
 
 def run_glsl(gl, case: Case, defines: dict[str, str] | None = None, band: int = 32) -> dict:
     """The generated GLSL over the case's rays in the browser: status, t, steps per ray, and draw time (ms)."""
-    frag = program([glsl_text(case.spec)], RAY_MAIN.replace("NAME", case.spec.name), "es", defines)
+    prefix = glsl_name(case.spec.name)
+    frag = program([glsl_text(case.spec)], RAY_MAIN, "es", {**shape_defines(prefix), **(defines or {})})
     orig = np.concatenate([case.origins, case.tmin[..., None]], -1)
     dirs = np.concatenate([case.dirs, case.tmax[..., None]], -1)
-    uniforms = {f"{case.spec.name}_params": list(case.params.values())} if case.params else {}
+    uniforms = {f"{prefix}_params": list(case.params.values())} if case.params else {}
     out, ms = gl.run(frag, case.size, uniforms, orig, dirs, band)
     status = out[..., 0].astype(np.int32)
     return {"status": status, "t": out[..., 1], "steps": out[..., 2].astype(np.int32), "ms": ms}

@@ -23,8 +23,8 @@ from sympy.printing.precedence import PRECEDENCE
 
 from implgen.codegen.chebform import ChebForm, OverBudget, better_form
 from implgen.codegen.derive import Derivation
-from implgen.errors import UserError
-from implgen.spec.parse import X, Y, Z
+from implgen.codegen.glslprogram import SHAPE_FUNCTIONS
+from implgen.spec.parse import X, Y, Z, param_symbol
 
 _F32_MAX = Fraction(float(np.finfo(np.float32).max))
 _MIN_NORMAL = Fraction(2) ** -126  # GPUs may flush anything smaller to zero
@@ -77,6 +77,44 @@ def constant_code(q: Fraction) -> str:
     return parts[0] if len(parts) == 1 else "(" + " * ".join(parts) + ")"
 
 
+# Identifiers. GLSL reserves every identifier that holds two consecutive underscores (GLSL ES 3.00 and 4.50,
+# section 3.7; WebGL refuses them) and those that start gl_; WebGL those that start webgl_ or _webgl_. A spec's
+# names are checked as C and Python identifiers (codegen/names.py) and may still make such identifiers here: a
+# shape `ball_` would define `ball__hit`, a param `a__b` the local `k_a__b`. Rather than refuse a spec the
+# other backends take, such names are written another way, one-to-one (docs/glsl.md, "Names"):
+_GLSL_RESERVED_PREFIXES = ("gl_", "webgl_")
+# the shape's own identifiers are <prefix>_<suffix> (templates/glsl/shape.glsl.j2)
+SUFFIXES = (*SHAPE_FUNCTIONS, "params")
+MANGLED_SHAPE = "ig_shape_"  # names.py refuses shape names that start ig_, so no kept name starts so
+MANGLED_PARAM = "k0_"  # a kept param's local starts k_
+
+
+def _spelled(name: str) -> str:
+    """`name` with each _ written _u: no two underscores meet, nothing ends in _, and reading each _u back as _
+    gives `name` again."""
+    return "".join("_u" if ch == "_" else ch for ch in name)
+
+
+def glsl_name(name: str) -> str:
+    """The prefix of a shape's GLSL identifiers (`<prefix>_hit`, `<prefix>_params`, ...): the shape's name,
+    unless the identifiers it makes are reserved in GLSL (the name holds __, ends in _ or starts gl_ or
+    webgl_); then ig_shape_ and the name spelled with _u (`ball_` -> `ig_shape_ball_u`)."""
+    if "__" in name or name.endswith("_") or name.lower().startswith(_GLSL_RESERVED_PREFIXES):
+        return MANGLED_SHAPE + _spelled(name)
+    return name
+
+
+def param_local(name: str) -> str:
+    """The local variable that holds a param in the shape's GLSL functions: k_<name>, unless that holds __ or
+    ends like a shape's own identifier (`_value`, ..., `_params`: a param `params` of a shape `k` would hide
+    the uniform `k_params`); then k0_, the name spelled with _u, and _u (`a__b` -> `k0_a_u_ub_u`), which ends
+    in no suffix."""
+    local = f"k_{name}"
+    if "__" in name or local.endswith(tuple(f"_{s}" for s in SUFFIXES)):
+        return MANGLED_PARAM + _spelled(name) + "_u"
+    return local
+
+
 class GLSLPrinter(C99CodePrinter):
     """Float code for GLSL ES 3.00 and 4.50: every number a float literal (GLSL has no implicit int to float),
     integer powers as products (GLSL's pow() is undefined for a negative base), open box sides as IG_OPEN."""
@@ -89,6 +127,12 @@ class GLSLPrinter(C99CodePrinter):
 
     def _print_Infinity(self, expr: sympy.Expr) -> str:  # noqa: N802
         return "IG_OPEN"
+
+    def _print_Symbol(self, expr: sympy.Symbol) -> str:  # noqa: N802
+        name = expr.name
+        if name.startswith("k_") and expr == param_symbol(name[2:]):  # a param: its local (param_local)
+            return param_local(name[2:])
+        return super()._print_Symbol(expr)
 
     def _print_NegativeInfinity(self, expr: sympy.Expr) -> str:  # noqa: N802
         return "-IG_OPEN"
@@ -246,18 +290,13 @@ def affine_code(f: sympy.Expr, params: dict[sympy.Symbol, str]) -> tuple[list[st
     return code.lines, code.node(reduced)
 
 
-_GLSL_RESERVED_PREFIXES = ("gl_", "webgl_", "_webgl_")
-
-
 def glsl_extra(derivation: Derivation) -> dict:
-    """What the GLSL templates need beyond the printed blocks: the affine code and the params' uniform."""
+    """What the GLSL templates need beyond the printed blocks: the affine code, the prefix of the shape's
+    identifiers, the params' uniform and their local variables."""
     spec = derivation.spec
-    low = spec.name.lower()
-    if low.startswith(_GLSL_RESERVED_PREFIXES) or "__" in spec.name:
-        raise UserError(
-            spec.source, f"name: {spec.name!r} cannot name GLSL functions (gl_, webgl_ and __ are reserved there)"
-        )
-    uniform = f"{spec.name}_params"
+    prefix = glsl_name(spec.name)
+    uniform = f"{prefix}_params"
+    locals_ = {s.name: param_local(p) for p, s in zip(spec.params, spec.param_symbols)}
     params = {s: f"{uniform}[{i}]" for i, s in enumerate(spec.param_symbols)}
     form, cut = None, False
     if not params:
@@ -273,4 +312,9 @@ def glsl_extra(derivation: Derivation) -> dict:
     else:
         lines, result = chebyshev_affine_code(form)
         basis = "the Chebyshev basis of the box, which float evaluates far better than the tree as written"
-    return {"uniform": uniform, "raa": {"lines": lines, "result": result, "basis": basis}}
+    return {
+        "prefix": prefix,
+        "uniform": uniform,
+        "param_locals": locals_,
+        "raa": {"lines": lines, "result": result, "basis": basis},
+    }

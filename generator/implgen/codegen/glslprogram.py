@@ -6,6 +6,7 @@ A generated `<name>.glsl` has no #version line, so one file serves WebGL2 (GLSL 
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from functools import lru_cache
 
@@ -15,6 +16,12 @@ HEADERS = {
     "es": "#version 300 es\nprecision highp float;\nprecision highp int;\n",
     "450": "#version 450\n",
 }
+# A shape's functions are <prefix>_value, ... (templates/glsl/shape.glsl.j2; the prefix: codegen/glsl.py
+# glsl_name). A main written once for any shape calls them as IG_SHAPE_VALUE, ..., IG_SHAPE_HIT: #defines of
+# the program's one shape's (shape_defines), never text put into the main.
+SHAPE_FUNCTIONS = ("value", "gradient", "normal", "bounds", "raa", "hit")
+# what glsl_name gives: letters and digits in runs joined by single underscores, not gl_ or webgl_ first
+_PREFIX = re.compile(r"(?!gl_|webgl_)[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)*\Z", re.IGNORECASE)
 
 
 @lru_cache(maxsize=1)
@@ -31,3 +38,10 @@ def program(shapes: Sequence[str], main: str, target: str = "es", defines: dict[
     lines = [HEADERS[target]]
     lines += [f"#define {k} {v}\n" for k, v in (defines or {}).items()]
     return "".join(lines) + runtime_text() + "".join(s + "\n" for s in shapes) + main
+
+
+def shape_defines(prefix: str) -> dict[str, str]:
+    """IG_SHAPE_VALUE, ..., IG_SHAPE_HIT as the functions of the shape whose identifiers start `prefix`."""
+    if not _PREFIX.match(prefix):
+        raise ValueError(f"not the prefix of a shape's GLSL identifiers: {prefix!r}")
+    return {f"IG_SHAPE_{s.upper()}": f"{prefix}_{s}" for s in SHAPE_FUNCTIONS}

@@ -62,7 +62,7 @@ def _parser() -> ArgumentParser:
 
 
 def _params(spec, pairs: Sequence[str]) -> dict[str, float]:
-    """--param NAME=VALUE items: named as `implgen share` names them (codegen.paramvalues.named_items), each a
+    """--param NAME=VALUE items: named as `implgen share` names them (spec.paramvalues.named_items), each a
     number or a constant's name, then checked against the shape."""
     out = {
         k: validate.number("--param", k, v.strip(), text_ok=True)

@@ -28,6 +28,7 @@ import jinja2
 
 from implgen import __version__
 from implgen.codegen.emit import generate
+from implgen.codegen.glsl import glsl_name
 from implgen.codegen.glslprogram import HEADERS, runtime_text
 from implgen.spec.model import Spec
 
@@ -155,6 +156,7 @@ def render_page(spec: Spec, sliders: list[Slider], look: Look, source_name: str,
     shape = generate(spec, ("glsl",))[f"{spec.name}.glsl"]
     data = {
         "name": spec.name,
+        "glsl_name": glsl_name(spec.name),  # the prefix of the shape's GLSL identifiers
         "shape": shape,
         "runtime": runtime_text(),
         "header": HEADERS["es"],

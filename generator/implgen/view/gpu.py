@@ -23,11 +23,12 @@ import threading
 
 from implgen.codegen import chebform
 from implgen.codegen.emit import generate
+from implgen.codegen.glsl import glsl_name
 from implgen.codegen.glslprogram import HEADERS, runtime_text
-from implgen.codegen.spec import Spec
 from implgen.errors import UserError
 from implgen.scene.model import Csg, Leaf, Node
 from implgen.share.page import MATERIAL
+from implgen.spec.model import Spec
 from implgen.view.document import LIGHT_PRESETS, Document
 
 log = logging.getLogger("implgen.view")
@@ -108,6 +109,7 @@ def program_message(doc: Document, budget: float | None = None, stop: threading.
             log.exception("GLSL generation failed")
             reason = "the GLSL target failed on this shape"
         else:
-            msg = {"type": "glsl", "name": spec.name, "shape": shape, "params": list(spec.params)}
+            prefix = glsl_name(spec.name)  # of the shape's GLSL identifiers
+            msg = {"type": "glsl", "name": spec.name, "glsl_name": prefix, "shape": shape, "params": list(spec.params)}
             return {**msg, "note": note} if note else msg
     return {"type": "glsl", "name": spec.name, "reason": reason}

@@ -111,7 +111,7 @@ class IgOrbit {
     if (canvas.tabIndex < 0) canvas.tabIndex = 0;
     canvas.addEventListener("keydown", (e) => {
       const turns = { ArrowLeft: [-12.5, 0], ArrowRight: [12.5, 0], ArrowUp: [0, -12.5], ArrowDown: [0, 12.5] };
-      if (e.key in turns) this.turn(...turns[e.key]);
+      if (Object.hasOwn(turns, e.key)) this.turn(...turns[e.key]);
       else if (e.key === "+" || e.key === "=") this.zoom(1 / 1.1);
       else if (e.key === "-") this.zoom(1.1);
       else return;

@@ -28,7 +28,7 @@
 
   function start() {
     const log = r.setEquationProgram({
-      name: data.name, shape: data.shape, runtime: data.runtime, header: data.header, params: data.params.length,
+      name: data.glsl_name, shape: data.shape, runtime: data.runtime, header: data.header, params: data.params.length,
     });
     r.setMaterial(data.material); // the viewer's (share/page.py MATERIAL)
     if (log) {

@@ -15,17 +15,21 @@
 "use strict";
 
 const IgSurface = (() => {
-  const NAME = /^[A-Za-z][A-Za-z0-9_]{0,63}$/;
+  // The prefix of the shape's GLSL identifiers (implgen.codegen.glsl.glsl_name: its name, or its name spelled for
+  // GLSL): runs of letters and digits joined by single underscores, not gl_ or webgl_ first.
+  const NAME = /^(?!gl_|webgl_)[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)*$/i;
+  const SHAPE_FUNCTIONS = ["value", "gradient", "normal", "bounds", "raa", "hit"]; // glslprogram.SHAPE_FUNCTIONS
   const VERTEX = "#version 300 es\nin vec2 p;\nvoid main() { gl_Position = vec4(p, 0.0, 1.0); }\n";
-  const CLIPS = { none: 0, sphere: 1, box: 2 };
+  const CLIPS = Object.freeze(Object.assign(Object.create(null), { none: 0, sphere: 1, box: 2 })); // no prototype
   const MAX_LIGHTS = 4;
   const LIGHT = [-0.6, 0.8, 1.0]; // the default key light: towards it, in the camera's right, up and back
 
   // The page's main: camera ray, clip, the surface cut open by the clip (SURFER's picture: both sides show) or
   // the shape's solid cut by the clip (its cut face in the inside colour), two-sided shading under up to
   // MAX_LIGHTS lights (point lights in the world, or directions in the camera's frame), shadows if asked, the
-  // flagged pixels marked. ig_page_output 1 writes the status instead (red: hit, green: IG_UNSURE). SHAPE is
-  // the shape's name (checked against NAME first).
+  // flagged pixels marked. ig_page_output 1 writes the status instead (red: hit, green: IG_UNSURE). It is the
+  // same text for every shape: it calls the shape's functions as IG_SHAPE_BOUNDS, IG_SHAPE_RAA, IG_SHAPE_HIT and
+  // sizes its lights by IG_PAGE_MAX_LIGHTS, #defines that fragmentSource writes before the runtime.
   const MAIN = `
 uniform vec2 ig_page_size;
 uniform vec3 ig_page_eye;
@@ -40,8 +44,8 @@ uniform vec3 ig_page_inside;
 uniform vec3 ig_page_background;
 uniform vec4 ig_page_material;   // ambient, diffuse, specular, shininess
 uniform int ig_page_nlights;
-uniform vec4 ig_page_light[MAX_LIGHTS];      // w = 1: a point in the world; w = 0: towards it, camera frame
-uniform vec3 ig_page_light_colour[MAX_LIGHTS];
+uniform vec4 ig_page_light[IG_PAGE_MAX_LIGHTS];      // w = 1: a point in the world; w = 0: towards it, camera frame
+uniform vec3 ig_page_light_colour[IG_PAGE_MAX_LIGHTS];
 uniform int ig_page_shadows;     // 1: a shadow ray to each light
 uniform int ig_page_mark;        // 1: pixels flagged IG_UNSURE get the magenta checker
 uniform int ig_page_output;      // 0: the colour; 1: the status (red: hit, green: not sure)
@@ -53,13 +57,13 @@ int ig_page_side(vec3 o, vec3 d, float t0, out float guess)
 {
     vec3 p = o + t0 * d;
     vec3 lo, hi;
-    SHAPE_bounds(lo, hi);
+    IG_SHAPE_BOUNDS(lo, hi);
     guess = 1.0;
     if (any(lessThan(p, lo)) || any(greaterThan(p, hi))) {
         return 1;
     }
     vec3 e = (IG_ULP * (abs(t0 * d) + abs(p))) * (1.0 + IG_UP_REL) + IG_TINY;
-    vec3 f = SHAPE_raa(ig_raa_var(p.x, 0.0, e.x), ig_raa_var(p.y, 0.0, e.y), ig_raa_var(p.z, 0.0, e.z));
+    vec3 f = IG_SHAPE_RAA(ig_raa_var(p.x, 0.0, e.x), ig_raa_var(p.y, 0.0, e.y), ig_raa_var(p.z, 0.0, e.z));
     guess = f.x;
     return ig_raa_sign(f);
 }
@@ -103,7 +107,7 @@ bool ig_page_blocked(vec3 o, vec3 d, float tmax, inout int status)
     }
     float t;
     vec3 n;
-    int s = SHAPE_hit(o, d, t0, t1, t, n);
+    int s = IG_SHAPE_HIT(o, d, t0, t1, t, n);
     status |= s & IG_UNSURE;
     return (s & IG_HIT) != 0;
 }
@@ -113,7 +117,7 @@ bool ig_page_blocked(vec3 o, vec3 d, float tmax, inout int status)
 bool ig_page_certain(vec3 q)
 {
     vec3 e = IG_ULP * abs(q) * (1.0 + IG_UP_REL) + IG_TINY;
-    return ig_raa_sign(SHAPE_raa(ig_raa_var(q.x, 0.0, e.x), ig_raa_var(q.y, 0.0, e.y), ig_raa_var(q.z, 0.0, e.z))) != 0;
+    return ig_raa_sign(IG_SHAPE_RAA(ig_raa_var(q.x, 0.0, e.x), ig_raa_var(q.y, 0.0, e.y), ig_raa_var(q.z, 0.0, e.z))) != 0;
 }
 
 // Two-sided shading as the C tracer's (runtime_c/tracer_shade.c): ambient, then for each light that faces the
@@ -133,7 +137,7 @@ vec3 ig_page_shade(vec3 front, vec3 back, vec3 n, vec3 d, vec3 p, IgCamera cam, 
         off *= 4.0;
         start = p + nf * off;
     }
-    for (int i = 0; i < MAX_LIGHTS; ++i) {
+    for (int i = 0; i < IG_PAGE_MAX_LIGHTS; ++i) {
         if (i >= ig_page_nlights) {
             break;
         }
@@ -184,7 +188,7 @@ void main()
         } else {
             float t;
             vec3 n;
-            status = SHAPE_hit(cam.eye, d, t0, t1, t, n) | (side == 0 ? IG_UNSURE : 0);
+            status = IG_SHAPE_HIT(cam.eye, d, t0, t1, t, n) | (side == 0 ? IG_UNSURE : 0);
             if ((status & IG_HIT) != 0) {
                 rgb = ig_page_shade(ig_page_outside, ig_page_inside, n, d, cam.eye + t * d, cam, status);
             }
@@ -205,11 +209,13 @@ void main()
    * #version and precision lines) comes from the server or the page's data, as the runtime does: its one
    * source is implgen.codegen.glslprogram.HEADERS["es"]. */
   function fragmentSource(name, shape, runtime, header) {
-    if (!NAME.test(name)) throw new Error(`not a shape name: ${JSON.stringify(name)}`);
+    if (typeof name !== "string" || name.length > 256 || !NAME.test(name)) {
+      throw new Error(`not the prefix of a shape's GLSL identifiers: ${JSON.stringify(String(name)).slice(0, 80)}`);
+    }
     if (typeof header !== "string" || !header.startsWith("#version 300 es\n")) throw new Error("no GLSL ES 3.00 header");
-    const HEADER = header;
-    const main = MAIN.replaceAll("SHAPE", name).replaceAll("MAX_LIGHTS", String(MAX_LIGHTS));
-    return HEADER + runtime + "\n" + shape + "\n" + main;
+    const defines = [`#define IG_PAGE_MAX_LIGHTS ${MAX_LIGHTS | 0}\n`];
+    for (const f of SHAPE_FUNCTIONS) defines.push(`#define IG_SHAPE_${f.toUpperCase()} ${name}_${f}\n`);
+    return header + defines.join("") + runtime + "\n" + shape + "\n" + MAIN;
   }
 
   /** VERTEX and a fragment shader compiled and linked, the vertex attribute `p` at location 0: the program, or
@@ -264,6 +270,7 @@ void main()
       this.gl = gl;
       this.prog = null;
       this.name = "";
+      this.fragment = "";
       this.nparams = 0;
       this.params = [];
       this.camera = { eye: [3, 2, 4], target: [0, 0, 0], up: [0, 1, 0], fov: 40 };
@@ -304,6 +311,7 @@ void main()
         return String(err.message || err);
       }
       this.name = name;
+      this.fragment = src; // the fragment shader it compiled (for tests and for people poking at the page)
       this.nparams = params | 0;
       this.params = new Array(this.nparams).fill(0);
       this.uniforms = {};

@@ -15,10 +15,17 @@
   const gpu = window.ImplgenGpu ? ImplgenGpu.create({ stage: $("stage"), view: canvas, note: $("gpu-note"),
     toggle: $("gpu"), compare: $("compare"), status: $("status") }) : null;
 
+  // Everything keyed by a param's name is a map without a prototype: a param may be called constructor,
+  // toString or __proto__, and state.ranges[name] must not find Object.prototype's member instead (issue 31).
+  const byName = (obj) => {
+    const out = Object.create(null);
+    if (obj && typeof obj === "object") for (const [k, v] of Object.entries(obj)) out[k] = v;
+    return out;
+  };
   const state = {
-    params: {}, // name -> default (as the server parsed it)
-    values: {}, // name -> slider value
-    ranges: {}, // name -> [min, max], editable
+    params: byName(), // name -> default (as the server parsed it)
+    values: byName(), // name -> slider value
+    ranges: byName(), // name -> [min, max], editable
     orbit: { yaw: 30, pitch: 25, distance: 6, target: [0, 0, 0], fov: 40 },
     options: {},
     home: null, // the orbit to go back to
@@ -145,7 +152,7 @@
   }
 
   function parseParamsText(text) {
-    const out = {};
+    const out = byName();
     for (const part of text.split(",")) {
       if (!part.trim()) continue;
       const [name, value] = part.split("=").map((s) => s.trim());
@@ -194,15 +201,15 @@
   function showShape(msg) {
     $("equation").classList.remove("bad");
     $("equation-error").textContent = "";
-    state.params = msg.params;
-    state.values = Object.assign({}, msg.values);
-    for (const [k, v] of Object.entries(msg.params)) {
-      if (!state.ranges[k]) {
+    state.params = byName(msg.params);
+    state.values = byName(msg.values);
+    for (const [k, v] of Object.entries(state.params)) {
+      if (!Object.hasOwn(state.ranges, k)) {
         const span = Math.max(1, Math.abs(v));
         state.ranges[k] = [v - span, v + span];
       }
     }
-    $("params-text").value = Object.entries(msg.params).map(([k, v]) => `${k} = ${v}`).join(", ");
+    $("params-text").value = Object.entries(state.params).map(([k, v]) => `${k} = ${v}`).join(", ");
     $("shape-name").value = msg.name;
     acceptedEquation = $("equation").value;
     $("degree").textContent = `degree ${msg.degree}`;
@@ -310,6 +317,10 @@
   function onMessage(ev) {
     if (ev.data instanceof ArrayBuffer) { drawFrame(ev.data); return; }
     const msg = JSON.parse(ev.data);
+    if (msg.type === "hello" || msg.type === "shape") { // name -> default, name -> value
+      msg.params = byName(msg.params);
+      msg.values = byName(msg.values);
+    }
     if (msg.type === "hello") {
       overlay.connect = "";
       showOverlay();
@@ -331,7 +342,7 @@
     } else if (msg.type === "shape") {
       if (linkValues) { // the link's slider values, for the params the shape has
         for (const [k, v] of Object.entries(linkValues)) {
-          if (k in msg.values) {
+          if (Object.hasOwn(msg.values, k)) {
             msg.values[k] = v;
             const span = Math.max(1, Math.abs(msg.params[k]));
             state.ranges[k] = [Math.min(v, msg.params[k] - span), Math.max(v, msg.params[k] + span)];
@@ -485,7 +496,7 @@
     const params = g.params || {};
     $("equation").value = g.equation;
     $("params-text").value = Object.entries(params).map(([k, v]) => `${k} = ${v}`).join(", ");
-    state.ranges = Object.assign({}, g.ranges || {});
+    state.ranges = byName(g.ranges);
     $("gallery-note").textContent = `${g.title}: ${g.description} (${g.reference})`;
     userName = false;
     send({ type: "shape", equation: g.equation, name: g.name, params, ranges: g.ranges || {}, bounds: g.bounds || null,

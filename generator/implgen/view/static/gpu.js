@@ -97,7 +97,7 @@ const ImplgenGpu = (() => {
         g.reason = msg.reason;
       } else {
         const log = g.renderer.setEquationProgram({
-          name: msg.name, shape: msg.shape, runtime: g.runtime.runtime, header: g.runtime.header,
+          name: msg.glsl_name, shape: msg.shape, runtime: g.runtime.runtime, header: g.runtime.header,
           params: msg.params.length,
         });
         if (log) {
@@ -126,7 +126,8 @@ const ImplgenGpu = (() => {
       const o = new IgOrbit(orbit);
       const { right, up, back } = o.basis();
       const d = orbit.distance;
-      return (g.runtime.lights[preset] || g.runtime.lights.studio).map((l) => ({
+      const presets = g.runtime.lights;
+      return (Object.hasOwn(presets, preset) ? presets[preset] : presets.studio).map((l) => ({
         position: l.frame === "camera"
           ? orbit.target.map((t, i) => t + 2 * d * (l.at[0] * right[i] + l.at[1] * up[i] + l.at[2] * back[i]))
           : orbit.target.map((t, i) => t + d * l.at[i]),
@@ -137,7 +138,7 @@ const ImplgenGpu = (() => {
     function apply({ orbit, values, options }) {
       const r = g.renderer;
       r.setSize(view.width, view.height);
-      r.setParams(g.shape.params.map((name) => values[name]));
+      r.setParams(g.shape.params.map((name) => (Object.hasOwn(values, name) ? values[name] : NaN))); // NaN: refused
       r.setCamera(new IgOrbit(orbit).camera());
       r.setClip({ kind: options.clip, size: options.clip_size, cut: options.cut });
       r.setColours({ outside: options.color, inside: options.inside, background: options.background });

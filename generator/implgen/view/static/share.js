@@ -59,7 +59,7 @@ window.implgenLink = (() => {
     if (params !== null) { if (params.length <= 4096) view.params = params; else bad.push("params"); }
     const values = q.get("values");
     if (values !== null) {
-      const out = {};
+      const out = Object.create(null); // keyed by params' names: constructor or __proto__ is a name like any other
       const parts = values ? values.split(",") : [];
       for (const part of parts.slice(0, MAX_PARAMS)) {
         const [k, v] = part.split(":");
