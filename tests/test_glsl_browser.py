@@ -17,8 +17,8 @@ import pytest
 
 from conftest import SHAPES_DIR
 from implgen.bench import glslcases, glslcheck
-from implgen.codegen.glsl import glsl_name
-from implgen.codegen.glslprogram import program, shape_defines
+from implgen.codegen.backends.glsl.printer import glsl_name
+from implgen.codegen.backends.glsl.program import program, shape_defines
 from implgen.roots import exactray
 from implgen.spec.entry import load_spec, parse_spec
 
@@ -60,7 +60,7 @@ def test_hit_mask_matches_the_exact_answer(gl, case):
 @pytest.mark.parametrize("n", [16, 24])
 def test_power_form_is_drawn_from_its_chebyshev_form(gl, n):
     """The expanded Chebyshev polynomial cancels by ~(1 + sqrt 2)^n / 2 near |x| = 1; its box's Chebyshev form
-    (codegen/chebform.py) does not, and the surface is certified like the nested one."""
+    (codegen/backends/glsl/chebform.py) does not, and the surface is certified like the nested one."""
     case = glslcases.view_case(f"chmutov{n}", glslcases.chmutov(n, nested=False), SIZE)
     r = _compare(gl, case)
     assert r.object_pixels > 0.1 * r.pixels

@@ -1,4 +1,4 @@
-"""The GLSL's second tree for f (codegen/chebform.py): the tensor Chebyshev form of f on its box is f exactly,
+"""The GLSL's second tree for f (backends/glsl/chebform.py): the tensor Chebyshev form of f on its box is f exactly,
 and it is chosen only where it lowers float's error bound (the expanded Chmutov surfaces), never for a tree
 the user wrote well. The pixels it gives are checked in the browser (tests/test_glsl_browser.py)."""
 
@@ -13,7 +13,7 @@ import sympy
 
 from conftest import SHAPES_DIR
 from implgen.bench.glslcases import chmutov
-from implgen.codegen import chebform
+from implgen.codegen.backends.glsl import chebform
 from implgen.codegen.emit import generate
 from implgen.spec.entry import load_spec, parse_spec
 from implgen.spec.parse import X, Y, Z
@@ -124,7 +124,7 @@ def _form_at(form: chebform.ChebForm, point: tuple[Fraction, ...]) -> Fraction:
     ids=lambda s: s.name,
 )
 def test_the_monomials_are_sympy_s_expansion_in_its_order(spec):
-    """codegen/chebform.py expands f by integer ring arithmetic on its tree, not by sympy.Poly: the same
+    """codegen/backends/glsl/chebform.py expands f by integer ring arithmetic on its tree, not by sympy.Poly: the same
     coefficients, exactly, in the same order (lex, highest first), so the Chebyshev form is unchanged."""
     if spec.f.free_symbols - {X, Y, Z}:
         pytest.skip("params: no Chebyshev form")

@@ -13,7 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from conftest import SHAPES_DIR
-from implgen.codegen import escape, glsl
+from implgen.codegen import escape
+from implgen.codegen.backends.glsl import printer as glsl
 from implgen.codegen.command import main as generate_command
 from implgen.codegen.emit import generate
 from implgen.spec.entry import load_spec, parse_spec

@@ -11,9 +11,9 @@ import pytest
 
 from conftest import GENERATED, SHAPE_NAMES
 from implgen.bench.glslcases import chmutov
+from implgen.codegen.backends.glsl.printer import glsl_name
+from implgen.codegen.backends.glsl.program import program, shape_defines
 from implgen.codegen.emit import generate
-from implgen.codegen.glsl import glsl_name
-from implgen.codegen.glslprogram import program, shape_defines
 from implgen.spec.entry import parse_spec
 from page_shader import glslang_problems
 
@@ -84,7 +84,7 @@ def test_awkward_constants_and_params_compile(tmp_path):
 
 @pytest.mark.parametrize("name", ["ball_", "a__b", "gl_ball", "webgl_ball", "k", "MAX_LIGHTS"])
 def test_names_glsl_reserves_or_that_hide_the_shape_s_compile(tmp_path, name):
-    """Names whose identifiers GLSL reserves (spelled another way: codegen/glsl.py glsl_name, param_local), and
+    """Names whose identifiers GLSL reserves (spelled another way: backends/glsl/printer.py glsl_name, param_local), and
     params whose locals would hide the shape's own identifiers (shape k: k_params, k_value), all in use."""
     params = {"params": 1.0, "value": 0.5, "a__b": 2.0, "c_": 0.25, "gl_x": 1.0, "x_hit": 0.0}
     spec = parse_spec(

@@ -187,6 +187,24 @@ def test_the_package_lives_in_a_folder_of_its_name() -> None:
     assert (PACKAGE / "__init__.py").is_file()
     installed = Path(implgen.__file__).resolve().parent
     assert installed.name == "implgen"
-    # every subpackage in the tree is one the installed package has (pyproject lists them by hand)
-    subpackages = {p.parent.name for p in PACKAGE.glob("*/__init__.py")}
-    assert subpackages <= {p.parent.name for p in installed.glob("*/__init__.py")}
+    # every subpackage in the tree, at any depth, is one the installed package has (pyproject lists them by hand)
+    subpackages = {p.parent.relative_to(PACKAGE) for p in PACKAGE.rglob("__init__.py")}
+    assert subpackages <= {p.parent.relative_to(installed) for p in installed.rglob("__init__.py")}
+
+
+def test_one_folder_per_backend_and_one_template_folder_of_its_name() -> None:
+    """codegen/backends/<lang>/ for each of LANGS, its Backend named so, its templates in templates/<lang>/; every
+    template folder but the scene glue's belongs to a backend."""
+    from implgen.codegen.backends import LANGS, backend
+
+    folders = {p.parent.name for p in (PACKAGE / "codegen" / "backends").glob("*/backend.py")}
+    assert folders == set(LANGS)
+    for lang in LANGS:
+        b = backend(lang)
+        assert b.name == b.templates == lang
+        for template, _ in b.outputs():
+            assert (ROOT / "templates" / template).is_file(), template
+    assert {p.name for p in (ROOT / "templates").iterdir() if p.is_dir() and p.name != "__pycache__"} == {
+        *LANGS,
+        "scene",
+    }

@@ -27,9 +27,9 @@ import needs_program
 import page_shader
 from conftest import SHAPES_DIR
 from implgen.cli import main
+from implgen.codegen.backends.glsl.printer import glsl_name
+from implgen.codegen.backends.glsl.program import program, shape_defines
 from implgen.codegen.emit import generate
-from implgen.codegen.glsl import glsl_name
-from implgen.codegen.glslprogram import program, shape_defines
 from implgen.spec.entry import load_spec, parse_spec
 
 pytestmark = pytest.mark.needs_program("chromium", "chromedriver")

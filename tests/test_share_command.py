@@ -22,9 +22,9 @@ import needs_program
 import page_shader
 from conftest import ROOT, SHAPES_DIR
 from implgen.cli import main
+from implgen.codegen.backends.glsl.printer import glsl_name
+from implgen.codegen.backends.glsl.program import HEADERS, runtime_text
 from implgen.codegen.emit import generate
-from implgen.codegen.glsl import glsl_name
-from implgen.codegen.glslprogram import HEADERS, runtime_text
 from implgen.share.page import script_json
 from implgen.spec.entry import load_spec
 
@@ -288,7 +288,7 @@ AWKWARD_NAMES = {
 @pytest.mark.parametrize("name", AWKWARD_NAMES)
 def test_a_page_for_names_glsl_or_the_page_would_misread(tmp_path, capsys, name):
     """Exit 0 and a page whose shader compiles (every_page_s_shader_compiles); the C backend takes these names
-    too. The page's shape functions are the spelled ones (codegen/glsl.py glsl_name)."""
+    too. The page's shape functions are the spelled ones (codegen/backends/glsl/printer.py glsl_name)."""
     params = AWKWARD_NAMES[name]
     terms = " + ".join(f"{p}*{p}" for p in params)
     spec = tmp_path / "awkward.yaml"

@@ -16,9 +16,9 @@ from starlette.testclient import TestClient
 
 from conftest import ROOT
 from implgen.bench.glslcases import chmutov
-from implgen.codegen import chebform
+from implgen.codegen.backends.glsl import chebform
+from implgen.codegen.backends.glsl.program import HEADERS, runtime_text
 from implgen.codegen.emit import generate
-from implgen.codegen.glslprogram import HEADERS, runtime_text
 from implgen.scene.load import load_scene
 from implgen.view import gpu
 from implgen.view.command import document_factory
@@ -66,7 +66,7 @@ def test_the_hello_and_the_glsl_of_each_shape(client) -> None:
     assert shape["shape_id"] == second["shape_id"] == 1
     assert second["params"] == ["r"] and second["name"] == shape["name"]
     assert "f(x, y, z) = -r^2 + x^2 + y^2 + z^2" in second["shape"] and second["shape"] != first["shape"]
-    # ball__hit would be reserved in GLSL: the page gets the prefix the shape's GLSL uses (codegen/glsl.py)
+    # ball__hit would be reserved in GLSL: the page gets the prefix the shape's GLSL uses (backends/glsl/printer.py)
     assert third["name"] == "ball_" and third["glsl_name"] == "ig_shape_ball_u"
     assert "int ig_shape_ball_u_hit(vec3 o" in third["shape"]
 

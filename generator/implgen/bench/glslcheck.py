@@ -16,9 +16,9 @@ from types import ModuleType
 
 import numpy as np
 
+from implgen.codegen.backends.glsl.printer import glsl_name
+from implgen.codegen.backends.glsl.program import program, shape_defines
 from implgen.codegen.emit import generate
-from implgen.codegen.glsl import glsl_name
-from implgen.codegen.glslprogram import program, shape_defines
 from implgen.roots import exactray
 from implgen.scene.camera import camera_rays as scene_camera_rays
 from implgen.scene.model import Camera

@@ -13,7 +13,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from implgen.args import ArgumentParser
-from implgen.codegen.emit import LANGS, generate
+from implgen.codegen.backends import LANGS
+from implgen.codegen.emit import generate
 from implgen.errors import UserError
 from implgen.outputs import check_output_folder, write_text_files
 from implgen.spec.entry import load_spec

@@ -1,4 +1,4 @@
-"""Derivation -> source files through a backend (codegen/backends.py: a printer and its templates).
+"""Derivation -> source files through a backend (codegen/backends/: a printer and its templates per language).
 
 `generate(spec, langs)` returns {file name: text}; `outputs.write_text_files` puts them on disk atomically.
 Output is deterministic (byte-identical on rerun), so the checked-in `generated/` folder can be compared in
@@ -15,13 +15,12 @@ import sympy
 from sympy.codegen.rewriting import optimize
 
 from implgen import __version__
-from implgen.codegen.backends import BACKENDS, EXPAND_POW, ConstantRangeError
+from implgen.codegen.backends import LANGS, backend
+from implgen.codegen.backends.contract import EXPAND_POW, ConstantRangeError
 from implgen.codegen.derive import DIRECTION, ORIGIN, POINT, Block, Derivation, derive
 from implgen.codegen.templating import environment
 from implgen.errors import UserError
 from implgen.spec.parse import Spec
-
-LANGS = tuple(BACKENDS)
 
 
 @dataclass(frozen=True)
@@ -81,20 +80,18 @@ def _render(env, template: str, context: dict) -> str:
 
 
 def generate(spec: Spec, langs: Iterable[str] = LANGS, derivation: Derivation | None = None) -> dict[str, str]:
-    """{file name: text} for the requested languages (BACKENDS: "c" -> .h and .c, "python" -> .py, "glsl" -> .glsl)."""
-    unknown = [lang for lang in langs if lang not in BACKENDS]
-    if unknown:
-        raise ValueError(f"unknown language {unknown[0]!r}; backends: {', '.join(BACKENDS)}")
+    """{file name: text} for the requested languages (backends.LANGS: "c" -> .h and .c, "python" -> .py, "glsl"
+    -> .glsl)."""
+    chosen = [backend(lang) for lang in langs]  # an unknown language: ValueError, before any work
     derivation = derivation or derive(spec)
     env = environment()
     files: dict[str, str] = {}
     try:
-        for lang in langs:
-            backend = BACKENDS[lang]
-            ctx = _context(derivation, backend.printer().doprint)
-            if backend.extra is not None:
-                ctx.update(backend.extra(derivation))
-            for template, pattern in backend.files:
+        for b in chosen:
+            ctx = _context(derivation, b.printer().doprint)
+            if b.extra is not None:
+                ctx.update(b.extra(derivation))
+            for template, pattern in b.outputs():
                 files[pattern.format(name=spec.name)] = _render(env, template, ctx)
     except ConstantRangeError as err:
         raise UserError(spec.source, f"equation: {err}") from None

@@ -27,9 +27,9 @@ from typing import Any
 import jinja2
 
 from implgen import __version__
+from implgen.codegen.backends.glsl.printer import glsl_name
+from implgen.codegen.backends.glsl.program import HEADERS, runtime_text
 from implgen.codegen.emit import generate
-from implgen.codegen.glsl import glsl_name
-from implgen.codegen.glslprogram import HEADERS, runtime_text
 from implgen.spec.model import Spec
 
 STATIC = Path(__file__).resolve().parent / "static"

@@ -21,10 +21,10 @@ from __future__ import annotations
 import logging
 import threading
 
-from implgen.codegen import chebform
+from implgen.codegen.backends.glsl import chebform
+from implgen.codegen.backends.glsl.printer import glsl_name
+from implgen.codegen.backends.glsl.program import HEADERS, runtime_text
 from implgen.codegen.emit import generate
-from implgen.codegen.glsl import glsl_name
-from implgen.codegen.glslprogram import HEADERS, runtime_text
 from implgen.errors import UserError
 from implgen.scene.model import Csg, Leaf, Node
 from implgen.share.page import MATERIAL

@@ -10,7 +10,7 @@ from __future__ import annotations
 import threading
 from dataclasses import asdict
 
-from implgen.codegen import chebform
+from implgen.codegen.backends.glsl import chebform
 from implgen.share.page import CLIPS, Look, render_page, slider
 from implgen.view import gpu
 from implgen.view.document import Document

@@ -20,9 +20,10 @@ the page's previous render, times the row's samples) is refused before it starts
 `Work.shutdown` cancels every render, so Ctrl-C never waits for one: a parse or a build still running ends with
 the process.
 
-A GLSL derivation (gpu.py, sharepage.py) runs under `derive_glsl`: its Chebyshev step (codegen/chebform.py, the one
-part whose time the spec limits do not bound) checks the GLSL budget and a stop between its small steps, and past
-them the shader evaluates f's tree as written, which the page is told. A cancelled caller (a newer request, the
+A GLSL derivation (gpu.py, sharepage.py) runs under `derive_glsl`: its Chebyshev step
+(codegen/backends/glsl/chebform.py, the one part whose time the spec limits do not bound) checks the GLSL budget
+and a stop between its small steps, and past them the shader evaluates f's tree as written, which the page is
+told. A cancelled caller (a newer request, the
 page closed) sets the stop.
 
 A mesh (meshsave.py) is not a C render: it runs `stoppable`, its own time budget and stop checked by the mesh

@@ -15,7 +15,7 @@
 "use strict";
 
 const IgSurface = (() => {
-  // The prefix of the shape's GLSL identifiers (implgen.codegen.glsl.glsl_name: its name, or its name spelled for
+  // The prefix of the shape's GLSL identifiers (implgen.codegen.backends.glsl.printer.glsl_name: its name, or its name spelled for
   // GLSL): runs of letters and digits joined by single underscores, not gl_ or webgl_ first.
   const NAME = /^(?!gl_|webgl_)[A-Za-z][A-Za-z0-9]*(?:_[A-Za-z0-9]+)*$/i;
   const SHAPE_FUNCTIONS = ["value", "gradient", "normal", "bounds", "raa", "hit"]; // glslprogram.SHAPE_FUNCTIONS
@@ -207,7 +207,7 @@ void main()
 
   /** The fragment shader for a shape: header, runtime, shape, main (docs/glsl.md, "A program"). The header (the
    * #version and precision lines) comes from the server or the page's data, as the runtime does: its one
-   * source is implgen.codegen.glslprogram.HEADERS["es"]. */
+   * source is implgen.codegen.backends.glsl.program.HEADERS["es"]. */
   function fragmentSource(name, shape, runtime, header) {
     if (typeof name !== "string" || name.length > 256 || !NAME.test(name)) {
       throw new Error(`not the prefix of a shape's GLSL identifiers: ${JSON.stringify(String(name)).slice(0, 80)}`);

@@ -1,6 +1,6 @@
 """A second tree for f, in the Chebyshev basis of its own box, for the GLSL when the user's tree cancels in float.
 
-The GLSL evaluates f in float (24 bits) as a tree (codegen/glsl.py). A polynomial typed in expanded form --
+The GLSL evaluates f in float (24 bits) as a tree (backends/glsl/printer.py). A polynomial typed in expanded form --
 the Chmutov surface's T_n(x) written as its monomials -- carries terms of size about (1 + sqrt 2)^n / 2 that
 cancel to O(1) on the surface, and float keeps nothing of f there. The same polynomial in the tensor
 Chebyshev basis of its box, f = sum c_ijk T_i(u) T_j(v) T_k(w) with u = (x - centre) / half-width, has terms
@@ -16,7 +16,7 @@ coefficients are exact rationals, computed once, here, from f expanded by intege
 
 The command line computes the form to its end, so what it writes never depends on the machine. The viewer
 computes it under `budget` (a deadline and a stop, checked between small steps); past them OverBudget, and
-the GLSL keeps f's tree as written (codegen/glsl.py).
+the GLSL keeps f's tree as written (backends/glsl/printer.py).
 """
 
 from __future__ import annotations
@@ -229,7 +229,7 @@ def _tree_bound(e: sympy.Expr, point: dict, memo: dict):
 
 
 def _chebyshev_bound(form: ChebForm, coords: list[np.ndarray]):
-    """(value, mu) of the Chebyshev tree, in the order codegen/glsl.py emits it."""
+    """(value, mu) of the Chebyshev tree, in the order backends/glsl/printer.py emits it."""
     tables = []
     for axis, x in enumerate(coords):
         u = _mul(

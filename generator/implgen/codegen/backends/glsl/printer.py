@@ -21,9 +21,9 @@ import sympy
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from implgen.codegen.chebform import ChebForm, OverBudget, better_form
+from implgen.codegen.backends.glsl.chebform import ChebForm, OverBudget, better_form
+from implgen.codegen.backends.glsl.program import SHAPE_FUNCTIONS
 from implgen.codegen.derive import Derivation
-from implgen.codegen.glslprogram import SHAPE_FUNCTIONS
 from implgen.spec.parse import X, Y, Z, param_symbol
 
 _F32_MAX = Fraction(float(np.finfo(np.float32).max))
@@ -233,7 +233,7 @@ class _AffineCode:
 
 def chebyshev_affine_code(form: ChebForm) -> tuple[list[str], str]:
     """(statements, result) computing f's affine form from x, y, z in the Chebyshev basis of its box
-    (codegen/chebform.py): u = (x - centre) / half-width, T_n(u) by doubling, then
+    (codegen/backends/glsl/chebform.py): u = (x - centre) / half-width, T_n(u) by doubling, then
     sum_i T_i(u) (sum_j T_j(v) (sum_k c_ijk T_k(w)))."""
     code = _AffineCode({})
     tables = []

@@ -16,7 +16,7 @@ HEADERS = {
     "es": "#version 300 es\nprecision highp float;\nprecision highp int;\n",
     "450": "#version 450\n",
 }
-# A shape's functions are <prefix>_value, ... (templates/glsl/shape.glsl.j2; the prefix: codegen/glsl.py
+# A shape's functions are <prefix>_value, ... (templates/glsl/shape.glsl.j2; the prefix: backends/glsl/printer.py
 # glsl_name). A main written once for any shape calls them as IG_SHAPE_VALUE, ..., IG_SHAPE_HIT: #defines of
 # the program's one shape's (shape_defines), never text put into the main.
 SHAPE_FUNCTIONS = ("value", "gradient", "normal", "bounds", "raa", "hit")

@@ -1,0 +1,1 @@
+"""The GLSL backend: backend.py, its printer, the Chebyshev form, program assembly."""

@@ -1,0 +1,1 @@
+"""The Python backend (backend.py)."""
