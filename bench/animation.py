@@ -29,8 +29,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from implgen.bench.machine import describe as machine
-from implgen.bench.machine import write_results
+from implgen.measure.machine import describe as machine
+from implgen.measure.machine import write_results
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -19,17 +19,16 @@ import argparse
 import re
 import statistics
 import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
-from implgen.bench.machine import describe as machine
-from implgen.bench.machine import load_average, write_results
+from embree_scenes import build_driver, grid  # beside this script
+
+from implgen.measure.machine import describe as machine
+from implgen.measure.machine import load_average, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "bench"))
 
-from embree_scenes import build_driver, grid  # noqa: E402
 
 COLUMNS = ("tracer", "embree1", "embree8", "tracer_shadow", "embree_shadow")
 

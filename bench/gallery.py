@@ -17,8 +17,8 @@ from pathlib import Path
 from implgen.animation.batch import Runner, render_frames
 from implgen.animation.frameout import plan_output
 from implgen.animation.frames import FrameOptions, load_frames
-from implgen.bench.machine import describe as machine
 from implgen.imagefile import write_png
+from implgen.measure.machine import describe as machine
 from implgen.scene.load import load_scene
 from implgen.scene.render import RenderInfo, render
 

@@ -2,7 +2,7 @@
 
     .venv/bin/python bench/glsl_compare.py [--size 640x480] [--judge 3000] [-o bench/results/glsl.md] [--quick]
 
-For every case of implgen.bench.glslcases (the example shapes through a camera, Chmutov surfaces of degree 12,
+For every case of implgen.measure.glslcases (the example shapes through a camera, Chmutov surfaces of degree 12,
 16, 20 and 24 nested and in power form, torus_y seen from 1e3 units, grazing rays over torus_z) it
   1. runs the generated shader in headless Chromium's WebGL2 (ANGLE on SwiftShader, a CPU emulation of a
      GPU) over the case's float32 rays, and reads back status (IG_HIT, IG_UNSURE, IG_EARLIER), t and the
@@ -25,8 +25,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 SHAPES = ROOT / "examples" / "shapes"
 
-from implgen.bench import glslcases, glslcheck, machine  # noqa: E402
-from implgen.bench.webgl import FLAGS, WebGL  # noqa: E402
+from implgen.measure import glslcases, glslcheck, machine  # noqa: E402
+from implgen.measure.webgl import FLAGS, WebGL  # noqa: E402
 
 
 def parse_args(argv):

@@ -25,9 +25,9 @@ import numpy as np
 import trimesh
 from skimage.measure import marching_cubes
 
-from implgen.bench.machine import describe as machine
-from implgen.bench.machine import load_average, write_results
 from implgen.codegen.emit import generate
+from implgen.measure.machine import describe as machine
+from implgen.measure.machine import load_average, write_results
 from implgen.mesh.contour import contour
 from implgen.mesh.crossings import boundary_value_gradient
 from implgen.mesh.pipeline import closed_and_euler

@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from implgen.bench.machine import describe as machine
-from implgen.bench.machine import load_average, write_results
+from implgen.measure.machine import describe as machine
+from implgen.measure.machine import load_average, write_results
 from implgen.mesh import budget
 from implgen.mesh.budget import OverBudget
 from implgen.mesh.pipeline import mesh_spec

@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from implgen.bench.machine import describe as machine
-from implgen.bench.machine import write_results
+from implgen.measure.machine import describe as machine
+from implgen.measure.machine import write_results
 from implgen.mesh.contour import contour
 from implgen.mesh.crossings import grid_flags, inside_flags, line_points
 from implgen.mesh.pipeline import closed_and_euler

@@ -140,7 +140,7 @@ def cmd_callgrind(args: argparse.Namespace) -> int:
 def cmd_time(args: argparse.Namespace) -> int:
     import statistics
 
-    from implgen.bench.render import _measure
+    from implgen.measure.render import _measure
     from implgen.scene.build import build_scene
     from implgen.scene.load import load_scene
     from implgen.scene.tracer import CScene

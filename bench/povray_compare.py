@@ -54,8 +54,8 @@ def _ensure_current_install() -> None:
 
 _ensure_current_install()
 
-from implgen.bench.machine import cpu_model  # noqa: E402
 from implgen.export import povray as pv  # noqa: E402
+from implgen.measure.machine import cpu_model  # noqa: E402
 from implgen.roots.exactray import ExactJudge, Placed  # noqa: E402
 from implgen.scene.camera import camera_rays  # noqa: E402
 from implgen.scene.load import load_scene  # noqa: E402
@@ -215,10 +215,10 @@ def degree_family(degrees, rays: int, reps: int) -> list[dict]:
 def build_degree_cost(n: int, rt: Path, tmp: Path):
     """The dense degree-n surface (n/2 offset unit spheres) as a spec, its derivation, and its generated C
     (written into tmp) built with the runtime's roots and shape code and bench/c/degree_cost.c, loaded."""
-    from implgen.bench.gen import dense_equation
     from implgen.codegen.derive import derive
     from implgen.codegen.emit import generate
     from implgen.compile import clib as cbuild
+    from implgen.measure.gen import dense_equation
     from implgen.spec.entry import parse_spec
 
     k = n // 2

@@ -23,9 +23,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 SHAPES = ROOT / "examples" / "shapes"
 
-from implgen.bench import machine  # noqa: E402
-from implgen.bench.webgl import FLAGS, WebGL  # noqa: E402
 from implgen.cli import main as implgen  # noqa: E402
+from implgen.measure import machine  # noqa: E402
+from implgen.measure.webgl import FLAGS, WebGL  # noqa: E402
 
 WRAP = """
 const r = implgenShare.renderer, p = implgenShare.progressive;

@@ -20,8 +20,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from implgen.bench.machine import describe as machine
-from implgen.bench.machine import load_average, write_results
+from implgen.measure.machine import describe as machine
+from implgen.measure.machine import load_average, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "bench" / "scenes"

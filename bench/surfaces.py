@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 from PIL import Image, ImageDraw
 
-from implgen.bench.machine import describe as machine
 from implgen.imagefile import to_uint8, write_png
+from implgen.measure.machine import describe as machine
 from implgen.scene.preview import preview_scene
 from implgen.scene.render import render
 from implgen.spec import gallery

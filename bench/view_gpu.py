@@ -3,7 +3,7 @@
     nice .venv/bin/python bench/view_gpu.py [--size 640x480] [--rounds 2] [--seconds 3] [-o bench/results/view.md]
 
 Starts `implgen view --no-browser --port 0` (its own process), opens the page in headless Chromium with WebGL2
-through ANGLE on SwiftShader (implgen.bench.webgl.FLAGS), gives the picture --size device pixels, ticks "GPU
+through ANGLE on SwiftShader (implgen.measure.webgl.FLAGS), gives the picture --size device pixels, ticks "GPU
 preview" (off by default on a software renderer) and, for each case, opens its view through the page's share
 link (equation, camera, clip), waits for the shape's GLSL and the server's refined frame, then drags the mouse
 across the picture for --seconds (a move every 1/60 s, through Selenium's pointer actions). Every draw the page
@@ -30,9 +30,9 @@ from pathlib import Path
 
 from view_latency import CHMUTOV12  # the drags of view_latency.py: the same shapes
 
-from implgen.bench.machine import describe as machine
-from implgen.bench.machine import write_results
-from implgen.bench.webgl import FLAGS
+from implgen.measure.machine import describe as machine
+from implgen.measure.machine import write_results
+from implgen.measure.webgl import FLAGS
 
 ROOT = Path(__file__).resolve().parents[1]
 BEGIN, END = "<!-- bench/view_gpu.py: begin -->", "<!-- bench/view_gpu.py: end -->"

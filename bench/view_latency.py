@@ -39,8 +39,8 @@ from pathlib import Path
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
-from implgen.bench.machine import describe as machine
-from implgen.bench.machine import write_results
+from implgen.measure.machine import describe as machine
+from implgen.measure.machine import write_results
 from implgen.spec.entry import load_spec
 from implgen.view.dump import spec_mapping
 from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_ONE, MAX_RENDERS_PER_SECOND

@@ -29,8 +29,8 @@ from pathlib import Path
 from view_latency import Page, start_server  # the page's side of the protocol, the server (view_latency.py)
 from websockets.exceptions import ConnectionClosed
 
-from implgen.bench.machine import describe as machine
-from implgen.bench.machine import load_average, write_results
+from implgen.measure.machine import describe as machine
+from implgen.measure.machine import load_average, write_results
 from implgen.view.session import KIND_COARSE
 
 ROOT = Path(__file__).resolve().parents[1]

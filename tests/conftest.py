@@ -6,7 +6,6 @@ import ctypes
 import importlib.util
 import os
 import subprocess
-import sys
 from pathlib import Path
 from types import ModuleType
 
@@ -23,7 +22,6 @@ RUNTIME = ROOT / "runtime_c"
 SHAPE_FILES = sorted(SHAPES_DIR.glob("*.yaml"))
 SHAPE_NAMES = [p.stem for p in SHAPE_FILES]
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 # @pytest.mark.needs_program(...): skipped when a Debian package's program is missing, failed instead when
 # IMPLGEN_REQUIRE_ALL is set (CI)

@@ -410,13 +410,13 @@ def test_cache_command_usage_is_one_line(cache: Path) -> None:
 
 
 def test_the_exact_reference_cache_is_data_never_a_pickle(tmp_path: Path, monkeypatch) -> None:
-    """roots/reference.py keeps its exact roots as JSON numbers: a pickle (code, when loaded) planted under the
+    """measure/cases/reference.py keeps its exact roots as JSON numbers: a pickle (code, when loaded) planted under the
     entry's name is not read, and neither is a file others can write; both are computed again."""
     import pickle
 
     import numpy as np
 
-    from implgen.roots import reference
+    from implgen.measure.cases import reference
 
     monkeypatch.setenv("IMPLGEN_CACHE", str(tmp_path / "cache"))
     coeffs = np.array([[-2.0, 0.0, 1.0], [6.0, -5.0, 1.0]])  # roots +-sqrt(2); 2 and 3

@@ -24,9 +24,7 @@ import yaml
 
 from implgen.animation import cluster
 from implgen_proc import assert_one_line, implgen, start
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_animation_render import anim_scene  # noqa: E402
+from test_animation_render import anim_scene
 
 distributed = pytest.importorskip("distributed")
 cloudpickle = pytest.importorskip("cloudpickle")

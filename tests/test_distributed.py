@@ -19,9 +19,7 @@ from implgen.animation.frames import FrameOptions, frames_from_data, render_fram
 from implgen.cli import main as cli_main
 from implgen.imagefile import to_uint8
 from implgen.scene.render import render
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_animation_render import FRAMES, anim_scene  # noqa: E402
+from test_animation_render import FRAMES, anim_scene
 
 distributed = pytest.importorskip("distributed")
 cloudpickle = pytest.importorskip("cloudpickle")

@@ -11,16 +11,14 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from embree_scenes import build_driver, exact_judge, read_agree, showcase  # bench/ (pytest's pythonpath)
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "bench"))
 
-from embree_scenes import build_driver, exact_judge, read_agree, showcase  # noqa: E402
 
 pytestmark = pytest.mark.needs_library("embree3")
 W, H = 320, 180  # 57,600 pixels: 99.99 % allows 5 disagreements

@@ -1,8 +1,8 @@
 """First-root mode (`implgen.roots.solvers.first_root`, `ig_first_root`) and the generated `first_hit`, checked against
 two independent things: the full root list of the same method (`real_roots`), and exact real-root isolation on
-the rationals of the double coefficients (`implgen.roots.reference`, scored with that module's tolerances).
+the rationals of the double coefficients (`implgen.measure.cases.reference`, scored with that module's tolerances).
 
-The case sets are those of the solver report (`implgen.roots.cases.CASE_SETS`): random polynomials, ray
+The case sets are those of the solver report (`implgen.measure.cases.polys.CASE_SETS`): random polynomials, ray
 polynomials of the catalogue shapes (near, far at 1e4, inside and grazing rays, box-clipped and shifted) and
 the built hard set.
 """
@@ -17,8 +17,8 @@ import pytest
 
 from conftest import SHAPE_FILES, load_python_shape
 from implgen.errors import UserError
-from implgen.roots.cases import CASE_SETS, hard_set
-from implgen.roots.reference import Score, reference, score_one
+from implgen.measure.cases.polys import CASE_SETS, hard_set
+from implgen.measure.cases.reference import Score, reference, score_one
 from implgen.roots.solvers import METHODS, first_root, first_root_batch, real_roots, real_roots_batch
 from implgen.spec.entry import load_spec
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from conftest import SHAPE_NAMES, CShapes, load_python_shape, random_rays
+from implgen.measure.cases.polys import find_shapes_dir
 from implgen.roots import raycast
-from implgen.roots.cases import find_shapes_dir
 from implgen.spec.entry import load_spec
 
 

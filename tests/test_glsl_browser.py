@@ -1,6 +1,6 @@
 """The generated GLSL in a real browser: headless Chromium's WebGL2 (ANGLE on SwiftShader), pixels read back.
 
-Each case is a grid of float32 rays (implgen.bench.glslcases: every example shape through a camera, Chmutov
+Each case is a grid of float32 rays (implgen.measure.glslcases: every example shape through a camera, Chmutov
 surfaces of degree 12 to 24, a torus from 10^3 units, grazing rays). The GLSL's hit mask is compared with the C
 solvers' (double) on the same rays, and every pixel where they disagree or the GLSL flagged IG_UNSURE is
 decided by the exact judge (f(o + t d) over Q, Descartes). The reduced affine forms themselves are checked
@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from conftest import SHAPES_DIR
-from implgen.bench import glslcases, glslcheck
 from implgen.codegen.backends.glsl.printer import glsl_name
 from implgen.codegen.backends.glsl.program import program, shape_defines
+from implgen.measure import glslcases, glslcheck
 from implgen.roots import exactray
 from implgen.spec.entry import load_spec, parse_spec
 
@@ -28,7 +28,7 @@ SIZE = (96, 72)
 
 @pytest.fixture(scope="module")
 def gl():
-    from implgen.bench.webgl import WebGL
+    from implgen.measure.webgl import WebGL
 
     with WebGL() as browser:
         version, renderer = browser.info()

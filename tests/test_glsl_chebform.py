@@ -12,9 +12,9 @@ import pytest
 import sympy
 
 from conftest import SHAPES_DIR
-from implgen.bench.glslcases import chmutov
 from implgen.codegen.backends.glsl import chebform
 from implgen.codegen.emit import generate
+from implgen.measure.glslcases import chmutov
 from implgen.spec.entry import load_spec, parse_spec
 from implgen.spec.parse import X, Y, Z
 

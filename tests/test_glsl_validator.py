@@ -10,10 +10,10 @@ from pathlib import Path
 import pytest
 
 from conftest import GENERATED, SHAPE_NAMES
-from implgen.bench.glslcases import chmutov
 from implgen.codegen.backends.glsl.printer import glsl_name
 from implgen.codegen.backends.glsl.program import program, shape_defines
 from implgen.codegen.emit import generate
+from implgen.measure.glslcases import chmutov
 from implgen.spec.entry import parse_spec
 from page_shader import glslang_problems
 

@@ -30,7 +30,7 @@ FLOORS = {
     "export": 7,
     "share": 7,
     "mesh": 7,
-    "bench": 7,
+    "measure": 7,
     "demo": 7,
     "cli": 8,
 }

@@ -8,14 +8,12 @@ from __future__ import annotations
 import json
 import math
 import shutil
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "bench"))
 
 povray = pytest.importorskip("implgen.export.povray")
 if not hasattr(povray, "scene_pov"):

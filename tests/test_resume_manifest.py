@@ -9,7 +9,6 @@ the run. Never a mixed set. Each frame is on the disk (fsync) before it is renam
 from __future__ import annotations
 
 import os
-import sys
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -18,9 +17,7 @@ import yaml
 from PIL import Image
 
 from implgen_proc import assert_one_line, implgen
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_animation_render import FRAMES, anim_scene  # noqa: E402
+from test_animation_render import FRAMES, anim_scene
 
 
 def write_scene(tmp_path: Path, **changes) -> Path:

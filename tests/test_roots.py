@@ -1,5 +1,5 @@
 """implgen.roots.solvers against the exact reference (SymPy root isolation on the exact rationals of the double
-coefficients, implgen.roots.reference), plus the API contract."""
+coefficients, implgen.measure.cases.reference), plus the API contract."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import pytest
 
 from conftest import SHAPES_DIR
 from implgen.errors import UserError
-from implgen.roots.cases import hard_set, random_set, shape_set
-from implgen.roots.reference import Score, exact_roots, score_one
+from implgen.measure.cases.polys import hard_set, random_set, shape_set
+from implgen.measure.cases.reference import Score, exact_roots, score_one
 from implgen.roots.solvers import METHODS, real_roots, real_roots_batch
 
 

@@ -10,8 +10,7 @@ import numpy as np
 import pytest
 
 from conftest import SHAPES_DIR
-from implgen.bench.solvers import FIRST, FIRST_METHODS, HIGH_METHODS, METHODS, main
-from implgen.roots.cases import (
+from implgen.measure.cases.polys import (
     BENCH_SHAPES,
     CASE_SETS,
     HIGH_CASE_SETS,
@@ -24,7 +23,8 @@ from implgen.roots.cases import (
     shape_module,
     shape_set,
 )
-from implgen.roots.reference import exact_roots, reference, score_first, score_one
+from implgen.measure.cases.reference import exact_roots, reference, score_first, score_one
+from implgen.measure.solvers import FIRST, FIRST_METHODS, HIGH_METHODS, METHODS, main
 from implgen.roots.solvers import (
     bench_fallbacks,
     bench_first_batch,

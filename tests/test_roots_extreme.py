@@ -1,6 +1,6 @@
 """Roots at the edges of the double range, against exact real-root isolation on the rationals of the double
-coefficients (implgen.roots.reference): quartics whose roots spread over ~150 decades next to the overflow limit,
-and torus ray polynomials written at a far origin, where the double polynomial's roots are what counts."""
+coefficients (implgen.measure.cases.reference): quartics whose roots spread over ~150 decades next to the overflow
+limit, and torus ray polynomials written at a far origin, where the double polynomial's roots are what counts."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import mpmath
 import numpy as np
 import pytest
 
-from implgen.roots.cases_extreme import far_torus_rays, spread_quartics
-from implgen.roots.reference import U, exact_roots, reference, score_one
+from implgen.measure.cases.extreme import far_torus_rays, spread_quartics
+from implgen.measure.cases.reference import U, exact_roots, reference, score_one
 from implgen.roots.solvers import first_root_batch, real_roots, real_roots_batch
 
 ACCURATE = ["auto", "bracket", "bernstein"]

@@ -2,7 +2,7 @@
 (file://, no server) and is used as a person would: it draws, a slider moves the picture, a drag turns it, the
 wheel zooms, the flagged pixels' marking switches on and off.
 
-The reference is the GLSL test harness (implgen.bench.webgl, as in tests/test_glsl_browser.py): the shape's
+The reference is the GLSL test harness (implgen.measure.webgl, as in tests/test_glsl_browser.py): the shape's
 generated GLSL and the runtime assembled by glslprogram.program with a main written here from docs/share.md's
 description of the picture (camera, clip, two-sided shading, the key light), at the page's camera and params.
 The page's canvas must equal it: colours within 2 of 255 on every pixel the reference did not flag, and on
@@ -67,7 +67,7 @@ void main()
 
 @pytest.fixture(scope="module")
 def gl():
-    from implgen.bench.webgl import WebGL
+    from implgen.measure.webgl import WebGL
 
     with WebGL(console_log=True) as browser:
         yield browser

@@ -15,10 +15,10 @@ import pytest
 from starlette.testclient import TestClient
 
 from conftest import ROOT
-from implgen.bench.glslcases import chmutov
 from implgen.codegen.backends.glsl import chebform
 from implgen.codegen.backends.glsl.program import HEADERS, runtime_text
 from implgen.codegen.emit import generate
+from implgen.measure.glslcases import chmutov
 from implgen.scene.load import load_scene
 from implgen.view import gpu
 from implgen.view.command import document_factory

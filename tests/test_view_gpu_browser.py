@@ -21,9 +21,9 @@ import pytest
 import yaml
 from PIL import Image
 
-from implgen.bench.glslcases import chmutov
-from implgen.bench.webgl import FLAGS
 from implgen.imagefile import to_uint8
+from implgen.measure.glslcases import chmutov
+from implgen.measure.webgl import FLAGS
 from implgen.scene.render import render
 from implgen.view import protocol
 from implgen.view.command import document_factory

@@ -31,7 +31,7 @@ and no symbolic link is followed):
     glue/glue-<32 hex>.c          the C list of a library's shapes, sealed
     obj/<stem>-<32 hex>.o         one object per C source, sealed
     lib/<tag>-<32 hex>.so         a linked library, sealed
-    roots_reference/<24 hex>.json exact reference roots (roots/reference.py: data, read back only as numbers)
+    roots_reference/<24 hex>.json exact reference roots (measure/cases/reference.py: data, read back only as numbers)
 """
 
 from __future__ import annotations

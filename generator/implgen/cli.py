@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 from implgen import __version__
 from implgen.args import examples_text
+from implgen.codegen.backends import LANGS
 from implgen.errors import UserError
 
 HELP = ("--help", "-h")
@@ -48,8 +49,8 @@ def _version(argv: Sequence[str]) -> int:
 
 
 GENERATE = Command(
-    "SPEC.yaml ... [--lang c|python|all] [-o DIR]",
-    "generate C and Python ray intersectors",
+    f"SPEC.yaml ... [--lang {'|'.join(LANGS)}|all] [-o DIR]",
+    "generate C, Python and GLSL ray intersectors",
     "implgen.codegen.command:main",
 )
 COMMANDS: dict[str, Command] = {
@@ -71,13 +72,13 @@ COMMANDS: dict[str, Command] = {
         "measurements: each prints a table and writes it, with the machine, to a results file (bench/README.md).",
         sub={
             "solvers": Command(
-                "bench solvers [options]", "measure root solvers: speed against error", "implgen.bench.solvers:main"
+                "bench solvers [options]", "measure root solvers: speed against error", "implgen.measure.solvers:main"
             ),
-            "gen": Command("bench gen [options]", "measure code generation against degree", "implgen.bench.gen:main"),
+            "gen": Command("bench gen [options]", "measure code generation against degree", "implgen.measure.gen:main"),
             "render": Command(
                 "bench render [SCENE.yaml ...] [options]",
                 "measure render speed and thread scaling",
-                "implgen.bench.render:main",
+                "implgen.measure.render:main",
             ),
         },
         examples=(

@@ -57,7 +57,7 @@ def gallery_dir() -> Path:
 
 def surface_js() -> Path:
     """The WebGL2 drawing code (`IgSurface`): the shared page's and the viewer's renderer, and the compile step of
-    the GLSL browser harness (implgen.bench.webgl). Package data of implgen.share."""
+    the GLSL browser harness (implgen.measure.webgl). Package data of implgen.share."""
     return _PACKAGE_DIR / "share" / "static" / "surface.js"
 
 

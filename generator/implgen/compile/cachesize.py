@@ -12,7 +12,7 @@ its mtime (cachedir.touch), so "least recently used" does not depend on the file
 times. Never evicted: the libraries this process holds loaded (clib keeps a weak map of live handles), what
 another process used in the last GRACE_SECONDS (it may be linking those objects now; this process's own
 entries may go, oldest first, since its library is linked), and `roots_reference/` (the tests' exact
-reference roots: minutes to compute, written by roots/reference.py without touching them on use, so their
+reference roots: minutes to compute, written by measure/cases/reference.py without touching them on use, so their
 mtime says nothing of their use). Leftovers of an earlier layout and of interrupted writes go first.
 """
 

@@ -6,7 +6,7 @@ computed exactly; Descartes' rule with bisection (implgen.roots.descartes) says 
 the clipped interval, a tangent (even) root included. A shape placed by a 3x4 matrix (Placed) takes the world ray
 into its own space in rationals; ExactJudge decides which of several placed shapes a ray meets first. This is the
 judge of bench/povray_compare.py's disputed pixels, of the Embree checks (bench/embree_scenes.py) and of the GLSL
-checks (implgen.bench.glslcheck, bench/glsl_compare.py).
+checks (implgen.measure.glslcheck, bench/glsl_compare.py).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The camera's primary rays as runtime_c/tracer_render.c builds them (one sample at a pixel's centre), in the
 same double operations: the basis w = eye - look_at, u = up x w, v = w x u, each made unit by dividing by its
 length, and the half-height tan(vfov / 2). For Python that needs the tracer's own rays: the POV-Ray comparison's
-exact judge (bench/povray_compare.py), the GLSL checks' ray sets (implgen.bench.glslcheck) and the viewer's pick
+exact judge (bench/povray_compare.py), the GLSL checks' ray sets (implgen.measure.glslcheck) and the viewer's pick
 (view/pick.py).
 """
 

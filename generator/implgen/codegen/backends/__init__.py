@@ -5,8 +5,10 @@ name, template folder, files, printer. `backend(lang)` imports only the one aske
 from __future__ import annotations
 
 import importlib
+from typing import TYPE_CHECKING
 
-from implgen.codegen.backends.contract import Backend
+if TYPE_CHECKING:  # contract.py imports SymPy: LANGS alone stays cheap (the CLI's usage line reads it)
+    from implgen.codegen.backends.contract import Backend
 
 LANGS = ("c", "python", "glsl")  # every backend, in the order `--lang all` writes them
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from numpy.polynomial import chebyshev
 
-from implgen.bench.glslcheck import Case, camera_rays, make_case, sphere_interval
+from implgen.measure.glslcheck import Case, camera_rays, make_case, sphere_interval
 from implgen.spec.entry import load_spec, parse_spec
 
 VIEW = np.array([0.55, 0.45, 0.7]) / np.linalg.norm([0.55, 0.45, 0.7])

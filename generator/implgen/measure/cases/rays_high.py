@@ -3,7 +3,7 @@
 Each surface is written as polynomial arithmetic on the ray's coordinates X(s) = o'_x + s d_x (and Y, Z), with
 one row of coefficients per ray (lowest power first), exactly like the generated code does it: the expanded
 power form of the field, evaluated on polynomials in s. The rays are aimed like the example shapes' rays
-(`implgen.roots.cases.ray_polys`: from far, near and inside the box), clipped to the box and shifted to the
+(`implgen.measure.cases.polys.ray_polys`: from far, near and inside the box), clipped to the box and shifted to the
 point of the clipped interval closest to the box centre, as runtime_c/shape.c does.
 
 - Chmutov surfaces T_n(x) + T_n(y) + T_n(z) = 0 (T_n: Chebyshev's polynomial, in its power form);

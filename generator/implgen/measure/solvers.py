@@ -4,7 +4,7 @@
 
 For each case set and method: ns per solve measured in C (clock_gettime around every solve, median over
 --timed polynomials, plus the mean of an untimed pass), and against the exact reference
-(implgen.roots.reference, on a --ref subset): max relative error on well-conditioned roots, median relative
+(implgen.measure.cases.reference, on a --ref subset): max relative error on well-conditioned roots, median relative
 error, missed simple roots, phantom roots. Methods in FIRST_METHODS are also timed in first-root mode
 (ig_first_root) and scored against the smallest exact root. numpy.roots runs on the same polynomials as an
 outside reference (its time is a Python call, not comparable with the C figures). The ray sets are the
@@ -22,11 +22,11 @@ from pathlib import Path
 import numpy as np
 
 from implgen.args import ArgumentParser
-from implgen.bench.machine import describe as machine
-from implgen.bench.solvers_high import degree_table, high_targets
 from implgen.errors import UserError
-from implgen.roots.cases import CASE_SETS, HIGH_CASE_SETS, HIGH_RAYS, CaseSet, find_shapes_dir
-from implgen.roots.reference import Score, reference, score_first, score_one
+from implgen.measure.cases.polys import CASE_SETS, HIGH_CASE_SETS, HIGH_RAYS, CaseSet, find_shapes_dir
+from implgen.measure.cases.reference import Score, reference, score_first, score_one
+from implgen.measure.machine import describe as machine
+from implgen.measure.solvers_high import degree_table, high_targets
 from implgen.roots.solvers import bench_fallbacks, bench_first_batch, bench_solve_batch
 
 METHODS = ["closed_plain", "closed", "sturm", "bracket", "bernstein", "auto"]

@@ -2,7 +2,7 @@
 bench/glsl_compare.py's measurement.
 
 A case is a grid of rays (a camera's pixels, or any rays), each rounded to float32 once: that float ray is
-what all three answer for. The GLSL runs in headless Chromium (implgen.bench.webgl) and writes, per ray, its
+what all three answer for. The GLSL runs in headless Chromium (implgen.measure.webgl) and writes, per ray, its
 status bits (IG_HIT, IG_UNSURE), t and the number of shape evaluations; the C side is the generated
 intersector's `first_hit` (the runtime's clip, shift and first-root solver, in double); every ray where the two
 disagree, and every ray the GLSL flagged, is decided exactly (implgen.roots.exactray). Where the GLSL and C

@@ -18,10 +18,10 @@ from pathlib import Path
 import sympy
 
 from implgen.args import ArgumentParser
-from implgen.bench.machine import describe, load_average, write_results
 from implgen.codegen.derive import derive, exact_ray_coefficients
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.errors import UserError
+from implgen.measure.machine import describe, load_average, write_results
 from implgen.outputs import check_output_file
 from implgen.spec.entry import parse_spec
 from implgen.spec.parse import MAX_DEGREE

@@ -1,13 +1,13 @@
 """Polynomials at the edges of the double range, for the tests: quartics whose real roots spread over ~150
 decades close to the overflow limit, and torus ray polynomials written at a far origin (not shifted), where
 rounding the coefficients to double moves the roots: every root of the double polynomial counts, and the exact
-reference (`implgen.roots.reference`) works on those doubles."""
+reference (`implgen.measure.cases.reference`) works on those doubles."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from implgen.roots import raysets_high
+from implgen.measure.cases import rays_high as raysets_high
 
 
 def _from_roots(roots: list[float]) -> np.ndarray:

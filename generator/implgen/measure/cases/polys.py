@@ -364,12 +364,12 @@ def _high(name: str, describe: str, make) -> CaseSet:
     rays = "rays from far (1e4 units), near (3-6 box radii) and inside the box, a third each"
     return CaseSet(
         name,
-        f"{describe}; {rays}, box-clipped and shifted as runtime_c/shape.c does (implgen.roots.raysets_high)",
+        f"{describe}; {rays}, box-clipped and shifted as runtime_c/shape.c does (implgen.measure.cases.rays_high)",
         lambda k, r, s=None: make(k, r),
     )
 
 
-#: degree 12-24 ray sets (implgen.roots.raysets_high): the report's cost and fallback rate per degree
+#: degree 12-24 ray sets (implgen.measure.cases.rays_high): the report's cost and fallback rate per degree
 HIGH_CASE_SETS = [
     *(
         _high(

@@ -28,8 +28,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from implgen.args import ArgumentParser
-from implgen.bench.machine import cpu_model, load_average
 from implgen.errors import UserError
+from implgen.measure.machine import cpu_model, load_average
 from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.build import build_scene
 from implgen.scene.load import load_scene
