@@ -18,7 +18,9 @@ built for this source. Hence:
   the SHA-256 of its bytes. An entry is used only when both files are regular, ours, not writable by group
   or others, the sidecar names the key we expect, and the bytes hash to the recorded value; anything else
   (truncated, empty, replaced, missing sidecar) is a miss, and the caller builds it again over it. The key
-  also sits in the entry's name, so a name is predictable but never trusted for its own sake.
+  also sits in the entry's name, so a name is predictable but never trusted for its own sake. A file that
+  cannot be opened because the process is out of descriptors is not a miss: that is said as it is
+  (errors.out_of_files_error), never as a broken seal or a compiler that wrote nothing.
 - **The bound.** `$IMPLGEN_CACHE_MAX_MB` (default 500, checked here with the folder): each use of an entry
   touches its mtime, and after a new library is linked the least recently used entries are removed until
   the cache fits (compile/cachesize.py, which also lists the cache for `implgen cache info|clear`).
@@ -44,7 +46,7 @@ import shutil
 import stat
 from pathlib import Path
 
-from implgen.errors import UserError
+from implgen.errors import UserError, out_of_files, out_of_files_error
 
 ENV = "IMPLGEN_CACHE"
 MAX_ENV = "IMPLGEN_CACHE_MAX_MB"
@@ -161,7 +163,9 @@ def _open_checked(path: Path) -> int | None:
     O_NONBLOCK: a fifo in place of an entry must not hang us."""
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | getattr(os, "O_NONBLOCK", 0))
-    except OSError:
+    except OSError as err:
+        if out_of_files(err):  # not a miss: the entry may be sound, and a rebuild would fail the same way
+            raise out_of_files_error(label(), err) from None
         return None
     st = os.fstat(fd)
     if not stat.S_ISREG(st.st_mode) or (_euid() >= 0 and st.st_uid != _euid()) or st.st_mode & 0o022:
@@ -292,7 +296,10 @@ def seal(tmp: Path, path: Path, key: str) -> None:
     (and removes `tmp`) when there is nothing to seal."""
     try:
         fd = os.open(tmp, os.O_RDONLY | os.O_NOFOLLOW)
-    except OSError:
+    except OSError as err:
+        if out_of_files(err):  # the compiler's output may be there: not "wrote nothing"
+            unlink_quietly(tmp)
+            raise out_of_files_error(label(), err) from None
         raise EmptyOutput(str(tmp)) from None
     try:
         st = os.fstat(fd)

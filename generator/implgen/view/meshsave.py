@@ -37,7 +37,7 @@ from collections.abc import Awaitable, Callable
 
 import numpy as np
 
-from implgen.errors import UserError
+from implgen.errors import UserError, out_of_files, out_of_files_error
 from implgen.mesh.budget import OverBudget, Stopped, estimate_bytes
 from implgen.mesh.job import CHILD, SOURCE, MeshJob, read_message, write_message
 from implgen.mesh.region import Clip, Sphere, box_clips
@@ -103,20 +103,12 @@ def run(job: MeshJob, seconds: float, stop: threading.Event, started: Callable[[
     if stop.is_set():
         raise Stopped
     started()
-    read_fd, write_fd = os.pipe()
     try:
-        child = subprocess.Popen(
-            [sys.executable, *CHILD, str(write_fd)],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.DEVNULL,
-            pass_fds=(write_fd,),
-            start_new_session=True,  # a Ctrl-C at the terminal is the server's: it kills this
-        )
-    except BaseException:
-        os.close(read_fd)
+        child, read_fd = _spawn()
+    except OSError as err:  # out of descriptors: that, not "internal error: OSError"
+        if out_of_files(err):
+            raise out_of_files_error(SOURCE, err) from None
         raise
-    finally:
-        os.close(write_fd)
     with _children_lock:
         _children.add(child)
     receive = os.fdopen(read_fd, "rb")
@@ -149,6 +141,25 @@ def run(job: MeshJob, seconds: float, stop: threading.Event, started: Callable[[
     if kind == "user":
         raise UserError(what[0], what[1])
     raise ChildBug(what[0], what[1])
+
+
+def _spawn() -> tuple[subprocess.Popen, int]:
+    """The mesh's process, started in a session (and a process group) of its own, and the pipe it replies on."""
+    read_fd, write_fd = os.pipe()
+    try:
+        child = subprocess.Popen(
+            [sys.executable, *CHILD, str(write_fd)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.DEVNULL,
+            pass_fds=(write_fd,),
+            start_new_session=True,  # a Ctrl-C at the terminal is the server's: it kills this
+        )
+    except BaseException:
+        os.close(read_fd)
+        raise
+    finally:
+        os.close(write_fd)
+    return child, read_fd
 
 
 def _end(child: subprocess.Popen) -> None:
