@@ -41,6 +41,7 @@ from __future__ import annotations
 import hashlib
 import math
 import os
+import re
 import secrets
 import shutil
 import stat
@@ -55,6 +56,7 @@ SEAL = ".sha256"
 _SEAL_HEADER = "implgen-cache-entry 1"
 _SEAL_MAX = 512  # bytes: a sidecar is one short line
 TMP_PREFIX = ".tmp-"
+_TEMP_NAME = re.compile(r"\.tmp-([0-9]{1,10})-[0-9a-f]{16}")  # temp_path's names: the writer's process id
 
 used_here: set[Path] = set()  # entries this process built or used (compile/cachesize.py: eviction)
 
@@ -252,8 +254,47 @@ def touch(path: Path) -> None:
 
 
 def temp_path(folder: Path, suffix: str = "") -> Path:
-    """A fresh name in `folder` for something being written (ignored by readers, removed by clear)."""
-    return folder / f"{TMP_PREFIX}{secrets.token_hex(8)}{suffix}"
+    """A fresh name in `folder` for something being written, `.tmp-<pid>-<16 hex><suffix>`: ignored by readers; the
+    process id says who writes it, so that a temporary is removed only once that process has gone (writer)."""
+    return folder / f"{TMP_PREFIX}{os.getpid()}-{secrets.token_hex(8)}{suffix}"
+
+
+def writer(name: str) -> int | None:
+    """The id of the process that named a temporary (temp_path), or None for a name without one (an earlier
+    version's)."""
+    m = _TEMP_NAME.match(name)
+    return int(m.group(1)) if m else None
+
+
+def running(pid: int) -> bool:
+    """Whether process `pid` exists (a zombie, ended but not reaped, still does)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's: it exists
+        return True
+    return True
+
+
+def remove_temporaries(pid: int) -> int:
+    """Remove what process `pid`, which has ended (and been reaped), left half-written in the cache's subfolders;
+    returns how many. Only names that temp_path gave that process are touched."""
+    prefix = f"{TMP_PREFIX}{pid}-"
+    removed = 0
+    try:
+        subs = [e.path for e in os.scandir(cache_root()) if e.is_dir(follow_symlinks=False)]
+    except OSError:
+        return 0
+    for sub in subs:
+        try:
+            names = [e.path for e in os.scandir(sub) if e.name.startswith(prefix) and writer(e.name) == pid]
+        except OSError:
+            continue
+        for path in names:
+            unlink_quietly(Path(path))
+            removed += not os.path.lexists(path)
+    return removed
 
 
 def _write_new(path: Path, data: bytes) -> None:
