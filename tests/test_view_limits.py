@@ -632,3 +632,46 @@ def test_running_out_of_descriptors_is_said_as_it_is(tmp_path) -> None:
         assert "seal" not in line and "internal error" not in line, line
     kinds = [line.split()[1] for line in lines]
     assert kinds[0] == kinds[2] == "UserError", out.stdout  # the command line's one line too
+
+
+ACCEPT_OUT_OF_FILES_SCRIPT = """
+import asyncio, os, socket, sys
+from implgen.view.connections import Listener, quiet_accept_errors
+
+sock = Listener(socket.AF_INET, socket.SOCK_STREAM)
+sock.bind(("127.0.0.1", 0))
+sock.listen(64)
+
+async def main():
+    loop = asyncio.get_running_loop()
+    quiet_accept_errors(loop)
+    await loop.create_server(asyncio.Protocol, sock=sock, backlog=64)
+    held = []
+    while True:
+        try:
+            held.append(os.open(os.devnull, os.O_RDONLY))
+        except OSError:
+            break
+    print(sock.getsockname()[1], flush=True)
+    await asyncio.sleep(float(sys.argv[1]))
+
+asyncio.run(main())
+"""
+
+
+def test_an_accept_out_of_descriptors_is_one_line_not_a_storm(tmp_path) -> None:
+    """Issue 31: asyncio logs a traceback for each accept() of its backlog that fails for want of descriptors,
+    and again every second (96,217 in 15 s, 60-70 % of a core). The viewer's listening socket backs off after
+    one, and the loop's handler says it in one line a minute: with 20 connections waiting for 3 s, one line."""
+    err = tmp_path / "stderr.txt"
+    with open(err, "w") as stderr:
+        proc = subprocess.Popen(
+            [sys.executable, "-c", ACCEPT_OUT_OF_FILES_SCRIPT, "3"], stdout=subprocess.PIPE, stderr=stderr, text=True
+        )
+    port = int(proc.stdout.readline())
+    waiting = [socket.create_connection(("127.0.0.1", port), timeout=GUARD) for _ in range(20)]
+    assert proc.wait(GUARD) == 0, err.read_text()
+    for s in waiting:
+        s.close()
+    lines = err.read_text().splitlines()
+    assert len(lines) == 1 and "Too many open files" in lines[0] and "Traceback" not in lines[0], lines[:20]
