@@ -197,3 +197,89 @@ def test_a_mesh_process_killed_from_outside_is_one_line(heavy_built) -> None:
     os.kill(kids[0], signal.SIGKILL)
     t.join(GUARD)
     assert [str(e) for e in out] == ["save_mesh: the mesh's process ended with exit code -9: try fewer cells"]
+
+
+SLOW_CC = """#!/bin/sh
+# A compiler that starts its output, then takes a minute (as cc1 on a large source): what Stop must end.
+[ "$1" = --version ] && exec cc "$@"
+while [ $# -gt 0 ]; do [ "$1" = -o ] && : > "$2"; shift; done
+exec sleep 60
+"""
+
+
+def _group(pgid: int) -> list[int]:
+    """The processes of process group `pgid` that still run, from /proc."""
+    out = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                fields = (d / "stat").read_text().rsplit(")", 1)[1].split()
+            except (OSError, IndexError):
+                continue
+            if fields[2] == str(pgid) and fields[0] != "Z":
+                out.append(int(d.name))
+    return out
+
+
+def _temporaries(cache: Path) -> list[Path]:
+    return sorted(p for p in cache.rglob(".tmp-*"))
+
+
+def test_stop_ends_the_mesh_s_compilers_and_leaves_no_temporary(tmp_path) -> None:
+    """Issue 31: the mesh's process was killed by its pid alone, so the compilers of its build ran on under PID 1
+    and their `.tmp-*.o` stayed in the cache. Stop now kills the process group (the child's session), and the
+    server removes what the child's builds left half written. A cold cache and a compiler that takes a minute:
+    Stop comes while they compile."""
+    cc = tmp_path / "slowcc"
+    cc.write_text(SLOW_CC)
+    cc.chmod(0o700)
+    cache = tmp_path / "cache"
+    env = {**os.environ, "CC": str(cc), "IMPLGEN_CACHE": str(cache)}
+    with view_server(str(TORUS), env=env) as (srv, url), _ws(url) as ws:
+        hello = json.loads(ws.recv())
+        ws.send(json.dumps({"type": "save_mesh", "cells": 16, "values": hello["values"], "options": hello["options"]}))
+        deadline = time.monotonic() + GUARD
+        while not ((kids := mesh_children(srv.pid)) and len(_group(kids[0])) > 1 and _temporaries(cache)):
+            assert time.monotonic() < deadline, "no compiler started by the mesh's process"
+            time.sleep(0.05)
+        compilers = [pid for pid in _group(kids[0]) if pid != kids[0]]
+        ws.send(json.dumps({"type": "stop_mesh"}))
+        while (msg := json.loads(ws.recv(GUARD)))["type"] != "mesh" or msg["state"] == "running":
+            pass
+        assert msg["state"] == "stopped", msg
+        assert _gone(kids[0])
+        left = [pid for pid in compilers if running(pid)]
+        assert not left and not _group(kids[0]), f"compilers of the stopped mesh still run: {left}"
+        assert _temporaries(cache) == []
+
+
+def test_cache_info_counts_temporaries_and_a_build_removes_only_those_whose_writer_has_gone(tmp_path, monkeypatch):
+    """Issue 31: a killed build's `.tmp-*` files were not counted by `implgen cache info` (not for a minute) and
+    stayed. Each temporary names the process writing it: one whose process runs is "writing" (counted, never
+    removed: a concurrent build renames it into place), one whose process has gone is a "leftover", counted and
+    removed at the next eviction, whatever the bound."""
+    from implgen import cachedir
+    from implgen.compile import cachesize
+
+    obj = tmp_path / "cache" / "obj"
+    obj.mkdir(parents=True, mode=0o700)
+    (tmp_path / "cache").chmod(0o700)
+    ended = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    gone = int(ended.stdout)  # a process that has ended (and been reaped)
+    mine, theirs = (obj / f".tmp-{pid}-{'5a' * 8}.o" for pid in (os.getpid(), gone))  # as cachedir.temp_path
+    for path in (mine, theirs):
+        path.write_bytes(b"\x7fELF half an object")
+    env = {**os.environ, "IMPLGEN_CACHE": str(tmp_path / "cache")}
+    cmd = [sys.executable, "-m", "implgen.cli", "cache", "info"]
+    info = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    assert info.returncode == 0, info.stderr
+    lines = {line.split()[0]: line for line in info.stdout.splitlines() if line.startswith("  ")}
+    assert " 1 entries" in lines["writing"] and " 1 entries" in lines["leftover"], info.stdout
+    assert "total: 2 entries" in info.stdout, info.stdout
+    monkeypatch.setenv("IMPLGEN_CACHE", str(tmp_path / "cache"))
+    removed = cachesize.evict(bound=10**9)  # far within the bound: only the leftover goes
+    assert [u.path for u in removed] == [theirs] and mine.exists() and not theirs.exists()
+    cachesize.clear(tmp_path / "cache")  # `implgen cache clear` too leaves what a running build writes
+    assert mine.exists()
+    named = cachedir.temp_path(obj, ".o")  # the names a build gives its temporaries
+    assert cachedir.writer(named.name) == os.getpid() and named.name.endswith(".o")

@@ -18,7 +18,9 @@ built for this source. Hence:
   the SHA-256 of its bytes. An entry is used only when both files are regular, ours, not writable by group
   or others, the sidecar names the key we expect, and the bytes hash to the recorded value; anything else
   (truncated, empty, replaced, missing sidecar) is a miss, and the caller builds it again over it. The key
-  also sits in the entry's name, so a name is predictable but never trusted for its own sake.
+  also sits in the entry's name, so a name is predictable but never trusted for its own sake. A file that
+  cannot be opened because the process is out of descriptors is not a miss: that is said as it is
+  (errors.out_of_files_error), never as a broken seal or a compiler that wrote nothing.
 - **The bound.** `$IMPLGEN_CACHE_MAX_MB` (default 500, checked here with the folder): each use of an entry
   touches its mtime, and after a new library is linked the least recently used entries are removed until
   the cache fits (compile/cachesize.py, which also lists the cache for `implgen cache info|clear`).
@@ -39,12 +41,13 @@ from __future__ import annotations
 import hashlib
 import math
 import os
+import re
 import secrets
 import shutil
 import stat
 from pathlib import Path
 
-from implgen.errors import UserError
+from implgen.errors import UserError, out_of_files, out_of_files_error
 
 ENV = "IMPLGEN_CACHE"
 MAX_ENV = "IMPLGEN_CACHE_MAX_MB"
@@ -53,6 +56,7 @@ SEAL = ".sha256"
 _SEAL_HEADER = "implgen-cache-entry 1"
 _SEAL_MAX = 512  # bytes: a sidecar is one short line
 TMP_PREFIX = ".tmp-"
+_TEMP_NAME = re.compile(r"\.tmp-([0-9]{1,10})-[0-9a-f]{16}")  # temp_path's names: the writer's process id
 
 used_here: set[Path] = set()  # entries this process built or used (compile/cachesize.py: eviction)
 
@@ -161,7 +165,9 @@ def _open_checked(path: Path) -> int | None:
     O_NONBLOCK: a fifo in place of an entry must not hang us."""
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | getattr(os, "O_NONBLOCK", 0))
-    except OSError:
+    except OSError as err:
+        if out_of_files(err):  # not a miss: the entry may be sound, and a rebuild would fail the same way
+            raise out_of_files_error(label(), err) from None
         return None
     st = os.fstat(fd)
     if not stat.S_ISREG(st.st_mode) or (_euid() >= 0 and st.st_uid != _euid()) or st.st_mode & 0o022:
@@ -248,8 +254,47 @@ def touch(path: Path) -> None:
 
 
 def temp_path(folder: Path, suffix: str = "") -> Path:
-    """A fresh name in `folder` for something being written (ignored by readers, removed by clear)."""
-    return folder / f"{TMP_PREFIX}{secrets.token_hex(8)}{suffix}"
+    """A fresh name in `folder` for something being written, `.tmp-<pid>-<16 hex><suffix>`: ignored by readers; the
+    process id says who writes it, so that a temporary is removed only once that process has gone (writer)."""
+    return folder / f"{TMP_PREFIX}{os.getpid()}-{secrets.token_hex(8)}{suffix}"
+
+
+def writer(name: str) -> int | None:
+    """The id of the process that named a temporary (temp_path), or None for a name without one (an earlier
+    version's)."""
+    m = _TEMP_NAME.match(name)
+    return int(m.group(1)) if m else None
+
+
+def running(pid: int) -> bool:
+    """Whether process `pid` exists (a zombie, ended but not reaped, still does)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's: it exists
+        return True
+    return True
+
+
+def remove_temporaries(pid: int) -> int:
+    """Remove what process `pid`, which has ended (and been reaped), left half-written in the cache's subfolders;
+    returns how many. Only names that temp_path gave that process are touched."""
+    prefix = f"{TMP_PREFIX}{pid}-"
+    removed = 0
+    try:
+        subs = [e.path for e in os.scandir(cache_root()) if e.is_dir(follow_symlinks=False)]
+    except OSError:
+        return 0
+    for sub in subs:
+        try:
+            names = [e.path for e in os.scandir(sub) if e.name.startswith(prefix) and writer(e.name) == pid]
+        except OSError:
+            continue
+        for path in names:
+            unlink_quietly(Path(path))
+            removed += not os.path.lexists(path)
+    return removed
 
 
 def _write_new(path: Path, data: bytes) -> None:
@@ -292,7 +337,10 @@ def seal(tmp: Path, path: Path, key: str) -> None:
     (and removes `tmp`) when there is nothing to seal."""
     try:
         fd = os.open(tmp, os.O_RDONLY | os.O_NOFOLLOW)
-    except OSError:
+    except OSError as err:
+        if out_of_files(err):  # the compiler's output may be there: not "wrote nothing"
+            unlink_quietly(tmp)
+            raise out_of_files_error(label(), err) from None
         raise EmptyOutput(str(tmp)) from None
     try:
         st = os.fstat(fd)

@@ -14,6 +14,13 @@ another process used in the last GRACE_SECONDS (it may be linking those objects 
 entries may go, oldest first, since its library is linked), and `roots_reference/` (the tests' exact
 reference roots: minutes to compute, written by measure/cases/reference.py without touching them on use, so their
 mtime says nothing of their use). Leftovers of an earlier layout and of interrupted writes go first.
+
+Temporaries (cachedir.temp_path: `.tmp-<pid>-...`, renamed into place when whole) are counted too: "writing"
+while the process whose id the name holds runs, never removed (it will rename or remove it itself); a
+"leftover" once that process has gone (killed mid-compile: a stopped mesh's, issue 31), removed at every
+evict() whatever the bound, and by `implgen cache clear`. Only the name's own process decides, so a concurrent
+build's temporaries are safe; a name without an id (an earlier version's) is a leftover after GRACE_SECONDS,
+and any temporary after STALE_SECONDS (its id may have been taken by another process since).
 """
 
 from __future__ import annotations
@@ -29,6 +36,7 @@ from pathlib import Path
 from implgen import cachedir
 
 GRACE_SECONDS = 60.0
+STALE_SECONDS = 3600.0  # no build writes one file for an hour
 
 # kind -> (subfolder, what a name must look like). Folders of `gen` are units; the rest are files.
 KINDS: dict[str, tuple[str, re.Pattern[str]]] = {
@@ -39,7 +47,7 @@ KINDS: dict[str, tuple[str, re.Pattern[str]]] = {
     "spec": ("spec", re.compile(r"[0-9a-f]{40}\.json\Z")),
     "roots_reference": ("roots_reference", re.compile(r"[0-9a-f]{24}\.(json|pkl)\Z")),
 }
-NOT_EVICTED = ("roots_reference",)
+NOT_EVICTED = ("roots_reference", "writing")
 # What earlier versions of implgen left (libraries at the top, 20-hex names, no seals): never loaded again,
 # removed by `implgen cache clear` and first by eviction.
 _OLD = {
@@ -78,6 +86,18 @@ def _folder_size(path: Path) -> int:
     return total
 
 
+def _temporary_kind(name: str, age: float) -> str:
+    """A temporary is "writing" while the process that named it runs (the id in its name: cachedir.temp_path),
+    else a "leftover"; a name without a process id (an earlier version's) is a leftover after GRACE_SECONDS, and
+    any after STALE_SECONDS (its id taken by another process since)."""
+    pid = cachedir.writer(name)
+    if age > STALE_SECONDS:
+        return "leftover"
+    if pid is None:
+        return "leftover" if age > GRACE_SECONDS else "writing"
+    return "writing" if cachedir.running(pid) else "leftover"
+
+
 def _units_in(root: Path, sub: str, kind: str, pattern: re.Pattern[str]) -> Iterable[Unit]:
     folder = root / sub if sub else root
     st = _lstat(folder)
@@ -95,9 +115,10 @@ def _units_in(root: Path, sub: str, kind: str, pattern: re.Pattern[str]) -> Iter
         if st is None:
             continue
         if name.startswith((cachedir.TMP_PREFIX, ".gen-", ".ig-")) and sub:
-            if now - st.st_mtime > GRACE_SECONDS:  # a crashed build's leftover
-                size = _folder_size(path) if stat.S_ISDIR(st.st_mode) else st.st_size
-                yield Unit("leftover", path, size, st.st_mtime)
+            if kind == "old":  # the folder's own kind lists it (obj/ and glue/ are looked at twice)
+                continue
+            size = _folder_size(path) if stat.S_ISDIR(st.st_mode) else st.st_size
+            yield Unit(_temporary_kind(name, now - st.st_mtime), path, size, st.st_mtime)
             continue
         if name.endswith(cachedir.SEAL) and pattern.match(name.removesuffix(cachedir.SEAL)):
             if _lstat(path.with_name(name.removesuffix(cachedir.SEAL))) is None:  # the seal of nothing
@@ -133,9 +154,11 @@ def evict(keep: Iterable[Path] = (), bound: int | None = None) -> list[Unit]:
     was removed."""
     bound = cachedir.max_bytes() if bound is None else bound
     units = inventory()
+    removed = _remove([u for u in units if u.kind == "leftover"])  # their writers have gone: at every use
+    units = [u for u in units if u.kind != "leftover"]
     total = sum(u.size for u in units)
     if total <= bound:
-        return []
+        return removed
     kept = {Path(p) for p in keep}
     now = time.time()
 
@@ -144,15 +167,19 @@ def evict(keep: Iterable[Path] = (), bound: int | None = None) -> list[Unit]:
             return False
         return u.path in cachedir.used_here or now - u.mtime > GRACE_SECONDS
 
-    removed = []
-    for u in sorted(filter(removable, units), key=lambda u: (u.kind not in ("old", "leftover"), u.mtime)):
+    for u in sorted(filter(removable, units), key=lambda u: (u.kind != "old", u.mtime)):
         if total <= bound:
             break
+        removed += _remove([u])
+        total -= u.size
+    return removed
+
+
+def _remove(units: list[Unit]) -> list[Unit]:
+    for u in units:
         cachedir.remove_entry(u.path)
         cachedir.used_here.discard(u.path)
-        total -= u.size
-        removed.append(u)
-    return removed
+    return units
 
 
 def clear(root: Path) -> tuple[list[Unit], list[Unit]]:
@@ -160,6 +187,8 @@ def clear(root: Path) -> tuple[list[Unit], list[Unit]]:
     the subfolders if they are left empty. Returns (what was removed, what could not be: a read-only cache)."""
     removed, failed = [], []
     for u in inventory(root):
+        if u.kind == "writing":  # a build running now renames it into place: left to it
+            continue
         cachedir.remove_entry(u.path)
         cachedir.used_here.discard(u.path)
         (failed if os.path.lexists(u.path) else removed).append(u)

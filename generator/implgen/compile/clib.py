@@ -32,7 +32,7 @@ from pathlib import Path
 
 from implgen import cachedir
 from implgen.compile import cachesize
-from implgen.errors import UserError
+from implgen.errors import UserError, out_of_files, out_of_files_error
 
 # The project's C standard and warnings, stated once: every build here, the tests' C drivers (tests/conftest.py)
 # and what `implgen demo` says it compiled with.
@@ -115,6 +115,8 @@ def _run(job: Job) -> Path:
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
     except OSError as err:
+        if out_of_files(err):
+            raise out_of_files_error("CC", err) from None
         raise UserError("CC", f"cannot run the C compiler {cmd[0]!r} on {job.what}: {err.strerror or err}") from None
     if proc.returncode != 0:
         cachedir.unlink_quietly(tmp)
@@ -222,6 +224,15 @@ def build_shared(
     return build_jobs([(Path(s), include_dirs) for s in sources], extra_flags, libs, tag)
 
 
+def _descriptors_left() -> None:
+    """Raise the line for running out of file descriptors if no file can be opened now."""
+    try:
+        os.close(os.open(os.devnull, os.O_RDONLY))
+    except OSError as err:
+        if out_of_files(err):
+            raise out_of_files_error(cachedir.label(), err) from None
+
+
 def load(path: Path) -> ctypes.CDLL:
     """Load a library built by build_shared, after checking it once more: a regular file of ours that nobody
     else can write, in a folder of ours, whose bytes hash to its seal, and whose seal is the key its name was
@@ -244,6 +255,7 @@ def load(path: Path) -> ctypes.CDLL:
     try:
         lib = ctypes.CDLL(str(path))
     except OSError as err:
+        _descriptors_left()  # dlopen's error has no errno: a sound library that could not be opened is kept
         cachedir.remove_entry(path)
         raise UserError("CC", f"the library {path.name} built by {compiler()} does not load: {err}") from None
     _in_use[path] = lib

@@ -20,7 +20,7 @@ from implgen.compile import cachesize
 from implgen.errors import UserError
 
 USAGE = "usage: implgen cache info|clear"
-_KIND_ORDER = [*cachesize.KINDS, "old", "leftover"]
+_KIND_ORDER = [*cachesize.KINDS, "old", "writing", "leftover"]
 _KIND_NOTE = {
     "lib": "linked libraries",
     "obj": "object files",
@@ -29,7 +29,8 @@ _KIND_NOTE = {
     "spec": "parsed specs",
     "roots_reference": "exact reference roots (never evicted)",
     "old": "left by an earlier implgen",
-    "leftover": "unfinished writes",
+    "writing": "being written by a build that runs now (left alone)",
+    "leftover": "unfinished writes of builds that have ended (removed at the next build)",
 }
 
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from implgen.errors import UserError
+from implgen.errors import UserError, out_of_files, out_of_files_error
 from implgen.mesh.pipeline import closed_and_euler, mesh_spec
 from implgen.mesh.region import Clip
 from implgen.mesh.write import mesh_bytes, place, vertex_normals
@@ -110,6 +110,9 @@ def child(fd: int) -> int:
         reply = ("ok", *make(job, deadline, seconds, cancel))
     except UserError as err:
         reply = ("user", err.source, err.message)
+    except OSError as err:  # out of descriptors: said as it is; any other: a bug
+        said = out_of_files_error(SOURCE, err) if out_of_files(err) else None
+        reply = ("user", said.source, said.message) if said else ("bug", type(err).__name__, traceback.format_exc())
     except BaseException as err:  # a bug (or the server gone: no one reads it): its kind and traceback to the log
         reply = ("bug", type(err).__name__, traceback.format_exc())
     try:

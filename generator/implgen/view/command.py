@@ -10,6 +10,7 @@ which cancels every render and returns within a second or two.
 from __future__ import annotations
 
 import asyncio
+import functools
 import secrets
 import socket
 import sys
@@ -25,6 +26,7 @@ from implgen.view.document import STARTER, Document
 from implgen.view.work import Limits
 from implgen.yamlfile import read_yaml
 
+BACKLOG = 64  # connections the kernel holds for the server to accept, and asyncio accepts in one go
 SHUTDOWN_GRACE = 1  # seconds uvicorn waits for the pages' handlers at Ctrl-C (their renders are cancelled first)
 
 
@@ -55,15 +57,17 @@ def bind(host: str, port: int) -> socket.socket:
         infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
     except OSError as err:
         raise UserError("--host", f"cannot resolve {host!r} ({err.strerror or err})") from None
+    from implgen.view.connections import Listener
+
     family, _, _, _, addr = infos[0]
-    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock = Listener(family, socket.SOCK_STREAM)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
     try:
         sock.bind(addr)
     except OSError as err:
         sock.close()
         raise UserError("--port", f"cannot listen on {host}:{port} ({err.strerror or err})") from None
-    sock.listen(64)
+    sock.listen(BACKLOG)
     return sock
 
 
@@ -71,6 +75,25 @@ def is_loopback(host: str) -> bool:
     from implgen.view.server import LOOPBACK_HOSTS
 
     return host in LOOPBACK_HOSTS or host.startswith("127.")
+
+
+def _config(app, sock, limits: Limits):
+    import uvicorn
+
+    from implgen.view.connections import protocol_class
+    from implgen.view.protocol import MAX_MESSAGE
+
+    return uvicorn.Config(
+        app,
+        http=protocol_class(limits.request),
+        backlog=max(1, min(BACKLOG, sock.cap // 4)),  # what asyncio accepts at once, before any protocol runs
+        log_level="warning",
+        ws_max_size=MAX_MESSAGE,
+        ws_ping_interval=limits.ping,
+        ws_ping_timeout=limits.ping,
+        lifespan="off",
+        timeout_graceful_shutdown=SHUTDOWN_GRACE,
+    )
 
 
 def serve(
@@ -85,7 +108,7 @@ def serve(
     loopback needs a `token` (the page's link carries it)."""
     import uvicorn
 
-    from implgen.view.protocol import MAX_MESSAGE
+    from implgen.view.connections import capped, make_room, quiet_accept_errors
     from implgen.view.server import LOOPBACK_HOSTS, create_app
 
     host = sock.getsockname()[0]
@@ -100,15 +123,8 @@ def serve(
         limits=limits,
         token=None if loopback else token,
     )
-    config = uvicorn.Config(
-        app,
-        log_level="warning",
-        ws_max_size=MAX_MESSAGE,
-        ws_ping_interval=limits.ping,
-        ws_ping_timeout=limits.ping,
-        lifespan="off",
-        timeout_graceful_shutdown=SHUTDOWN_GRACE,
-    )
+    sock = capped(sock, limits.max_connections)
+    config = _config(app, sock, limits)
     work = app.state.work
     # the event loop's turn at the GIL comes sooner while SymPy parses on the parse pool (5 ms by default; the
     # heavy-neighbours measure of bench/view_latency.py is the check)
@@ -116,6 +132,10 @@ def serve(
     sys.setswitchinterval(0.001)
 
     class Server(uvicorn.Server):
+        async def startup(self, sockets=None) -> None:
+            quiet_accept_errors(asyncio.get_running_loop())  # out of descriptors: one line a minute
+            await super().startup(sockets=sockets)
+
         def handle_exit(self, sig, frame) -> None:
             """Ctrl-C: every render is cancelled at once and no page waits for its C threads to finish their
             row (on the event loop: this is a signal handler, which must not take the pools' locks)."""
@@ -126,6 +146,7 @@ def serve(
                 pass
 
     server = Server(config)
+    sock.make_room = functools.partial(make_room, server.server_state.connections)
     if on_ready is not None:
         on_ready(server)
     try:
@@ -160,7 +181,10 @@ def main(argv: Sequence[str]) -> int:
     args = ap.parse_args(list(argv))
     if not 0 <= args.port <= 65535:
         raise UserError("--port", f"{args.port} is outside [0, 65535]")
+    from implgen.view.connections import connection_cap
+
     limits = Limits.from_env()
+    connection_cap(limits.max_connections)  # a file-descriptor limit too low to serve: one line, before any work
     make_document = document_factory(args.file)
     make_document()  # a scene's shapes are checked now, not when the first page connects
     sock = bind(args.host, args.port)

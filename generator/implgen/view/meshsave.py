@@ -12,7 +12,9 @@ child process (mesh/job.py: a fresh interpreter, never a fork of the threaded se
 that a Ctrl-C at the terminal is the server's alone). The child stops itself at its budget, saying in which
 phase, and when the server goes (its stdin ends); a mesh pool thread waits for it and kills it at once on Stop,
 when its page closes or at Ctrl-C, or GRACE seconds past its budget; the children left at exit are killed. A
-page meshes one shape at a time. The singular-point search of `implgen mesh` is skipped: its time and memory do
+kill is the child's whole process group, so the compilers of a build it started end with it, and what they left
+half written in the build cache is removed once the child is reaped (cachedir.remove_temporaries). A page meshes
+one shape at a time. The singular-point search of `implgen mesh` is skipped: its time and memory do
 not depend on the cells (18 s and 443 MB on a degree-20 surface, bench/results/mesh_budget.md); nodes are
 closed around.
 
@@ -29,6 +31,7 @@ import logging
 import math
 import os
 import select
+import signal
 import subprocess
 import sys
 import threading
@@ -37,7 +40,8 @@ from collections.abc import Awaitable, Callable
 
 import numpy as np
 
-from implgen.errors import UserError
+from implgen import cachedir
+from implgen.errors import UserError, out_of_files, out_of_files_error
 from implgen.mesh.budget import OverBudget, Stopped, estimate_bytes
 from implgen.mesh.job import CHILD, SOURCE, MeshJob, read_message, write_message
 from implgen.mesh.region import Clip, Sphere, box_clips
@@ -103,20 +107,12 @@ def run(job: MeshJob, seconds: float, stop: threading.Event, started: Callable[[
     if stop.is_set():
         raise Stopped
     started()
-    read_fd, write_fd = os.pipe()
     try:
-        child = subprocess.Popen(
-            [sys.executable, *CHILD, str(write_fd)],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.DEVNULL,
-            pass_fds=(write_fd,),
-            start_new_session=True,  # a Ctrl-C at the terminal is the server's: it kills this
-        )
-    except BaseException:
-        os.close(read_fd)
+        child, read_fd = _spawn()
+    except OSError as err:  # out of descriptors: that, not "internal error: OSError"
+        if out_of_files(err):
+            raise out_of_files_error(SOURCE, err) from None
         raise
-    finally:
-        os.close(write_fd)
     with _children_lock:
         _children.add(child)
     receive = os.fdopen(read_fd, "rb")
@@ -136,10 +132,7 @@ def run(job: MeshJob, seconds: float, stop: threading.Event, started: Callable[[
         try:
             kind, *what = read_message(receive)
         except EOFError:
-            try:
-                code = child.wait(GRACE)
-            except subprocess.TimeoutExpired:
-                code = "none (it hung up)"
+            code = _exit_code(child, GRACE)
             raise UserError(SOURCE, f"the mesh's process ended with exit code {code}: try fewer cells") from None
     finally:
         _end(child)
@@ -151,10 +144,55 @@ def run(job: MeshJob, seconds: float, stop: threading.Event, started: Callable[[
     raise ChildBug(what[0], what[1])
 
 
+def _spawn() -> tuple[subprocess.Popen, int]:
+    """The mesh's process, started in a session (and a process group) of its own, and the pipe it replies on."""
+    read_fd, write_fd = os.pipe()
+    try:
+        child = subprocess.Popen(
+            [sys.executable, *CHILD, str(write_fd)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.DEVNULL,
+            pass_fds=(write_fd,),
+            start_new_session=True,  # a Ctrl-C at the terminal is the server's: it kills this
+        )
+    except BaseException:
+        os.close(read_fd)
+        raise
+    finally:
+        os.close(write_fd)
+    return child, read_fd
+
+
+def _exit_code(child: subprocess.Popen, timeout: float) -> int | str:
+    """The exit code of a child that has ended (negative: the signal that killed it), read without reaping it,
+    so that its process group keeps its id until _end has killed what the child started."""
+    end = time.monotonic() + timeout
+    while True:
+        try:
+            info = os.waitid(os.P_PID, child.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT)
+        except ChildProcessError:  # reaped already
+            return child.returncode if child.returncode is not None else "unknown"
+        if info is not None:
+            return -info.si_status if info.si_code in (os.CLD_KILLED, os.CLD_DUMPED) else info.si_status
+        if time.monotonic() > end:
+            return "none (it hung up)"
+        time.sleep(POLL)
+
+
+def _kill_group(child: subprocess.Popen) -> None:
+    """SIGKILL to the child's process group: the child and the compilers it runs (a build's cc and cc1 would run
+    on under PID 1, writing into the cache). Only while the child is not reaped: the group's id is its pid."""
+    if child.returncode is None:
+        try:
+            os.killpg(child.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
+
+
 def _end(child: subprocess.Popen) -> None:
-    """Kill the child if it still runs, and reap it."""
-    if child.poll() is None:
-        child.kill()
+    """Kill the child and what it started if they still run, reap it, and remove what its builds left half
+    written in the cache (their temporaries are named after the child's pid)."""
+    _kill_group(child)
     try:
         child.stdin.close()
     except OSError:
@@ -163,19 +201,20 @@ def _end(child: subprocess.Popen) -> None:
         child.wait(GRACE)
     except subprocess.TimeoutExpired:  # a killed process not gone in GRACE s: the kernel's to finish
         pass
+    else:
+        cachedir.remove_temporaries(child.pid)
     with _children_lock:
         _children.discard(child)
 
 
 @atexit.register
 def _kill_children() -> None:
-    """At exit (Ctrl-C: the mesh threads are daemons and may not get their turn), no mesh's process outlives the
-    server."""
+    """At exit (Ctrl-C: the mesh threads are daemons and may not get their turn), no mesh's process, nor a
+    compiler it started, outlives the server."""
     with _children_lock:
         left = list(_children)
     for child in left:
-        if child.poll() is None:
-            child.kill()
+        _kill_group(child)
 
 
 class MeshSaver:

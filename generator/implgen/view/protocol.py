@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from implgen import validate
-from implgen.errors import UserError
+from implgen.errors import UserError, out_of_files, out_of_files_error
 from implgen.mesh.budget import MAX_CELLS, MIN_CELLS
 from implgen.spec.entry import parse_spec
 from implgen.spec.grammar import format_expression
@@ -86,7 +86,10 @@ def error(field: str, message: str) -> dict:
 
 def error_for(err: Exception) -> dict:
     """The reply to a failure: bad input (UserError) as its line, the equation parser's beside the equation;
-    anything else is a bug, named by its kind only (the server's log has the traceback)."""
+    anything else is a bug, named by its kind only (the server's log has the traceback), except running out of file
+    descriptors, which is said as it is."""
+    if out_of_files(err):
+        err = out_of_files_error(None, err)
     if not isinstance(err, UserError):
         return error("message", f"internal error: {type(err).__name__}")
     if err.source == "equation":

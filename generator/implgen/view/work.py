@@ -68,6 +68,8 @@ class Limits:
     save_memory: float = 2048.0  # MB reserved by all saves, running or waiting
     idle: float = 600.0  # seconds a page may send nothing before it is closed
     ping: float = 20.0  # seconds between WebSocket pings, and for the answer: a vanished peer is closed
+    request: float = 10.0  # seconds a connection has to send a whole request (connections.py)
+    max_connections: int = 256  # connections at once, fewer when the file-descriptor limit says so (connections.py)
     parse_threads: int = 1  # SymPy holds the GIL: a second thread parses no faster and slows the event loop
     render_threads: int = 4
     save_threads: int = 1
