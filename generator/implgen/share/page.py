@@ -147,17 +147,12 @@ def _box_text(box: list[float] | None) -> str:
     return ", ".join(parts)
 
 
-def render_page(spec: Spec, sliders: list[Slider], look: Look, source_name: str, orbit: dict | None = None) -> str:
-    """The page as text. `sliders` in the spec's param order; `orbit` (yaw, pitch, distance, target, fov) defaults
-    to a view of the shape's box."""
-    values = {s.name: s.value for s in sliders}
-    if orbit is None:
-        orbit, _ = framing(spec, values)
-    shape = generate(spec, ("glsl",))[f"{spec.name}.glsl"]
-    data = {
+def _page_data(spec: Spec, sliders: list[Slider], look: Look, orbit: dict) -> dict:
+    """The page's JSON block: what its script draws (the shape's GLSL, the runtime, the view)."""
+    return {
         "name": spec.name,
         "glsl_name": glsl_name(spec.name),  # the prefix of the shape's GLSL identifiers
-        "shape": shape,
+        "shape": generate(spec, ("glsl",))[f"{spec.name}.glsl"],
         "runtime": runtime_text(),
         "header": HEADERS["es"],
         "params": [{"name": s.name, "value": s.value, "min": s.lo, "max": s.hi} for s in sliders],
@@ -165,9 +160,11 @@ def render_page(spec: Spec, sliders: list[Slider], look: Look, source_name: str,
         "clip": {"kind": look.clip, "size": look.clip_size, "cut": look.cut},
         "material": MATERIAL,
     }
-    scripts = [static_text(name) for name in SCRIPTS]
-    css = static_text("page.css")
-    csp = "; ".join(
+
+
+def _csp(scripts: list[str], css: str) -> str:
+    """The page's Content-Security-Policy: nothing but its own inline scripts and style, by their hashes."""
+    return "; ".join(
         (
             "default-src 'none'",
             "script-src " + " ".join(_csp_hash(s) for s in scripts),
@@ -177,6 +174,30 @@ def render_page(spec: Spec, sliders: list[Slider], look: Look, source_name: str,
             "form-action 'none'",
         )
     )
+
+
+def _slider_fields(s: Slider) -> dict:
+    """A slider as the template writes its input: numbers as the page parses them, the ends as shown."""
+    return {
+        "name": s.name,
+        "value": _number(s.value),
+        "min": _number(s.lo),
+        "max": _number(s.hi),
+        "step": _number((s.hi - s.lo) / 1000),
+        "min_text": f"{s.lo:.6g}",
+        "max_text": f"{s.hi:.6g}",
+    }
+
+
+def render_page(spec: Spec, sliders: list[Slider], look: Look, source_name: str, orbit: dict | None = None) -> str:
+    """The page as text. `sliders` in the spec's param order; `orbit` (yaw, pitch, distance, target, fov) defaults
+    to a view of the shape's box."""
+    values = {s.name: s.value for s in sliders}
+    if orbit is None:
+        orbit, _ = framing(spec, values)
+    data = _page_data(spec, sliders, look, orbit)
+    scripts = [static_text(name) for name in SCRIPTS]
+    css = static_text("page.css")
     description = " ".join(spec.description.split())
     if len(description) > MAX_DESCRIPTION:
         description = description[: MAX_DESCRIPTION - 3] + "..."
@@ -186,24 +207,13 @@ def render_page(spec: Spec, sliders: list[Slider], look: Look, source_name: str,
         .get_template("page.html.j2")
         .render(
             version=__version__,
-            csp=csp,
+            csp=_csp(scripts, css),
             name=spec.name,
             equation=spec.equation,
             degree=spec.degree,
             box=_box_text(box),
             description=description,
-            params=[
-                {
-                    "name": s.name,
-                    "value": _number(s.value),
-                    "min": _number(s.lo),
-                    "max": _number(s.hi),
-                    "step": _number((s.hi - s.lo) / 1000),
-                    "min_text": f"{s.lo:.6g}",
-                    "max_text": f"{s.hi:.6g}",
-                }
-                for s in sliders
-            ],
+            params=[_slider_fields(s) for s in sliders],
             clips=CLIPS,
             clip=look.clip,
             clip_size=_number(look.clip_size),

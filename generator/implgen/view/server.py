@@ -103,6 +103,105 @@ def _static(name: str, media: str, token: str | None) -> Callable:
     return serve
 
 
+def _sender(ws: WebSocket) -> Callable:
+    """send(msg): a JSON message or bytes to the page, nothing once the page or the server has closed it."""
+
+    async def send(msg: dict | bytes) -> None:
+        if ws.application_state != WebSocketState.CONNECTED:
+            return  # closed by the server (idle): a render that ends later has no one to tell
+        try:
+            if isinstance(msg, bytes):
+                await ws.send_bytes(msg)
+            else:
+                await ws.send_json(msg)
+        except (WebSocketDisconnect, RuntimeError, OSError):
+            pass  # the page has gone; its receive loop ends on the disconnect
+
+    return send
+
+
+class _Pages:
+    """The WebSocket endpoint: each page's admission, its session, its messages until it goes or idles."""
+
+    def __init__(self, make_document, threads, allowed_hosts, token, work: Work) -> None:
+        self.make_document, self.threads, self.work = make_document, threads, work
+        self.allowed_hosts, self.token = allowed_hosts, token
+        self.open = 0
+
+    async def _admit(self, ws: WebSocket) -> bool:
+        """The page's origin and token checked, the socket accepted, the open pages counted."""
+        if not origin_allowed(ws.headers, self.allowed_hosts):
+            await ws.close(code=1008, reason="not this page's origin")
+            return False
+        if not token_allowed(ws.query_params.get("token"), self.token):
+            await ws.close(code=1008, reason="no token, or not this server's")
+            return False
+        await ws.accept()
+        if self.open >= self.work.limits.max_pages:
+            message = f"too many pages open (at most {self.work.limits.max_pages}): close one, then reload this one"
+            await ws.send_json(protocol.error("pages", message))
+            await ws.close(code=1013, reason="too many pages open")
+            return False
+        return True
+
+    async def _session(self, ws: WebSocket, send) -> Session | None:
+        """The page's session, its hello sent; None (the page told, the socket closed) when it cannot start."""
+        try:  # a scene file is read again for each page: on the parse pool
+            slow = getattr(self.make_document, "reads_files", False)
+            doc = await self.work.call(self.work.parse, self.make_document) if slow else self.make_document()
+        except Exception as err:  # a scene file that no longer reads: its line to the page; a bug: logged
+            if not isinstance(err, UserError):
+                log.exception("viewer page could not start")
+            await send(protocol.error_for(err))
+            await _close(ws, 1011, "the page could not start")
+            return None
+        session = Session(doc, send, threads=self.threads, work=self.work)
+        await send(session.hello())
+        return session
+
+    async def _messages(self, ws: WebSocket, session: Session, send) -> None:
+        """The page's messages, each handled in turn, until it disconnects or is idle for the limit."""
+        idle = self.work.limits.idle
+        while True:
+            try:
+                async with asyncio.timeout(idle):  # not wait_for: it would receive in a task of its own
+                    msg = await ws.receive()
+            except TimeoutError:
+                await _close(ws, 1001, f"idle for {idle:g} s: reload the page to go on")
+                return
+            if msg["type"] == "websocket.disconnect":
+                return
+            text = msg.get("text")
+            if text is None:
+                await send(protocol.error("message", "message: expected text (JSON)"))
+                continue
+            try:
+                await session.handle(text)
+            except Exception as err:  # a bug, not bad input: tell the page, keep serving
+                log.exception("viewer message failed")
+                await send(protocol.error_for(err))
+
+    async def serve(self, ws: WebSocket) -> None:
+        """One page, from its connection to its end (Starlette's WebSocket endpoint: a method, not an ASGI app)."""
+        if not await self._admit(ws):
+            return
+        send = _sender(ws)
+        self.open += 1
+        session = None
+        try:
+            session = await self._session(ws, send)
+            if session is not None:
+                await self._messages(ws, session, send)
+        except (WebSocketDisconnect, asyncio.CancelledError):
+            pass  # the page has gone, or the server stops (Ctrl-C) while it waits for a parse: end quietly
+        finally:
+            try:
+                if session is not None:
+                    await session.close()  # its renders and its save stop first: they count against the page
+            finally:
+                self.open -= 1
+
+
 def create_app(
     make_document: Callable[[], Document],
     threads: int | None = None,
@@ -115,75 +214,7 @@ def create_app(
     may be reached under (None: any, for a server listening beyond this machine, which then needs `token`). The
     app's Work is `app.state.work`: shut it down when the server stops."""
     work = Work(limits)
-    idle = work.limits.idle
-    pages = {"open": 0}
-
-    async def frames(ws: WebSocket) -> None:
-        if not origin_allowed(ws.headers, allowed_hosts):
-            await ws.close(code=1008, reason="not this page's origin")
-            return
-        if not token_allowed(ws.query_params.get("token"), token):
-            await ws.close(code=1008, reason="no token, or not this server's")
-            return
-        await ws.accept()
-        if pages["open"] >= work.limits.max_pages:
-            message = f"too many pages open (at most {work.limits.max_pages}): close one, then reload this one"
-            await ws.send_json(protocol.error("pages", message))
-            await ws.close(code=1013, reason="too many pages open")
-            return
-
-        async def send(msg: dict | bytes) -> None:
-            if ws.application_state != WebSocketState.CONNECTED:
-                return  # closed by the server (idle): a render that ends later has no one to tell
-            try:
-                if isinstance(msg, bytes):
-                    await ws.send_bytes(msg)
-                else:
-                    await ws.send_json(msg)
-            except (WebSocketDisconnect, RuntimeError, OSError):
-                pass  # the page has gone; its receive loop ends on the disconnect
-
-        pages["open"] += 1
-        session = None
-        try:
-            try:  # a scene file is read again for each page: on the parse pool
-                slow = getattr(make_document, "reads_files", False)
-                doc = await work.call(work.parse, make_document) if slow else make_document()
-            except Exception as err:  # a scene file that no longer reads: its line to the page; a bug: logged
-                if not isinstance(err, UserError):
-                    log.exception("viewer page could not start")
-                await send(protocol.error_for(err))
-                await _close(ws, 1011, "the page could not start")
-                return
-            session = Session(doc, send, threads=threads, work=work)
-            await send(session.hello())
-            while True:
-                try:
-                    async with asyncio.timeout(idle):  # not wait_for: it would receive in a task of its own
-                        msg = await ws.receive()
-                except TimeoutError:
-                    await _close(ws, 1001, f"idle for {idle:g} s: reload the page to go on")
-                    break
-                if msg["type"] == "websocket.disconnect":
-                    break
-                text = msg.get("text")
-                if text is None:
-                    await send(protocol.error("message", "message: expected text (JSON)"))
-                    continue
-                try:
-                    await session.handle(text)
-                except Exception as err:  # a bug, not bad input: tell the page, keep serving
-                    log.exception("viewer message failed")
-                    await send(protocol.error_for(err))
-        except (WebSocketDisconnect, asyncio.CancelledError):
-            pass  # the page has gone, or the server stops (Ctrl-C) while it waits for a parse: end quietly
-        finally:
-            try:
-                if session is not None:
-                    await session.close()  # its renders and its save stop first: they count against the page
-            finally:
-                pages["open"] -= 1
-
+    pages = _Pages(make_document, threads, allowed_hosts, token, work)
     routes = [Route(path, _static(name, media, token)) for path, (name, media) in STATIC.items()]
     listing = gallery_json()  # the gallery specs' YAML, read once: no equation is parsed here
 
@@ -191,7 +222,7 @@ def create_app(
         return Response(listing, media_type="application/json", headers=HEADERS)
 
     routes.append(Route("/gallery.json", serve_gallery))
-    routes.append(WebSocketRoute("/ws", frames))
+    routes.append(WebSocketRoute("/ws", pages.serve))
     app = Starlette(routes=routes)
     app.state.work = work
     return app
