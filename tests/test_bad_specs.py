@@ -187,6 +187,12 @@ CASES += [
     equation("exponent-param", "x^a", "exponent must be a constant", "params: {a: 2}\n"),
     equation("deep-unary", "-" * 5000 + "x", "nested"),
     equation("deep-parentheses-110", "(" * 110 + "x" + ")" * 110, "parentheses nested deeper than 100"),
+    equation(
+        "deep-tree-55-levels",
+        "x^2 + z^2 + " + "b + a*(" * 55 + "y" + ")" * 55,
+        "nested 110 levels deep inside one another (at most 64)",
+        "params: {a: 0.5, b: 0.1}\n",
+    ),
     equation("equation-too-long", "x" + " + x" * 6000, "longer than 20000 characters"),
     equation("long-underscore-number", "x + " + "1_" * 50 + "1", "more than 80 digits"),
     equation("hex-exponent-bomb", "x^0xffffffffff", "degree would exceed 24"),

@@ -26,7 +26,14 @@ from sympy.polys.rings import ring
 from implgen import abi, validate
 from implgen.codegen import paramvalues
 from implgen.codegen.fingerprint import code_key
-from implgen.codegen.grammar import ParseError, check_terms, format_expression, parse_expression, split_equation
+from implgen.codegen.grammar import (
+    ParseError,
+    check_depth,
+    check_terms,
+    format_expression,
+    parse_expression,
+    split_equation,
+)
 from implgen.codegen.names import check_identifier, check_shape_name
 from implgen.codegen.specmodel import Spec
 from implgen.errors import UserError
@@ -166,9 +173,10 @@ def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[s
         lhs = parse_expression(lhs_text, VARIABLES, symbols, MAX_DEGREE)
         rhs = parse_expression(rhs_text, VARIABLES, symbols, MAX_DEGREE)
         check_terms(lhs.terms + rhs.terms)
+        f = lhs.expr - rhs.expr
+        check_depth(f)  # lhs - rhs: the right side negated can be a level deeper than either side
     except ParseError as err:
         raise UserError(source, f"equation: {err}") from None
-    f = lhs.expr - rhs.expr
     poly = exact_polynomial(f, list(symbols.values()))
     if poly == 0:
         raise UserError(source, "equation: is identically zero (every point would be on the surface)")
