@@ -68,7 +68,7 @@ def _params(spec, pairs: Sequence[str]) -> dict[str, float]:
         k: validate.number("--param", k, v.strip(), text_ok=True)
         for k, v in named_items("--param", pairs, spec.name, spec.params).items()
     }
-    spec.check_values(out, "--param", "--param")
+    spec.check_values(out, spec.source, "--param")  # "torus.yaml: --param: ...", as `implgen share` says it
     return out
 
 
