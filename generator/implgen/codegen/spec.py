@@ -14,6 +14,7 @@ Inside is f < 0 with f = lhs - rhs; the outward normal is grad f / |grad f|.
 from __future__ import annotations
 
 import math
+import unicodedata
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -267,13 +268,21 @@ def parse_spec(data: Any, source: str = "<spec>") -> Spec:
     return spec
 
 
+# Bidirectional-text controls reorder what is shown around them (a title that reads one way and is another).
+_BIDI_CONTROLS = frozenset("\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+
+
 def _parse_text(source: str, key: str, value: Any) -> str:
-    """A title, description or reference: text of bounded length, its whitespace runs made single spaces. It is
-    shown (the viewer, the gallery's table), never written into generated code."""
+    """A title, description or reference: text of bounded length, its whitespace runs made single spaces, and no
+    control characters (a terminal escape, NUL, DEL, a bidirectional override). It is shown (the viewer, the
+    gallery's table, a terminal), never written into generated code."""
     if not isinstance(value, str):
         raise UserError(source, f"{key}: must be text")
     if len(value) > MAX_TEXT[key]:
         raise UserError(source, f"{key}: longer than {MAX_TEXT[key]} characters")
+    for i, ch in enumerate(value):
+        if not ch.isspace() and (unicodedata.category(ch) in ("Cc", "Cs") or ch in _BIDI_CONTROLS):
+            raise UserError(source, f"{key}: control character U+{ord(ch):04X} at position {i + 1} is not allowed")
     return " ".join(value.split())
 
 
