@@ -22,7 +22,7 @@ from implgen.bench.machine import describe, load_average, write_results
 from implgen.codegen.derive import derive, exact_ray_coefficients
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.codegen.spec import MAX_DEGREE, parse_spec
-from implgen.errors import UserError
+from implgen.errors import UserError, printable
 from implgen.outputs import check_output_file
 
 DEGREES = (2, 4, 6, 8, 12, 16, 20, 24)
@@ -109,5 +109,5 @@ def main(argv: Sequence[str]) -> int:
         print(row, flush=True)
         table.append(row)
     write_results(args.output, "\n".join(lines + table) + "\n")
-    print(f"wrote {args.output}")
+    print(f"wrote {printable(str(args.output))}")
     return 0

@@ -29,7 +29,7 @@ from pathlib import Path
 
 from implgen.args import ArgumentParser
 from implgen.bench.machine import cpu_model, load_average
-from implgen.errors import UserError
+from implgen.errors import UserError, printable
 from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.build import build_scene
 from implgen.scene.load import load_scene
@@ -174,6 +174,9 @@ def main(argv: Sequence[str]) -> int:
     scenes = args.scenes or _default_scenes()
     if not scenes:
         raise UserError("bench render", "no scenes given and none in ./bench/scenes or ./examples/scenes")
+    check_options(width=args.width, height=args.height, spp=args.spp)
+    for path in scenes:  # a missing or bad scene: one line, before the report's first line is printed
+        load_scene(path)
     out = _Report()
     out.add(
         "# Render speed and thread scaling",
@@ -193,5 +196,5 @@ def main(argv: Sequence[str]) -> int:
     out.add("", f"Load average after: {load_average()}.")
     data = ("\n".join(out) + "\n").encode()
     atomic_write(args.output, lambda fh: fh.write(data))
-    print(f"wrote {args.output}")
+    print(f"wrote {printable(str(args.output))}")
     return 0

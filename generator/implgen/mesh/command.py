@@ -18,7 +18,7 @@ import numpy as np
 from implgen import validate
 from implgen.args import ArgumentParser
 from implgen.codegen.paramvalues import named_items
-from implgen.errors import UserError
+from implgen.errors import UserError, printable
 from implgen.mesh.budget import MAX_CELLS, MIN_CELLS
 from implgen.mesh.pipeline import Result, closed_and_euler, mesh_spec, signed_volume, singular_in_solid
 from implgen.mesh.region import parse_clip
@@ -163,7 +163,7 @@ def main(argv: Sequence[str]) -> int:
     print(
         f"implgen mesh: {spec.name}: {rep['vertices']} vertices, {rep['triangles']} triangles, "
         f"{'closed' if rep['closed'] else 'NOT closed'}, Euler characteristic {rep['euler_characteristic']}; "
-        f"{sing_text}{hidden_text} -> {out}",
+        f"{sing_text}{hidden_text} -> {printable(str(out))}",
         file=sys.stderr,
     )
     return 0
