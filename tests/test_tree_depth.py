@@ -10,6 +10,7 @@ is cold, through every path that derives, and a tree one level deeper is refused
 
 from __future__ import annotations
 
+import json
 import shutil
 import sys
 from pathlib import Path
@@ -105,6 +106,30 @@ def test_a_side_within_the_limit_whose_difference_is_not_is_refused(tmp_path):
     assert expression_depth(parse_expression(rhs, VARIABLES, NAMES, 24).expr) == MAX_TREE_DEPTH
     with pytest.raises(UserError, match=rf"s\.yaml: equation: .* nested {MAX_TREE_DEPTH + 1} levels deep"):
         load_spec(write_spec(tmp_path, "s", f"x^2 + z^2 = {rhs}"))
+
+
+def test_the_viewer_answers_beside_the_equation_and_draws_the_deepest(tmp_path):
+    """The page got "internal error: RecursionError" (and the terminal 2,400 lines): now the parser's line, beside
+    the equation; the deepest accepted equation is built (derived in the viewer's build thread) and drawn."""
+    from starlette.testclient import TestClient
+
+    from implgen.view.command import document_factory
+    from implgen.view.server import create_app
+    from test_view_api import picture, render_msg, reply
+
+    params = {"a": 0.5, "b": -0.1}
+    with TestClient(create_app(document_factory(None), threads=1)) as client, client.websocket_connect("/ws") as ws:
+        hello = reply(ws)
+        ws.send_text(json.dumps({"type": "shape", "equation": "x^2 + z^2 + " + nested(55), "params": params}))
+        err = reply(ws)
+        assert err["type"] == "error" and err["field"] == "equation", err
+        said = "equation: sums, products and powers nested 110 levels deep inside one another"
+        assert err["message"] == f"{said} (at most {MAX_TREE_DEPTH})"
+        ws.send_text(json.dumps({"type": "shape", "equation": DEEPEST["issue-form"], "params": params}))
+        shape = reply(ws)
+        assert shape["type"] == "shape" and shape["degree"] == 2, shape
+        ws.send_text(render_msg({**hello, "values": shape["values"]}, seq=4, refine=False, w=64, h=48))
+        assert len(picture(ws)) > 0
 
 
 # ------------------------------------------------------------------------------ the depth itself
