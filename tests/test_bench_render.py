@@ -36,3 +36,14 @@ def test_bad_options_are_one_line(tmp_path: Path, capsys, bad: list[str], option
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(f"implgen: error: {option}")
     assert list(tmp_path.iterdir()) == []  # refused before any work
+
+
+def test_a_missing_scene_is_one_line_before_the_report_starts(tmp_path: Path, capsys) -> None:
+    """The report prints its lines as they come: a scene that does not load is refused before the first, not
+    after the header (issue 31)."""
+    good = str(ROOT / "bench" / "scenes" / "torus.yaml")
+    assert cli_main(["bench", "render", good, str(tmp_path / "missing.yaml"), "-o", str(tmp_path / "r.md")]) == 2
+    said = capsys.readouterr()
+    assert said.out == ""
+    assert said.err == f"implgen: error: {tmp_path / 'missing.yaml'}: not found (expected a scene file)\n"
+    assert list(tmp_path.iterdir()) == []

@@ -80,7 +80,10 @@ def test_bench_help_lists_the_benches():
     assert (bare.returncode, bare.stdout, bare.stderr) == (2, "", p.stdout)
 
 
-@pytest.mark.parametrize("words", command_words(), ids=" ".join)
+CACHE_WORDS = [("cache", "info"), ("cache", "clear")]  # read without argparse (compile/command.py)
+
+
+@pytest.mark.parametrize("words", command_words() + CACHE_WORDS, ids=" ".join)
 def test_each_commands_help_has_examples(words):
     p = implgen_run(*words, "--help")
     assert p.returncode == 0, p.stderr

@@ -9,8 +9,11 @@ from __future__ import annotations
 
 import ast
 import ctypes
+import importlib.metadata
 import re
 import subprocess
+import sys
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -26,7 +29,7 @@ from implgen.errors import UserError
 from implgen.outputs import write_text_files
 from implgen.spec.entry import load_spec, parse_spec
 from implgen.spec.grammar import format_expression, parse_expression
-from implgen.spec.names import reserved_shape_name
+from implgen.spec.names import DEPENDENCY_MODULES, reserved_shape_name
 from implgen.spec.parse import VARIABLES, exact_polynomial, param_symbol
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -248,6 +251,33 @@ def test_headers_the_generated_code_includes_are_not_shape_names():
         if re.fullmatch(r"[A-Za-z]\w*", h):
             assert reserved_shape_name(h) is not None, h
             assert reserved_shape_name(h.upper()) is not None, h
+
+
+def test_python_modules_are_not_shape_names():
+    """`inspect.py` in the output folder was imported by numpy in place of the standard library's (issue 31):
+    every module of the standard library, and every top-level package of implgen's dependencies, is refused."""
+    modules = [m for m in sys.stdlib_module_names if re.fullmatch(r"[A-Za-z]\w*", m)]
+    assert {"inspect", "json", "ctypes", "os", "types", "random"} <= set(modules)
+    for name in modules:
+        for spelling in (name, name.upper(), name.capitalize()):
+            assert reserved_shape_name(spelling) is not None, spelling
+    with pytest.raises(UserError, match=r"^s\.yaml: name: 'inspect' is the name of a Python module"):
+        parse_spec({"name": "inspect", "equation": "x"}, "s.yaml")
+
+
+def test_the_dependencies_top_level_packages_are_not_shape_names():
+    """Read from pyproject.toml and the installed distributions, so a new dependency cannot be forgotten."""
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    wanted = {re.match(r"[A-Za-z0-9_.-]+", d).group(0).lower().replace("_", "-") for d in project["dependencies"]}
+    tops: dict[str, set[str]] = {}
+    for module, dists in importlib.metadata.packages_distributions().items():
+        for dist in dists:
+            tops.setdefault(dist.lower().replace("_", "-"), set()).add(module)
+    assert wanted <= set(tops), wanted - set(tops)
+    names = {m for d in wanted for m in tops[d] if re.fullmatch(r"[A-Za-z]\w*", m)}
+    assert {"numpy", "sympy", "yaml", "PIL", "trimesh"} <= names
+    assert names <= DEPENDENCY_MODULES, names - DEPENDENCY_MODULES
+    assert all(reserved_shape_name(m) is not None for m in DEPENDENCY_MODULES)
 
 
 @pytest.mark.parametrize(

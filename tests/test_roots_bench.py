@@ -4,12 +4,14 @@ mode is timed and scored, and `--quick` runs end to end with its table, targets 
 from __future__ import annotations
 
 import re
+import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from conftest import SHAPES_DIR
+from implgen.cli import main as cli_main
 from implgen.measure.cases.polys import (
     BENCH_SHAPES,
     CASE_SETS,
@@ -147,6 +149,20 @@ def _table(md: str) -> dict[tuple[str, str], list[str]]:
         if len(cells) == 10 and cells[0] not in ("case set", "---"):
             rows[(cells[0], cells[1])] = cells[2:]
     return rows
+
+
+def test_bench_solvers_refuses_a_shapes_folder_without_its_shapes_before_any_output(tmp_path: Path, capsys) -> None:
+    """A --shapes folder that lacks a shape the ray sets use: one line naming it, no header printed, and no -o
+    folder made (issue 31: the folder was created and a case set run before the refusal)."""
+    shapes = tmp_path / "shapes"
+    shapes.mkdir()
+    shutil.copy(SHAPES_DIR / "sphere.yaml", shapes)
+    out = tmp_path / "out" / "bench"
+    assert cli_main(["bench", "solvers", "--quick", "--shapes", str(shapes), "-o", str(out)]) == 2
+    said = capsys.readouterr()
+    assert said.out == "" and said.err.count("\n") == 1
+    assert said.err.startswith(f"implgen: error: {shapes}/") and "no such example shape" in said.err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["shapes"]
 
 
 def test_bench_solvers_quick(tmp_path: Path) -> None:

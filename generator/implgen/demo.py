@@ -14,7 +14,7 @@ from implgen.args import ArgumentParser
 from implgen.codegen.derive import derive
 from implgen.codegen.emit import derivation_ops, generate
 from implgen.compile.clib import WARNING_FLAGS, build_shared
-from implgen.errors import UserError
+from implgen.errors import UserError, printable
 from implgen.outputs import write_text_files
 from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, runtime_dir, runtime_sources
 from implgen.spec.entry import load_spec
@@ -85,6 +85,6 @@ def main(argv: Sequence[str]) -> int:
         except ImportError:
             return 0
         out = args.output / "glassware.png"
-        print(f"\nRendering {SHOWCASE} -> {out}")
+        print(f"\nRendering {SHOWCASE} -> {printable(str(out))}")
         return render_main([str(SHOWCASE), "-o", str(out)])
     return 0

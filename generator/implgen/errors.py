@@ -26,7 +26,12 @@ class UserError(Exception):
 
 def _one_line(text: str) -> str:
     """White space folded to single spaces; anything unprintable (terminal escapes, NUL) shown as \\xNN."""
-    text = " ".join(text.split())
+    return printable(" ".join(text.split()))
+
+
+def printable(text: str) -> str:
+    """`text` with anything unprintable (a newline, a terminal escape, NUL) shown as \\xNN or \\uNNNN, as error
+    lines show it: what success lines print of a path the user gave (`-o`), so output stays one line each."""
     return "".join(
         ch if ch.isprintable() else f"\\x{ord(ch):02x}" if ord(ch) < 0x100 else f"\\u{ord(ch):04x}" for ch in text
     )

@@ -18,7 +18,7 @@ from implgen.animation.batch import Runner, render_frames
 from implgen.animation.frameout import FrameOutput, plan_output
 from implgen.animation.frames import FrameOptions, Frames, load_frames, parse_range
 from implgen.args import ArgumentParser
-from implgen.errors import UserError
+from implgen.errors import UserError, printable
 from implgen.imagefile import write_png
 from implgen.scene.keys import MAX_FRAMES
 from implgen.scene.render import DEFAULT_FOLD, RenderInfo, image_options, render
@@ -139,7 +139,7 @@ def _still(args: argparse.Namespace, frames: Frames, frame: int, opts: FrameOpti
         raise UserError(f"-o {args.output}", f"cannot write: {err.strerror or err}") from None
     total = sum(info.rays.values())
     print(
-        f"implgen: wrote {out.target} ({img.shape[1]}x{img.shape[0]}, {info.seconds:.3f} s on "
+        f"implgen: wrote {printable(str(out.target))} ({img.shape[1]}x{img.shape[0]}, {info.seconds:.3f} s on "
         f"{info.threads} threads, {total / max(info.seconds, 1e-9) / 1e6:.2f} Mrays/s)"
     )
     return 0
@@ -168,6 +168,6 @@ def _run(
     again = f"; {k} frame{'' if k == 1 else 's'} there rendered again ({report.replaced_why})" if k else ""
     print(
         f"implgen: wrote {n} frame{'' if n == 1 else 's'}{skipped} of {opts.width}x{opts.height}{cut} "
-        f"to {out.target} in {report.seconds:.1f} s ({where}){again}"
+        f"to {printable(str(out.target))} in {report.seconds:.1f} s ({where}){again}"
     )
     return 0

@@ -15,7 +15,7 @@ from pathlib import Path
 from implgen.args import ArgumentParser
 from implgen.codegen.backends import LANGS
 from implgen.codegen.emit import generate
-from implgen.errors import UserError
+from implgen.errors import UserError, printable
 from implgen.outputs import check_output_folder, write_text_files
 from implgen.spec.entry import load_spec
 
@@ -63,7 +63,7 @@ def main(argv: Sequence[str]) -> int:
         for spec, seconds, names in summary:
             print(
                 f"{spec.name:<14} degree {spec.degree:>2}  {seconds * 1000:7.1f} ms  -> "
-                + ", ".join(str(args.output / n) for n in names),
+                + ", ".join(printable(str(args.output / n)) for n in names),
                 file=sys.stdout,
             )
     return 0

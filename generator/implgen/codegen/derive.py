@@ -20,6 +20,8 @@ import sympy
 from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
+from implgen.errors import UserError
+from implgen.spec.grammar import MAX_TREE_DEPTH
 from implgen.spec.parse import AXES, Spec, X, Y, Z
 
 # Names used inside generated code. User params are always prefixed `k_` (see spec.param_symbol), and cse
@@ -203,6 +205,21 @@ def _chain_powers(temps: list[tuple[sympy.Symbol, sympy.Expr]], outputs: list[sy
 
 
 def derive(spec: Spec) -> Derivation:
+    """The coefficients, value, gradient and bounds of `spec` as straight-line blocks. SymPy differentiates and
+    eliminates common subexpressions recursively; the parser keeps every equation within MAX_TREE_DEPTH levels,
+    which leaves room under Python's default recursion limit. Should the stack still run out (a caller already
+    deep in its own stack), the spec is refused in one line instead of a traceback of thousands."""
+    try:
+        return _derive(spec)
+    except RecursionError:
+        raise UserError(
+            spec.source,
+            f"equation: too deeply nested to derive here (Python's recursion limit was reached; an equation "
+            f"nests at most {MAX_TREE_DEPTH} levels)",
+        ) from None
+
+
+def _derive(spec: Spec) -> Derivation:
     n = spec.degree
     coeffs = ray_series(spec.f, n)
     at_point = {X: PX, Y: PY, Z: PZ}

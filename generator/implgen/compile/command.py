@@ -81,6 +81,19 @@ def clear() -> int:
     return 0
 
 
+SUBCOMMANDS = {
+    "info": (
+        "The folder, its entries by kind with their sizes, the total and the size bound. It creates nothing, and\n"
+        "says why a build would refuse the folder.",
+        "what the cache holds, and its bound",
+    ),
+    "clear": (
+        "Remove every entry (only names of the cache's layout; links are removed, not followed). The cache is\n"
+        "rebuilt on the next build.",
+        "empty it (it is rebuilt on the next render)",
+    ),
+}
+
 HELP = f"""{USAGE}
 
 The build cache: compiled libraries and objects, generated C and parsed specs (docs/tracer.md,
@@ -91,10 +104,12 @@ Its size bound is $IMPLGEN_CACHE_MAX_MB (default 500); past it, the least recent
   clear   remove every entry (only names of the cache's layout; links are removed, not followed)
 
 examples:
-  # what the cache holds, and its bound
-  implgen cache info
-  # empty it (it is rebuilt on the next render)
-  implgen cache clear"""
+""" + "\n".join(f"  # {example}\n  implgen cache {word}" for word, (_, example) in SUBCOMMANDS.items())
+
+
+def _sub_help(word: str) -> str:
+    text, example = SUBCOMMANDS[word]
+    return f"usage: implgen cache {word}\n\n{text}\n\nexamples:\n  # {example}\n  implgen cache {word}"
 
 
 def main(argv: Sequence[str]) -> int:
@@ -102,6 +117,9 @@ def main(argv: Sequence[str]) -> int:
     if args in (["-h"], ["--help"]):
         print(HELP)
         return 0
-    if len(args) != 1 or args[0] not in ("info", "clear"):
+    if len(args) == 2 and args[0] in SUBCOMMANDS and args[1] in ("-h", "--help"):
+        print(_sub_help(args[0]))
+        return 0
+    if len(args) != 1 or args[0] not in SUBCOMMANDS:
         raise UserError("cache", f"choose one of: info, clear ({USAGE})")
     return info() if args[0] == "info" else clear()

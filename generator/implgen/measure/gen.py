@@ -20,7 +20,7 @@ import sympy
 from implgen.args import ArgumentParser
 from implgen.codegen.derive import derive, exact_ray_coefficients
 from implgen.codegen.emit import derivation_ops, generate
-from implgen.errors import UserError
+from implgen.errors import UserError, printable
 from implgen.measure.machine import describe, load_average, write_results
 from implgen.outputs import check_output_file
 from implgen.spec.entry import parse_spec
@@ -110,5 +110,5 @@ def main(argv: Sequence[str]) -> int:
         print(row, flush=True)
         table.append(row)
     write_results(args.output, "\n".join(lines + table) + "\n")
-    print(f"wrote {args.output}")
+    print(f"wrote {printable(str(args.output))}")
     return 0

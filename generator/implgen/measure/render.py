@@ -28,7 +28,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from implgen.args import ArgumentParser
-from implgen.errors import UserError
+from implgen.errors import UserError, printable
 from implgen.measure.machine import cpu_model, load_average
 from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.build import build_scene
@@ -76,8 +76,7 @@ def _measure(cs: CScene, sc: Scene, args, threads: int) -> tuple[float, float, d
 
 
 def _prepared(path: Path, args, fold: bool = False) -> tuple[CScene, Scene]:
-    sc = load_scene(path)
-    image_options(sc, width=args.width, height=args.height, spp=args.spp)  # the options' ranges, checked
+    sc = load_scene(path)  # its options' ranges were checked before the report began (main)
     return CScene(sc, build_scene(sc, fold=fold)), sc
 
 
@@ -174,6 +173,8 @@ def main(argv: Sequence[str]) -> int:
     scenes = args.scenes or _default_scenes()
     if not scenes:
         raise UserError("bench render", "no scenes given and none in ./bench/scenes or ./examples/scenes")
+    for path in scenes:  # a missing or bad scene, an option out of range: one line, before the report's first line
+        image_options(load_scene(path), width=args.width, height=args.height, spp=args.spp)
     out = _Report()
     out.add(
         "# Render speed and thread scaling",
@@ -193,5 +194,5 @@ def main(argv: Sequence[str]) -> int:
     out.add("", f"Load average after: {load_average()}.")
     data = ("\n".join(out) + "\n").encode()
     atomic_write(args.output, lambda fh: fh.write(data))
-    print(f"wrote {args.output}")
+    print(f"wrote {printable(str(args.output))}")
     return 0

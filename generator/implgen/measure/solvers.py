@@ -22,11 +22,12 @@ from pathlib import Path
 import numpy as np
 
 from implgen.args import ArgumentParser
-from implgen.errors import UserError
-from implgen.measure.cases.polys import CASE_SETS, HIGH_CASE_SETS, HIGH_RAYS, CaseSet, find_shapes_dir
+from implgen.errors import UserError, printable
+from implgen.measure.cases.polys import CASE_SETS, HIGH_CASE_SETS, HIGH_RAYS, CaseSet, find_shapes_dir, prepare_shapes
 from implgen.measure.cases.reference import Score, reference, score_first, score_one
 from implgen.measure.machine import describe as machine
 from implgen.measure.solvers_high import degree_table, high_targets
+from implgen.outputs import check_output_folder
 from implgen.roots.solvers import bench_fallbacks, bench_first_batch, bench_solve_batch
 
 METHODS = ["closed_plain", "closed", "sturm", "bracket", "bernstein", "auto"]
@@ -354,7 +355,8 @@ def main(argv: list[str] | None = None) -> int:
         raise UserError("bench solvers", "need 1 <= --ref <= --timed")
     shapes = find_shapes_dir(args.shapes)
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    check_output_folder(out, "-o")
+    prepare_shapes(shapes)  # a missing or broken shape: one line, before the header and before -o is made
     t = time.time()
     print(
         f"implgen bench solvers: {len(CASE_SETS)} case sets x {len(METHODS)} methods and {len(HIGH_CASE_SETS)} "
@@ -365,8 +367,9 @@ def main(argv: list[str] | None = None) -> int:
     rows += run(args.timed, args.ref, args.seed, HIGH_METHODS, HIGH_CASE_SETS, shapes_dir=shapes)
     seconds = time.time() - t
     md = table(rows, CASE_SETS + HIGH_CASE_SETS, args.timed, args.ref, seconds)
+    out.mkdir(parents=True, exist_ok=True)
     (out / "solvers.md").write_text(md)
     plot(rows, out / "solvers.png")
     print(md)
-    print(f"wrote {out / 'solvers.md'} and {out / 'solvers.png'}")
+    print(f"wrote {printable(str(out / 'solvers.md'))} and {printable(str(out / 'solvers.png'))}")
     return 0

@@ -17,7 +17,7 @@ import numpy as np
 
 from implgen import validate
 from implgen.args import ArgumentParser
-from implgen.errors import UserError
+from implgen.errors import UserError, printable
 from implgen.mesh.budget import MAX_CELLS, MIN_CELLS
 from implgen.mesh.pipeline import Result, closed_and_euler, mesh_spec, signed_volume, singular_in_solid
 from implgen.mesh.region import parse_clip
@@ -68,7 +68,7 @@ def _params(spec, pairs: Sequence[str]) -> dict[str, float]:
         k: validate.number("--param", k, v.strip(), text_ok=True)
         for k, v in named_items("--param", pairs, spec.name, spec.params).items()
     }
-    spec.check_values(out, "--param", "--param")
+    spec.check_values(out, spec.source, "--param")  # "torus.yaml: --param: ...", as `implgen share` says it
     return out
 
 
@@ -163,7 +163,7 @@ def main(argv: Sequence[str]) -> int:
     print(
         f"implgen mesh: {spec.name}: {rep['vertices']} vertices, {rep['triangles']} triangles, "
         f"{'closed' if rep['closed'] else 'NOT closed'}, Euler characteristic {rep['euler_characteristic']}; "
-        f"{sing_text}{hidden_text} -> {out}",
+        f"{sing_text}{hidden_text} -> {printable(str(out))}",
         file=sys.stderr,
     )
     return 0

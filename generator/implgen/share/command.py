@@ -14,7 +14,7 @@ from pathlib import Path
 
 from implgen import validate
 from implgen.args import ArgumentParser
-from implgen.errors import UserError
+from implgen.errors import UserError, printable
 from implgen.outputs import atomic_write, check_output_file
 from implgen.share.page import CLIPS, Look, Slider, framing, render_page, slider
 from implgen.spec.entry import parse_spec
@@ -158,7 +158,8 @@ def main(argv: Sequence[str]) -> int:
     except OSError as err:
         raise UserError(f"-o {args.output}", f"cannot write: {err.strerror or err}") from None
     if not args.quiet:
-        print(f"{spec.name:<14} degree {spec.degree:>2}  {len(data_bytes) / 1024:6.1f} kB -> {args.output}")
+        size = len(data_bytes) / 1024
+        print(f"{spec.name:<14} degree {spec.degree:>2}  {size:6.1f} kB -> {printable(str(args.output))}")
     return 0
 
 

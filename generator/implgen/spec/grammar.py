@@ -32,6 +32,7 @@ from sympy.printing.str import StrPrinter
 
 MAX_TEXT_LENGTH = 20_000
 MAX_NESTING = 100  # parentheses / operator nesting a user could mean
+MAX_TREE_DEPTH = 64  # levels of the parsed expression tree (expression_depth); docs/limitations.md
 MAX_CONST_BITS = 256  # numerators and denominators of constants stay below 2^256 (about 1e77)
 MAX_DIGITS = 80  # digits in one number as written
 _LONG_NUMBER = re.compile(rf"[0-9_]{{{MAX_DIGITS + 1},}}")
@@ -311,8 +312,39 @@ def parse_expression(
         parsed = builder.build(tree)
     except RecursionError as err:
         raise ParseError("expression is nested too deeply") from err
+    check_depth(parsed.expr)
     check_terms(parsed.terms)
     return parsed
+
+
+def expression_depth(expr: sympy.Basic) -> int:
+    """The depth of `expr`'s tree as SymPy holds it: a number or a symbol is 0, a sum, product or power one more
+    than its deepest operand (SymPy flattens a sum in a sum, a product in a product, and writes -a as -1*a and
+    x - y^2 as x + (-1)*y^2). Walked without recursion, each shared subtree once, so in time linear in the
+    tree's size whatever its depth."""
+    depth: dict[int, tuple[sympy.Basic, int]] = {}  # id -> (node, depth); the node kept so no id is reused
+    stack: list[tuple[sympy.Basic, bool]] = [(expr, False)]
+    while stack:
+        node, ready = stack.pop()
+        if id(node) in depth:
+            continue
+        if ready or not node.args:
+            depth[id(node)] = (node, 1 + max((depth[id(a)][1] for a in node.args), default=-1))
+            continue
+        stack.append((node, True))
+        stack.extend((a, False) for a in node.args if id(a) not in depth)
+    return depth[id(expr)][1]
+
+
+def check_depth(expr: sympy.Basic) -> None:
+    """Refuse a tree deeper than MAX_TREE_DEPTH, before anything walks it recursively: SymPy's diff, cse and
+    printers recurse several Python frames a level, and a tree over 100 levels deep overflowed Python's
+    default recursion limit in a fresh process (docs/limitations.md)."""
+    depth = expression_depth(expr)
+    if depth > MAX_TREE_DEPTH:
+        raise ParseError(
+            f"sums, products and powers nested {depth} levels deep inside one another (at most {MAX_TREE_DEPTH})"
+        )
 
 
 def _check_text(text: object, what: str) -> None:

@@ -3,8 +3,9 @@
 A shape's name names its files (`<name>.c`, `.h`, `.py`) and its C symbols (`<name>_coeffs`, ...,
 `<NAME>_DEGREE`); a param's name becomes `k_<name>` inside generated code. Both must be identifiers that are
 not keywords, and a shape name must not collide with anything it shares a compiler, a linker or an import
-with: the runtime's and the scene glue's names, the C headers on the include path, the modules generated
-Python imports. tests/test_codegen_hostile.py checks this against every symbol of a built scene library,
+with: the runtime's and the scene glue's names, the C headers on the include path, and Python's modules (a
+generated `<name>.py` in a folder a script runs from is imported instead of the module of that name).
+tests/test_codegen_hostile.py checks this against every symbol of a built scene library,
 the headers generated code includes, the system headers' macros and libc/libm's exports.
 """
 
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import keyword
 import re
+import sys
 from typing import Any
 
 from implgen import validate
@@ -36,6 +38,16 @@ _C_HEADERS = frozenset(
     "stddef stdint stdio stdlib string tgmath time wchar wctype pthread unistd sched".split()
 )
 
+# Modules: `<name>.py` lands in the output folder, and Python imports from a script's own folder first, so a
+# shape called `inspect`, `json` or `ctypes` would stand in for the module numpy or implgen imports. Every module
+# of the standard library of the Python running implgen, and the top-level packages of implgen's dependencies
+# (pyproject.toml's `dependencies`; tests/test_codegen_hostile.py checks the list against them).
+DEPENDENCY_MODULES = frozenset(
+    "numpy sympy isympy jinja2 yaml PIL matplotlib mpl_toolkits pylab tqdm dask distributed imageio imageio_ffmpeg "
+    "starlette uvicorn websockets trimesh".split()
+)
+_PYTHON_MODULES = frozenset(m.lower() for m in sys.stdlib_module_names | DEPENDENCY_MODULES)
+
 
 def check_identifier(source: str, key: str, name: Any) -> str:
     if not isinstance(name, str) or not _IDENT.match(name):
@@ -55,6 +67,8 @@ def reserved_shape_name(name: str) -> str | None:
         return "is reserved by implgen (the C runtime's names start ig_, rt_, implgen)"
     if low in _C_HEADERS or low in {h.stem.lower() for h in runtime_dir().glob("*.h")}:
         return "is the name of a C header the generated code includes"
+    if low in _PYTHON_MODULES:
+        return "is the name of a Python module (the generated .py file would be imported in its place)"
     return None
 
 

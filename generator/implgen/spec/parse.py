@@ -14,6 +14,7 @@ Inside is f < 0 with f = lhs - rhs; the outward normal is grad f / |grad f|.
 from __future__ import annotations
 
 import math
+import unicodedata
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -26,7 +27,14 @@ from implgen import abi, validate
 from implgen.errors import UserError
 from implgen.spec import paramvalues
 from implgen.spec.fingerprint import code_key
-from implgen.spec.grammar import ParseError, check_terms, format_expression, parse_expression, split_equation
+from implgen.spec.grammar import (
+    ParseError,
+    check_depth,
+    check_terms,
+    format_expression,
+    parse_expression,
+    split_equation,
+)
 from implgen.spec.model import Spec
 from implgen.spec.names import check_identifier, check_shape_name
 
@@ -158,9 +166,10 @@ def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[s
         lhs = parse_expression(lhs_text, VARIABLES, symbols, MAX_DEGREE)
         rhs = parse_expression(rhs_text, VARIABLES, symbols, MAX_DEGREE)
         check_terms(lhs.terms + rhs.terms)
+        f = lhs.expr - rhs.expr
+        check_depth(f)  # lhs - rhs: the right side negated can be a level deeper than either side
     except ParseError as err:
         raise UserError(source, f"equation: {err}") from None
-    f = lhs.expr - rhs.expr
     poly = exact_polynomial(f, list(symbols.values()))
     if poly == 0:
         raise UserError(source, "equation: is identically zero (every point would be on the surface)")
@@ -252,13 +261,21 @@ def parse_full(data: Any, source: str = "<spec>") -> Spec:
     return spec
 
 
+# Bidirectional-text controls reorder what is shown around them (a title that reads one way and is another).
+_BIDI_CONTROLS = frozenset("\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+
+
 def _parse_text(source: str, key: str, value: Any) -> str:
-    """A title, description or reference: text of bounded length, its whitespace runs made single spaces. It is
-    shown (the viewer, the gallery's table), never written into generated code."""
+    """A title, description or reference: text of bounded length, its whitespace runs made single spaces, and no
+    control characters (a terminal escape, NUL, DEL, a bidirectional override). It is shown (the viewer, the
+    gallery's table, a terminal), never written into generated code."""
     if not isinstance(value, str):
         raise UserError(source, f"{key}: must be text")
     if len(value) > MAX_TEXT[key]:
         raise UserError(source, f"{key}: longer than {MAX_TEXT[key]} characters")
+    for i, ch in enumerate(value):
+        if not ch.isspace() and (unicodedata.category(ch) in ("Cc", "Cs") or ch in _BIDI_CONTROLS):
+            raise UserError(source, f"{key}: control character U+{ord(ch):04X} at position {i + 1} is not allowed")
     return " ".join(value.split())
 
 

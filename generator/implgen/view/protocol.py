@@ -51,6 +51,17 @@ MAX_SAVE_SPP = 64
 MESH_TYPES = ("save_mesh", "stop_mesh")  # meshsave.py
 TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object", "export_page", "glsl", *MESH_TYPES)
 PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
+# The ranges of the view's numbers, stated once: the checks below use them, and the hello sends them to the page,
+# whose share link (static/share.js) drops a number outside them instead of keeping a range of its own.
+RANGES = {
+    "value": (-validate.MAX_COORDINATE, validate.MAX_COORDINATE),  # a param's value (a slider)
+    "yaw": (-1e6, 1e6),
+    "pitch": (-89.0, 89.0),
+    "distance": (1e-3, 1e6),
+    "target": (-1e6, 1e6),
+    "fov": (1.0, 150.0),
+    "clip_size": (1e-3, 1e6),
+}
 
 
 @dataclass
@@ -175,18 +186,18 @@ def parse_values(raw: Any, spec: Spec) -> dict[str, float]:
     values = dict(spec.params)
     for name, v in _mapping("values", raw if raw is not None else {}).items():
         if name in spec.params:  # a stale slider of a param that is gone is ignored
-            values[name] = validate.number("values", str(name), v)
+            values[name] = validate.number("values", str(name), v, *RANGES["value"])
     return values
 
 
 def parse_orbit(raw: Any) -> Orbit:
     raw = _mapping("orbit", raw)
     o = Orbit()
-    o.yaw = validate.number("orbit", "yaw", raw.get("yaw", o.yaw), -1e6, 1e6) % 360.0
-    o.pitch = validate.number("orbit", "pitch", raw.get("pitch", o.pitch), -89.0, 89.0)
-    o.distance = validate.number("orbit", "distance", raw.get("distance", o.distance), 1e-3, 1e6)
-    o.target = validate.vector("orbit", "target", raw.get("target", list(o.target)), -1e6, 1e6)
-    o.fov = validate.number("orbit", "fov", raw.get("fov", o.fov), 1.0, 150.0)
+    o.yaw = validate.number("orbit", "yaw", raw.get("yaw", o.yaw), *RANGES["yaw"]) % 360.0
+    o.pitch = validate.number("orbit", "pitch", raw.get("pitch", o.pitch), *RANGES["pitch"])
+    o.distance = validate.number("orbit", "distance", raw.get("distance", o.distance), *RANGES["distance"])
+    o.target = validate.vector("orbit", "target", raw.get("target", list(o.target)), *RANGES["target"])
+    o.fov = validate.number("orbit", "fov", raw.get("fov", o.fov), *RANGES["fov"])
     return o
 
 
@@ -200,7 +211,7 @@ def parse_options(raw: Any) -> Options:
     raw = _mapping("options", raw)
     o = Options()
     o.clip = _choice("clip", raw.get("clip", o.clip), CLIPS)
-    o.clip_size = validate.number("options", "clip_size", raw.get("clip_size", o.clip_size), 1e-3, 1e6)
+    o.clip_size = validate.number("options", "clip_size", raw.get("clip_size", o.clip_size), *RANGES["clip_size"])
     cut = raw.get("cut", o.cut)
     if not isinstance(cut, bool):
         raise UserError("options", "cut: expected true or false")

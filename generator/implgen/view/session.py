@@ -92,6 +92,7 @@ class Session:
     def hello(self) -> dict:
         """The state the page starts from."""
         limits = {"frame": protocol.MAX_FRAME, "save": protocol.MAX_SAVE, "save_spp": protocol.MAX_SAVE_SPP}
+        limits["ranges"] = protocol.RANGES  # the share link reads its numbers within these (static/share.js)
         hello = {"type": "hello", **self.doc.state(), "limits": limits}
         return {**hello, "gpu": gpu.hello_part(), "shape_id": self._shape_id}
 

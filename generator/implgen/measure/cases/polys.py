@@ -317,6 +317,14 @@ RAYS_LOW = ["sphere", "cylinder", "cone", "piriform"]
 RAYS_HIGH = ["heart", "barth6", "chmutov8", "blobs10"]
 _RAY_MIX = "from far (1e4 units), near (3-6 box radii) and inside the box"
 
+
+def prepare_shapes(folder: str | Path | None = None) -> None:
+    """Every example shape the ray sets use, read and generated now (shape_module keeps them): a folder that
+    lacks one, or holds a broken one, is refused before a benchmark prints or writes anything."""
+    for name in (*TORUS, *RAYS_LOW, *RAYS_HIGH):
+        shape_module(name, folder)
+
+
 CASE_SETS = [
     CaseSet("random-4", "random quartics, N(0,1) coefficients, whole line", lambda k, r, s=None: random_set(4, k, r)),
     CaseSet(

@@ -125,8 +125,9 @@
   // A share link's view, applied once the page has its first state from the server: its equation is sent as a
   // new shape (its clip is the user's own: not fitted), its slider values wait for the shape's reply.
   let linkValues = null;
+  let linkRanges = null; // the server's ranges of the view's numbers (the hello): a link's are read within them
   function openLink() {
-    const { view, bad } = implgenLink.decode(location.hash);
+    const { view, bad } = implgenLink.decode(location.hash, linkRanges);
     // a note, not an error: the picture that follows does not clear it
     if (bad.length) showMessage(`share link: left out what did not read: ${bad.join(", ")}`, false);
     if (view.orbit) state.orbit = view.orbit;
@@ -328,6 +329,7 @@
       state.orbit = msg.orbit;
       state.home = JSON.parse(JSON.stringify(msg.orbit));
       maxFrame = msg.limits.frame;
+      linkRanges = msg.limits.ranges;
       fitCanvas();
       setOptions(msg.options);
       sceneMode = msg.mode === "scene";

@@ -3,7 +3,8 @@
 //     &clip=sphere:3[:cut]&color=f2bf4d&inside=5a8cf2&bg=1f1f24&lights=studio
 // A link is text from anywhere: decode() reads it as untrusted input, bounded in length, each field checked
 // by its own pattern and range and dropped when it does not pass (the server checks everything again); it
-// never evaluates anything. Plain JS, no build step.
+// never evaluates anything. The numbers' ranges are the server's, sent in its hello (view/protocol.py RANGES,
+// stated there once), so a link keeps no number the server would refuse. Plain JS, no build step.
 "use strict";
 
 window.implgenLink = (() => {
@@ -42,8 +43,13 @@ window.implgenLink = (() => {
     return q.toString();
   }
 
-  // the text after "#" -> {view: the fields that passed, bad: the names of those that did not}
-  function decode(fragment) {
+  // the text after "#" -> {view: the fields that passed, bad: the names of those that did not}; `ranges`: the
+  // hello's limits.ranges, {value: [lo, hi], yaw: ..., ...}; a number without its range does not read
+  function decode(fragment, ranges) {
+    const within = (s, key) => {
+      const r = ranges && Object.prototype.hasOwnProperty.call(ranges, key) ? ranges[key] : null;
+      return Array.isArray(r) && r.length === 2 ? num(s, r[0], r[1]) : null;
+    };
     const text = (fragment || "").replace(/^#/, "");
     const view = {}, bad = [];
     if (!text) return { view, bad };
@@ -63,7 +69,7 @@ window.implgenLink = (() => {
       const parts = values ? values.split(",") : [];
       for (const part of parts.slice(0, MAX_PARAMS)) {
         const [k, v] = part.split(":");
-        const x = num(v, -1e300, 1e300);
+        const x = within(v, "value");
         if (NAME.test(k || "") && x !== null) out[k] = x; else bad.push(`values (${part.slice(0, 20)})`);
       }
       view.values = out;
@@ -71,8 +77,7 @@ window.implgenLink = (() => {
     const cam = q.get("cam");
     if (cam !== null) {
       const c = cam.split(",");
-      const nums = [[-1e6, 1e6], [-89, 89], [1e-3, 1e6], [-1e6, 1e6], [-1e6, 1e6], [-1e6, 1e6], [1, 150]]
-        .map(([lo, hi], i) => num(c[i], lo, hi));
+      const nums = ["yaw", "pitch", "distance", "target", "target", "target", "fov"].map((k, i) => within(c[i], k));
       if (c.length === 7 && nums.every((x) => x !== null)) {
         view.orbit = { yaw: nums[0], pitch: nums[1], distance: nums[2], target: nums.slice(3, 6), fov: nums[6] };
       } else bad.push("cam");
@@ -81,7 +86,7 @@ window.implgenLink = (() => {
     const clip = q.get("clip");
     if (clip !== null) {
       const [kind, size, cut] = clip.split(":");
-      const r = num(size, 1e-3, 1e6);
+      const r = within(size, "clip_size");
       if (kind === "none") options.clip = "none";
       else if (CLIPS.includes(kind) && r !== null && (cut === undefined || cut === "cut")) {
         Object.assign(options, { clip: kind, clip_size: r, cut: cut === "cut" });
