@@ -12,7 +12,7 @@ For every case of implgen.measure.glslcases (the example shapes through a camera
   3. decides exactly (implgen.roots.exactray) every pixel where the two disagree and every pixel the GLSL
      flagged, up to --judge of them per case (a random sample beyond that: those counts are extrapolated
      and marked ~), and --silhouette agreed silhouette pixels to catch both being wrong;
-  4. writes the table per case and per degree, and the targets of issue 23 met or missed, to -o.
+  4. writes the table per case and per degree, and the precision targets met or missed, to -o.
 """
 
 from __future__ import annotations
@@ -168,7 +168,7 @@ def report(rows, size, judge: int, renderer: str, seconds: float, argv) -> str:
         "hits against C's t. Draw: the frame's time in the browser (the shape's ray entry point for every pixel, "
         "read back in bands of 32 rows).",
         "",
-        "## Per degree (issue 23's targets)",
+        "## Per degree (the precision targets)",
         "",
         "Surfaces as the user wrote them well (the example shapes, nested Chmutov, the far torus):",
         "",

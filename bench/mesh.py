@@ -218,7 +218,7 @@ def targets(rows) -> list[str]:
     err = [(r["label"], r["mc"]["max"] / max(r["ours"]["max"], 1e-300)) for r in rows]
     slow = [(r["label"], r["t_ours"] / r["t_mc"]) for r in rows if r["t_ours"] > 2 * r["t_mc"]]
     lines = [
-        "Targets (issue 25):",
+        "Targets (time, topology, vertex error, coarser grid):",
         "",
         "- topology right at every grid where marching cubes gets it right: "
         + ("met on every surface with a known Euler characteristic" if not every else "missed on " + ", ".join(every)),

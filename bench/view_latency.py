@@ -2,7 +2,7 @@
 
     .venv/bin/python bench/view_latency.py [--rounds N] [--orbit-frames N] [--neighbour-seconds S] [-o FILE]
     .venv/bin/python bench/view_latency.py --neighbours-only     # the last measure alone, printed, not written
-    nice .venv/bin/python bench/view_latency.py --drag-only [--compare /work/main]   # the drags alone (issue 24)
+    nice .venv/bin/python bench/view_latency.py --drag-only [--compare /work/main]   # the drags alone
 
 Starts `implgen view --no-browser --port 0` in its own process with an empty build cache, connects as the page
 does, and for every example shape of degree <= 8, interleaved round by round, measures:
@@ -11,13 +11,13 @@ does, and for every example shape of degree <= 8, interleaved round by round, me
   - cached equation: the same edit sent again (generated code, objects and library all in the cache);
   - orbit: coarse frames per second while turning, each request sent when the previous frame has arrived;
   - refinement: from the coarse frame to the full 640 x 480, 4 samples per pixel frame of a resting view.
-Then drags (project issue 24: item 1): the page's mouse moves at 60 a second, whatever comes back, for
+Then drags: the page's mouse moves at 60 a second, whatever comes back, for
 DRAG_SECONDS, on the glassware scene, a zoomed-in Chmutov 12, x^20 + y^20 + z^20 - 1 and Barth's sextic: the
 coarse frames a second that arrive, the longest gap between two, and from the release (a refined request for
 the last view) to the refined frame. With --compare TREE, the same drags against a server run from another
 source tree (PYTHONPATH=TREE/generator: the code before the change), interleaved case by case and round by
 round, so both see the same load.
-Then, with heavy neighbours (project issue 22): one page orbits while three other pages keep sending
+Then, with heavy neighbours: one page orbits while three other pages keep sending
 `(x+y+z+a+b+1)^15` with a new constant each time (seconds of SymPy, then a build), and the orbiting page's
 frames per second and its longest wait for a frame are measured.
 Prints the medians and writes them, with the machine, to the results file.
@@ -262,7 +262,7 @@ def drag_lines(new: dict, old: dict | None, rounds: int, compare: Path | None = 
         "release → 4 spp (s) |"
     )
     lines = [
-        f"Drags (issue 24: item 1): mouse moves every {MOVE_GAP * 1e3:.0f} ms for {DRAG_SECONDS:g} s, sent whatever "
+        f"Drags: mouse moves every {MOVE_GAP * 1e3:.0f} ms for {DRAG_SECONDS:g} s, sent whatever "
         f"comes back, 640×480 canvas, then the release; medians of {rounds} rounds. Targets: ≥ 15 coarse "
         "frames/s, refined ≤ 0.4 s after the release for degree ≤ 8. The server sends the full size at 1 sample "
         "per pixel first when its 4-sample frame is expected to take longer than 0.4 s.",

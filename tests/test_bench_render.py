@@ -40,7 +40,7 @@ def test_bad_options_are_one_line(tmp_path: Path, capsys, bad: list[str], option
 
 def test_a_missing_scene_is_one_line_before_the_report_starts(tmp_path: Path, capsys) -> None:
     """The report prints its lines as they come: a scene that does not load is refused before the first, not
-    after the header (issue 31)."""
+    after the header."""
     good = str(ROOT / "bench" / "scenes" / "torus.yaml")
     assert cli_main(["bench", "render", good, str(tmp_path / "missing.yaml"), "-o", str(tmp_path / "r.md")]) == 2
     said = capsys.readouterr()

@@ -1,6 +1,7 @@
 """The build cache is code (it holds the libraries implgen loads), so it is held to the project's rule: nothing
 is loaded unless this user owns it, nobody else can write it, and it is the entry built for this source
-(generator/implgen/cachedir.py, compile/clib.py, compile/cachesize.py; issue 22, item 4).
+(generator/implgen/cachedir.py, compile/clib.py, compile/cachesize.py): what a hostile or broken cache folder must
+never make us load or run.
 
 Run as the user runs it where the contract is the command's (`implgen render`, `implgen cache`: exit status 2,
 one line, no traceback), in process where a test needs to look inside (which library is loaded, eviction).

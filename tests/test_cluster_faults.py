@@ -1,4 +1,5 @@
-"""`--cluster` pointed at things that are not a working Dask scheduler (issue 22, items 6 and 8).
+"""`--cluster` pointed at things that are not a working Dask scheduler (an address that is not one, a scheduler lost
+mid-run): one line each.
 
 Every address is on 127.0.0.1: a socket that accepts and says nothing, an HTTP server, a worker of a real
 LocalCluster, a scheduler that goes away in the middle of a run, a scheduler with no workers yet. Each is one

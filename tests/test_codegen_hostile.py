@@ -254,7 +254,7 @@ def test_headers_the_generated_code_includes_are_not_shape_names():
 
 
 def test_python_modules_are_not_shape_names():
-    """`inspect.py` in the output folder was imported by numpy in place of the standard library's (issue 31):
+    """`inspect.py` in the output folder was imported by numpy in place of the standard library's:
     every module of the standard library, and every top-level package of implgen's dependencies, is refused."""
     modules = [m for m in sys.stdlib_module_names if re.fullmatch(r"[A-Za-z]\w*", m)]
     assert {"inspect", "json", "ctypes", "os", "types", "random"} <= set(modules)

@@ -82,7 +82,7 @@ def _stack_depth() -> int:
 def command_line_stack(frames_above_main: int = 10):
     """Python's recursion limit as the code under test has it under `implgen` from a shell: the default
     limit, less the few frames from the interpreter to cli.main. Hypothesis raises the limit by up to 2,000
-    frames while a test runs, which would hide a walk that overflows on the command line (docs: issue 22,
+    frames while a test runs, which would hide a walk that overflows on the command line (docs:
     200 levels of CSG); this puts it back for the duration of the call."""
     limit = sys.getrecursionlimit()
     sys.setrecursionlimit(_stack_depth() + 1000 - frames_above_main)

@@ -91,7 +91,7 @@ def test_the_shader_says_which_form_it_evaluates():
     assert "Evaluated in the tree as written" in generate(chmutov(20, True), ("glsl",))["chmutov20n.glsl"]
 
 
-# ------------------------------------------------------------------------- issue 31: time, and the GLSL budget
+# ----------------------------------------------------- its time on a degree-24 product, and the GLSL budget
 
 BOX = {a: [-1, 1] for a in "xyz"}
 # six distinct linear factors to the 4th power: degree 24, 2906 monomials; SymPy's Poly of it took 37.7 s
@@ -134,7 +134,8 @@ def test_the_monomials_are_sympy_s_expansion_in_its_order(spec):
 
 
 def test_a_degree_24_product_gets_its_chebyshev_form_in_bounded_time():
-    """Issue 31's spec: 37.7 s of SymPy for its Chebyshev form before (0.6 s now); a generous bound, and the form
+    """Six linear factors each to the 4th power (degree 24): 37.7 s of SymPy for its Chebyshev form before (0.6 s
+    now); a generous bound, and the form
     equals f exactly at rational points (f's tree evaluated in exact rationals)."""
     spec = parse_spec({"name": "six", "equation": SIX_FACTORS, "bounds": BOX}, "<test>")
     start = time.monotonic()

@@ -92,7 +92,7 @@ def test_bad_options(tmp_path, args, names):
 
 def test_a_param_the_shape_cannot_take_names_the_file_and_the_option_once(tmp_path):
     """R = 1e9 puts the torus's bounds past the coordinate range: "torus_z.yaml: --param: ...", not "--param:
-    --param: ..." (issue 31), the same line `implgen share` gives."""
+    --param: ...", the same line `implgen share` gives."""
     ran = implgen("mesh", TORUS, "--param", "R=1e9", "-o", tmp_path / "x.stl")
     assert ran.code == 2 and ran.err.count("\n") == 1 and "Traceback" not in ran.err
     assert ran.err.startswith(f"implgen: error: {TORUS}: --param: with these params the bounds"), ran.err

@@ -1,4 +1,4 @@
-"""Success lines show the output path as error lines do: anything unprintable escaped (issue 31).
+"""Success lines show the output path as error lines do: anything unprintable escaped.
 
 An `-o` path holding a terminal escape or a newline was printed raw by the line that says where the files went,
 while an error line about the same path showed it escaped (errors.UserError). Both go through one function now

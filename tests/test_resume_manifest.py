@@ -1,4 +1,5 @@
-"""Resume trusts only frames made by the same settings (issue 22, item 7).
+"""Resume trusts only frames made by the same settings (scene, options, implgen's version): a stale frame is
+rendered again, never kept.
 
 A manifest beside the frames records what made them (the scene's digest, the size and the options that change
 pixels). A rerun skips a frame only when the manifest matches and the file is a PNG of the run's size; frames

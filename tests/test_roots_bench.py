@@ -153,7 +153,7 @@ def _table(md: str) -> dict[tuple[str, str], list[str]]:
 
 def test_bench_solvers_refuses_a_shapes_folder_without_its_shapes_before_any_output(tmp_path: Path, capsys) -> None:
     """A --shapes folder that lacks a shape the ray sets use: one line naming it, no header printed, and no -o
-    folder made (issue 31: the folder was created and a case set run before the refusal)."""
+    folder made (before, the folder was created and a case set run before the refusal)."""
     shapes = tmp_path / "shapes"
     shapes.mkdir()
     shutil.copy(SHAPES_DIR / "sphere.yaml", shapes)

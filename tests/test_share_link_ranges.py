@@ -1,4 +1,4 @@
-"""The share link's numbers are read within the server's ranges, stated once (issue 31).
+"""The share link's numbers are read within the server's ranges, stated once.
 
 The page's share link (view/static/share.js) kept param values up to ±1e300 where the server takes ±1e9, with its
 own copy of every range. The ranges now live in view/protocol.py RANGES: the server's checks use them, the hello

@@ -1,4 +1,4 @@
-"""Every equation the parser accepts derives, or is refused by the documented depth limit in one line (issue 31).
+"""Every equation the parser accepts derives, or is refused by the documented depth limit in one line.
 
 SymPy's diff, cse and printers walk an expression recursively, several Python frames a level. An equation nested
 55 levels (`x^2 + z^2 + b + a*(b + a*( ... y ...))`, 110 levels of SymPy tree) was within the parenthesis and

@@ -150,7 +150,7 @@ BOX = {a: [-2, 2] for a in "xyz"}  # a spec without params in a finite box: its 
 
 
 def test_a_glsl_derivation_does_not_hold_another_page_s_new_equation(client, monkeypatch) -> None:
-    """Issue 31: one page's GLSL (a degree-24 Chebyshev form took 38 s) held the shared parse thread, and another
+    """One page's GLSL (a degree-24 Chebyshev form took 38 s) held the shared parse thread, and another
     page's trivial equation waited 73-87 s for it. Now the GLSL has a pool of its own: with page A's Chebyshev
     step held, page B's new equation is answered (before: only once A's derivation had ended)."""
     entered, gate, released = threading.Event(), threading.Event(), threading.Event()

@@ -61,7 +61,7 @@ CSG_SCENE = {
 
 
 # A shape called MAX_LIGHTS_ball (the page's main once had MAX_LIGHTS replaced in it) whose params are named as
-# Object.prototype's members (issue 31): its file is in the fuzz corpus.
+# Object.prototype's members: its file is in the fuzz corpus.
 PROTOTYPE_SPEC = Path(__file__).resolve().parent / "fuzz_corpus" / "object-prototype-param-names.yaml"
 PROTOTYPE_NAMES = ["constructor", "toString", "valueOf", "hasOwnProperty"]
 CATCH_ERRORS = "window.pageErrors = []; addEventListener('error', (e) => window.pageErrors.push(String(e.message)));"
@@ -377,7 +377,7 @@ def test_a_csg_scene_is_the_server_s(tmp_path, driver) -> None:
 
 
 def test_past_the_glsl_budget_the_page_says_the_gpu_draws_the_tree(tmp_path, driver) -> None:
-    """Issue 31: the GLSL derivation and Export page have a budget (IMPLGEN_VIEW_GLSL_BUDGET); past it the shader
+    """The GLSL derivation and Export page have a budget (IMPLGEN_VIEW_GLSL_BUDGET); past it the shader
     evaluates f's tree as written, and the page says so beside the GPU preview and after Export page. Chmutov's
     degree-12 surface typed expanded in its box, whose Chebyshev form needs more than 0.01 s."""
     spec = chmutov(12, nested=False)

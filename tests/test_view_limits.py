@@ -1,4 +1,4 @@
-"""`implgen view` under hostile use (project issue 22): every piece of work a page starts is bounded and ends with
+"""`implgen view` under hostile use: every piece of work a page starts is bounded and ends with
 its page; parsing never blocks the event loop; a broken scene file or a silent socket costs no page; beyond
 loopback the page needs its token. Each test runs the real server, `implgen view --no-browser --port 0` in its
 own process, with small limits set through its environment variables (docs/viewer.md#limits), and talks to it
@@ -31,7 +31,7 @@ from websockets.sync.client import connect
 
 from implgen.view.session import HEADER, KIND_COARSE
 
-COSTLY = "(x+y+z+1)^24"  # a 24-fold plane: a few ms a pixel (issue 22)
+COSTLY = "(x+y+z+1)^24"  # a 24-fold plane: a few ms a pixel
 SLOW_TO_PARSE = "(x+y+z+a+b+10^70)^15"  # seconds of SymPy, then refused (a coefficient beyond 2^900)
 GUARD = 90  # seconds: a hang guard, not a timing
 
@@ -482,7 +482,7 @@ def test_the_limits_come_from_the_environment_and_a_bad_one_is_one_line(monkeypa
         assert line.startswith(f"implgen: error: {name}: ") and line.count("\n") == 1, line
 
 
-# ------------------------------------------------------------------------------------- issue 31: connections
+# ----------------------------------------------------------- connections: half-sent requests, descriptors
 
 HALF_HEAD = b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n"  # a request head that never ends (no blank line)
 WHOLE_GET = b"GET /style.css HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n"
@@ -538,7 +538,7 @@ def _page_works(srv: Server) -> None:
 
 
 def test_half_sent_requests_are_closed_and_pages_still_work(servers) -> None:
-    """Issue 31: 200 connections that never finish their request head (one after a whole request, kept alive)
+    """200 connections that never finish their request head (one after a whole request, kept alive)
     stayed open for ever. Each now has IMPLGEN_VIEW_REQUEST seconds (here 2) to send it; meanwhile a page loads and
     draws, and its socket, whose request was whole, is not cut by that time."""
     srv = servers(IMPLGEN_VIEW_REQUEST="2")
@@ -556,7 +556,7 @@ def test_half_sent_requests_are_closed_and_pages_still_work(servers) -> None:
 
 
 def test_with_the_descriptors_short_a_page_still_works_and_the_log_stays_quiet(servers) -> None:
-    """Issue 31: with `ulimit -n` reached by half-sent requests, no page could connect and the log got about
+    """With `ulimit -n` reached by half-sent requests, no page could connect and the log got about
     6,000 accept() tracebacks a second. Now the connections are capped below the limit (with room kept for the
     server's own files), the oldest half-sent request gives its place to a new connection, and a page loads and
     draws while 200 of them keep coming."""
@@ -618,7 +618,7 @@ print("page", "OSError", protocol.error_for(real)["message"])
 
 
 def test_running_out_of_descriptors_is_said_as_it_is(tmp_path) -> None:
-    """Issue 31: with no descriptor left, a frame failed with "scene-....so changed since it was built (its seal
+    """With no descriptor left, a frame failed with "scene-....so changed since it was built (its seal
     does not match)" and Save mesh with "internal error: OSError". The build cache, Save mesh and the page's error
     line now say what happened."""
     out = subprocess.run(
@@ -660,7 +660,7 @@ asyncio.run(main())
 
 
 def test_an_accept_out_of_descriptors_is_one_line_not_a_storm(tmp_path) -> None:
-    """Issue 31: asyncio logs a traceback for each accept() of its backlog that fails for want of descriptors,
+    """asyncio logs a traceback for each accept() of its backlog that fails for want of descriptors,
     and again every second (96,217 in 15 s, 60-70 % of a core). The viewer's listening socket backs off after
     one, and the loop's handler says it in one line a minute: with 20 connections waiting for 3 s, one line."""
     err = tmp_path / "stderr.txt"

@@ -1,4 +1,4 @@
-"""The viewer's Save mesh (project issue 25, item 8): the shape the page shows, with its param values and its clip,
+"""The viewer's Save mesh: the shape the page shows, with its param values and its clip,
 as a closed binary STL, read back with trimesh and checked against analytic volumes; a scene's picked object
 placed by its transform and cut by its own clip; and every way it can fail said in one line, with no file: a
 surface that runs on without end, no real points, a mesh beyond the saves' memory, over its time budget, a

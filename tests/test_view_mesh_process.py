@@ -226,7 +226,7 @@ def _temporaries(cache: Path) -> list[Path]:
 
 
 def test_stop_ends_the_mesh_s_compilers_and_leaves_no_temporary(tmp_path) -> None:
-    """Issue 31: the mesh's process was killed by its pid alone, so the compilers of its build ran on under PID 1
+    """The mesh's process was killed by its pid alone, so the compilers of its build ran on under PID 1
     and their `.tmp-*.o` stayed in the cache. Stop now kills the process group (the child's session), and the
     server removes what the child's builds left half written. A cold cache and a compiler that takes a minute:
     Stop comes while they compile."""
@@ -254,7 +254,7 @@ def test_stop_ends_the_mesh_s_compilers_and_leaves_no_temporary(tmp_path) -> Non
 
 
 def test_cache_info_counts_temporaries_and_a_build_removes_only_those_whose_writer_has_gone(tmp_path, monkeypatch):
-    """Issue 31: a killed build's `.tmp-*` files were not counted by `implgen cache info` (not for a minute) and
+    """A killed build's `.tmp-*` files were not counted by `implgen cache info` (not for a minute) and
     stayed. Each temporary names the process writing it: one whose process runs is "writing" (counted, never
     removed: a concurrent build renames it into place), one whose process has gone is a "leftover", counted and
     removed at the next eviction, whatever the bound."""

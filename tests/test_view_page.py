@@ -1,4 +1,4 @@
-"""`implgen view`, round two (project issue 24), in real headless Chromium: each defect the issue lists, as a
+"""`implgen view` in real headless Chromium, what a SURFER user checks first: each defect once found, as a
 person meets it. A drag keeps getting frames; the first run says the runtime is being compiled; errors clear,
 wrap and say what they mean; the picture fills the window, sharp on high-DPI screens, and 800×600 needs no
 sideways scroll. Frame rates are measured by bench/view_latency.py, not here: these tests only ask that frames
@@ -431,7 +431,7 @@ def test_a_scene_s_object_is_picked_by_a_click_or_from_the_list(balls_server, dr
 
 
 def test_the_gallery_picks_a_famous_surface_with_its_source(fresh_server, driver) -> None:
-    """Issue 24's gallery: at least 20 famous surfaces in the page's picker; picking one shows its equation,
+    """The gallery: at least 20 famous surfaces in the page's picker; picking one shows its equation,
     its name, a slider over the spec's own range and its source, and draws it."""
     from selenium.webdriver.support.ui import Select
 

@@ -17,7 +17,7 @@ mtime says nothing of their use). Leftovers of an earlier layout and of interrup
 
 Temporaries (cachedir.temp_path: `.tmp-<pid>-...`, renamed into place when whole) are counted too: "writing"
 while the process whose id the name holds runs, never removed (it will rename or remove it itself); a
-"leftover" once that process has gone (killed mid-compile: a stopped mesh's, issue 31), removed at every
+"leftover" once that process has gone (killed mid-compile: a stopped mesh's), removed at every
 evict() whatever the bound, and by `implgen cache clear`. Only the name's own process decides, so a concurrent
 build's temporaries are safe; a name without an id (an earlier version's) is a leftover after GRACE_SECONDS,
 and any temporary after STALE_SECONDS (its id may have been taken by another process since).

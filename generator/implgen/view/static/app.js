@@ -16,7 +16,7 @@
     toggle: $("gpu"), compare: $("compare"), status: $("status") }) : null;
 
   // Everything keyed by a param's name is a map without a prototype: a param may be called constructor,
-  // toString or __proto__, and state.ranges[name] must not find Object.prototype's member instead (issue 31).
+  // toString or __proto__, and state.ranges[name] must not find Object.prototype's member instead.
   const byName = (obj) => {
     const out = Object.create(null);
     if (obj && typeof obj === "object") for (const [k, v] of Object.entries(obj)) out[k] = v;
