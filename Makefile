@@ -28,7 +28,7 @@ demo: install
 	$(BIN)/implgen demo
 
 test: install browser povray glslang embree
-	$(BIN)/python -m pytest -q tests
+	$(BIN)/python -m pytest -q --durations=20 tests
 
 # $(call debian,PROGRAMS,PACKAGES,WHAT IS SKIPPED): when a program is missing, install the Debian packages as
 # root (CI runs as root); as anyone else say in one line what is skipped and how to install it, and go on --

@@ -27,6 +27,7 @@ from implgen.measure.webgl import FLAGS
 from implgen.scene.render import render
 from implgen.view import protocol
 from implgen.view.command import document_factory
+from implgen.view.protocol import RANGES
 from view_fixtures import view_process
 
 pytestmark = pytest.mark.needs_program("chromium", "chromedriver")
@@ -423,8 +424,11 @@ def test_params_named_as_object_prototype_s_members(driver) -> None:
         d.get("about:blank")
         open_page(d, f"{url}#{urlencode(link)}", script=CATCH_ERRORS)
         until(d, lambda d: js(d, "return window.implgenState().values.constructor") == 1.2, "the link's value")
-        decoded = "return Object.keys(implgenLink.decode(arguments[0]).view.values)"
-        assert js(d, decoded, "#" + urlencode(link)) == [*PROTOTYPE_NAMES, "__proto__"]  # a key like any other
+        decoded = (
+            "return Object.keys(implgenLink.decode(arguments[0], arguments[1]).view.values)"  # the server's ranges
+        )
+        ranges = {k: list(v) for k, v in RANGES.items()}
+        assert js(d, decoded, "#" + urlencode(link), ranges) == [*PROTOTYPE_NAMES, "__proto__"]  # a key like any other
         shown = dict(js(d, SLIDERS))
         assert sorted(shown) == sorted(PROTOTYPE_NAMES) and shown["constructor"] == 1.2
         assert js(d, "return document.getElementById('message').textContent") == ""
