@@ -10,7 +10,7 @@ SOURCES := pyproject.toml $(wildcard examples/shapes/*.yaml) \
                        -o -name '*.html' -o -name '*.js' -o -name '*.css' \) 2>/dev/null)
 C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c examples/embree/*.c)
 
-.PHONY: demo test lint tools browser povray glslang embree embree-example embree-picture screenshot install regen gallery bench clean
+.PHONY: demo test check lint tools browser povray glslang embree embree-example embree-picture screenshot install regen gallery bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -29,6 +29,17 @@ demo: install
 
 test: install browser povray glslang embree
 	$(BIN)/python -m pytest -q --durations=20 tests
+
+# The quick tier a developer runs while working (under two minutes on 2 cores): a few fast test files from every
+# room -- the house rules, the spec and its hostile inputs, each backend, the cache and ABI, the solvers and the
+# C kernels by name, scenes, keyed frames, the viewer's API, share, export, mesh, the benchmarks' commands.
+# `make test` stays the whole suite (docs/testing.md#two-tiers).
+CHECK_TESTS := layout house_rules doc_links public_api codegen_hostile deep_nesting generator_bad_input \
+  generator_textbook glsl_codegen abi cli_threads roots roots_auto descartes exactray raycast numerics_c \
+  mesh_kernels_c scene_clip scene_camera two_sided renderjob render_loop scene_limits animation_keys fps_ranges \
+  view_api view_gpu share_command povray_export mesh bench_gen bench_render output_lines
+check: install
+	$(BIN)/python -m pytest -q --durations=5 $(CHECK_TESTS:%=tests/test_%.py)
 
 # $(call debian,PROGRAMS,PACKAGES,WHAT IS SKIPPED): when a program is missing, install the Debian packages as
 # root (CI runs as root); as anyone else say in one line what is skipped and how to install it, and go on --
