@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from cdriver import CDriver, case_names
-from conftest import CDIR, RUNTIME, compile_c, run_c
+from conftest import CDIR, RUNTIME, compile_c
 from implgen.resources import (
     EMBREE_SOURCES,
     MESH_SOURCES,
@@ -33,14 +33,32 @@ def test_roots_hard_cases_under_sanitizers(roots_driver, case):
     roots_driver.check(case)
 
 
-def test_refinement_batched_equals_single_under_sanitizers(tmp_path):
-    out = run_c(compile_c(tmp_path / "test_refine", [CDIR / "test_refine.c", *SOLVERS]))
-    assert "all refinement checks passed" in out
+REFINE_SOURCE = CDIR / "test_refine.c"
+TORUS_SOURCE = CDIR / "test_shape_torus.c"
+BATCH_SOURCE = CDIR / "test_shape_batch.c"
+TORUS_FIXTURE = [CDIR / "shape_torus_fixture.c", *runtime_sources(SHAPE_SOURCES), *SOLVERS]
 
 
-def test_far_torus_matches_near_torus_under_sanitizers(tmp_path):
-    sources = [CDIR / "test_shape_torus.c", CDIR / "shape_torus_fixture.c", *runtime_sources(SHAPE_SOURCES), *SOLVERS]
-    assert "all checks passed" in run_c(compile_c(tmp_path / "test_shape_torus", sources))
+@pytest.fixture(scope="module")
+def refine_driver(tmp_path_factory) -> CDriver:
+    return CDriver.build(tmp_path_factory.mktemp("refine") / "test_refine", [REFINE_SOURCE, *SOLVERS])
+
+
+@pytest.mark.parametrize("case", case_names(REFINE_SOURCE))
+def test_refinement_batched_equals_single_under_sanitizers(refine_driver, case):
+    """tests/c/test_refine.c's named cases: batched refinement bitwise the single one, both at the known roots."""
+    refine_driver.check(case)
+
+
+@pytest.fixture(scope="module")
+def torus_driver(tmp_path_factory) -> CDriver:
+    return CDriver.build(tmp_path_factory.mktemp("torus") / "test_shape_torus", [TORUS_SOURCE, *TORUS_FIXTURE])
+
+
+@pytest.mark.parametrize("case", case_names(TORUS_SOURCE))
+def test_far_torus_matches_near_torus_under_sanitizers(torus_driver, case):
+    """tests/c/test_shape_torus.c's named cases: the far torus is the near one; the normal's hard points."""
+    torus_driver.check(case)
 
 
 def _runtime_source(path):
@@ -62,6 +80,12 @@ def test_runtime_sources_compile_clean(tmp_path, src):
     compile_c(tmp_path / "x.o", [src], sanitize=False, flags=["-c"])
 
 
-def test_shape_batch_equals_one_by_one_under_sanitizers(tmp_path):
-    sources = [CDIR / "test_shape_batch.c", CDIR / "shape_torus_fixture.c", *runtime_sources(SHAPE_SOURCES), *SOLVERS]
-    assert "all batch checks passed" in run_c(compile_c(tmp_path / "test_shape_batch", sources))
+@pytest.fixture(scope="module")
+def batch_driver(tmp_path_factory) -> CDriver:
+    return CDriver.build(tmp_path_factory.mktemp("batch") / "test_shape_batch", [BATCH_SOURCE, *TORUS_FIXTURE])
+
+
+@pytest.mark.parametrize("case", case_names(BATCH_SOURCE))
+def test_shape_batch_equals_one_by_one_under_sanitizers(batch_driver, case):
+    """tests/c/test_shape_batch.c's named cases: the batch entry points bit for bit the single calls."""
+    batch_driver.check(case)

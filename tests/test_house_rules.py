@@ -45,6 +45,24 @@ def test_no_function_over_60_lines():
     assert not long, f"functions over {MAX_LINES} lines: {long}"
 
 
+# the C test drivers that are not named cases (tests/c/ctest.h), and why
+NOT_NAMED_CASES = {
+    "embree_check.c": "a driver of several modes with its own command line, timed by bench/embree.py",
+    "tracer_offsets.c": "a measurement with arguments (hits per shape, seed) whose rows tests/test_tracer_c.py judges",
+}
+
+
+def test_no_function_over_60_lines_in_the_c_test_cases():
+    """The C test drivers written as named cases keep the rule too: a case is a small function."""
+    cdir = ROOT / "tests" / "c"
+    paths = [p for p in sorted(cdir.glob("*.[ch]")) if p.name not in NOT_NAMED_CASES]
+    found = [f for path in paths for f in c_functions(path)]
+    assert set(NOT_NAMED_CASES) <= {p.name for p in cdir.glob("*.c")}
+    assert len(found) > 100  # the walk found the functions
+    long = sorted((n, where) for n, where in found if n > MAX_LINES)
+    assert not long, f"functions over {MAX_LINES} lines: {long}"
+
+
 def test_the_c_walk_measures_a_known_function(tmp_path):
     src = tmp_path / "f.c"
     src.write_text(

@@ -55,3 +55,20 @@ def test_a_failing_case_is_named_and_the_others_still_run(tmp_path, monkeypatch)
     with pytest.raises(AssertionError, match="case crash did not finish"):
         d2.check("crash")
     d2.check("good")  # not reported by the crashed run: run alone, and it passes
+
+
+def test_a_leak_fails_the_case_that_leaks(tmp_path):
+    """LeakSanitizer reports at exit, after every case said ok: the run's exit status is not ignored, each case
+    is run again alone, and only the case that leaks fails."""
+    src = tmp_path / "t.c"
+    src.write_text(
+        '#include "ctest.h"\n#include <stdlib.h>\n'
+        "static void good(ctest *t) { CHECK(t, 1 + 1 == 2); }\n"
+        "static void leaky(ctest *t) { char *p = malloc(64); CHECK(t, p != NULL); if (p) p[0] = 1; }\n"
+        "static const ctest_case CASES[] = {CTEST_CASE(good), CTEST_CASE(leaky)};\n"
+        "int main(int argc, char **argv) { return ctest_main(CASES, CTEST_COUNT(CASES), argc, argv); }\n"
+    )
+    d = CDriver.build(tmp_path / "t", [src])
+    d.check("good")
+    with pytest.raises(AssertionError, match=r"(?s)case leaky exited 1:.*LeakSanitizer"):
+        d.check("leaky")

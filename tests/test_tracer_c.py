@@ -2,9 +2,10 @@
 
 tracer_rays.c + tracer_rays_optics.c (one driver) check ray-level answers against analytic values (sphere
 distances, Snell, TIR, Fresnel, CSG event sequences, a transformed torus against the inverse-transformed ray,
-the piriform in the paper's basis form). tracer_offsets.c measures secondary-ray robustness on every example
-shape at scales 1e-3 .. 1e3. tracer_render_rows.c checks that a band of rows renders exactly those rows of the
-whole image.
+the piriform in the paper's basis form); tracer_render_rows.c checks that a band of rows renders exactly those
+rows of the whole image. Both are named cases (tests/c/ctest.h), each a pytest case (tests/cdriver.py).
+tracer_offsets.c measures secondary-ray robustness on every example shape at scales 1e-3 .. 1e3; it takes its
+size and seed as arguments and prints a row of counts per shape, which the tests here judge shape by shape.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from pathlib import Path
 
 import pytest
 
+from cdriver import CDriver, case_names
 from conftest import CDIR, GENERATED, ROOT, compile_c, run_c
 from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, TRACER_SOURCES, runtime_sources
 
@@ -37,22 +39,51 @@ def run(exe: Path, *args: str, timeout: float = 300) -> str:
     return out
 
 
-def test_ray_level_analytic(tmp_path: Path) -> None:
+RAYS_SOURCE = CDIR / "tracer_rays.c"
+ROWS_SOURCE = CDIR / "tracer_render_rows.c"
+
+# What some cases print, checked here too: the figures behind their verdicts.
+RAYS_FIGURES = {
+    "sphere_random_rays_against_the_closest_root": r"sphere: 20000 random rays, hit/miss disagreements 0",
+    "transformed_torus_against_the_inverse_transformed_ray": (
+        r"transformed torus: 20000 rays \(\d+ hits\), hit/miss disagreements 0"
+    ),
+    "plane_path_against_long_double_and_the_general_solve": r"plane path: \d+ hits within 0\.\d+ of the tolerance",
+}
+
+
+@pytest.fixture(scope="module")
+def rays_driver(tmp_path_factory: pytest.TempPathFactory) -> CDriver:
     shapes = [GENERATED / f"{n}.c" for n in ("sphere", "torus_z", "piriform")]
-    exe = compile_c(
-        tmp_path / "rays", [CDIR / "tracer_rays.c", CDIR / "tracer_rays_optics.c", *runtime_c_sources(), *shapes]
-    )
-    out = run(exe)
-    assert "0 failures" in out
-    assert re.search(r"sphere: 20000 random rays, hit/miss disagreements 0", out)
-    assert re.search(r"transformed torus: 20000 rays \(\d+ hits\), hit/miss disagreements 0", out)
-    assert re.search(r"plane path: \d+ hits within 0\.\d+ of the tolerance", out)
+    sources = [RAYS_SOURCE, CDIR / "tracer_rays_optics.c", *runtime_c_sources(), *shapes]
+    return CDriver.build(tmp_path_factory.mktemp("rays") / "rays", sources)
 
 
-def test_a_band_of_rows_is_exactly_those_rows_of_the_image(tmp_path: Path) -> None:
+@pytest.mark.parametrize("case", case_names(RAYS_SOURCE))
+def test_ray_level_analytic(rays_driver: CDriver, case: str) -> None:
+    """tracer_rays.c's named cases (with tracer_rays_optics.c's): each ray-level answer against its analytic
+    value, and the figures some cases print."""
+    detail = rays_driver.check(case)
+    print(detail)
+    if case in RAYS_FIGURES:
+        assert re.search(RAYS_FIGURES[case], detail), detail
+
+
+def test_every_figure_belongs_to_a_case() -> None:
+    assert set(RAYS_FIGURES) <= set(case_names(RAYS_SOURCE))
+
+
+@pytest.fixture(scope="module")
+def rows_driver(tmp_path_factory: pytest.TempPathFactory) -> CDriver:
     shapes = [GENERATED / f"{n}.c" for n in ("sphere", "torus_z")]
-    exe = compile_c(tmp_path / "rows", [CDIR / "tracer_render_rows.c", *runtime_c_sources(), *shapes])
-    assert "render rows: 6 bands, 0 failures" in run(exe)
+    return CDriver.build(tmp_path_factory.mktemp("rows") / "rows", [ROWS_SOURCE, *runtime_c_sources(), *shapes])
+
+
+@pytest.mark.parametrize("case", case_names(ROWS_SOURCE))
+def test_a_band_of_rows_is_exactly_those_rows_of_the_image(rows_driver: CDriver, case: str) -> None:
+    detail = rows_driver.check(case)
+    if case == "each_band_is_those_rows_of_the_whole_image":
+        assert "render rows: 6 bands" in detail
 
 
 def shape_table(path: Path, names: list[str]) -> Path:
@@ -101,27 +132,42 @@ def offsets_exes(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path, 
     return san, fast, names
 
 
-def test_secondary_rays_sanitized(offsets_exes) -> None:
-    """Fewer points, but under ASan/UBSan: the same code paths must be memory- and UB-clean."""
+def offsets_rows(exe: Path, names: list[str], *args: str, timeout: float = 300) -> dict[str, dict[str, float]]:
+    """One run of tracer_offsets: a row of counts per shape, every shape's."""
+    rows = parse_offsets(run(exe, *args, timeout=timeout))
+    assert set(rows) == set(names)
+    return rows
+
+
+@pytest.fixture(scope="module")
+def sanitized_offsets(offsets_exes) -> dict[str, dict[str, float]]:
     san, _, names = offsets_exes
-    rows = parse_offsets(run(san, "2000", "7"))
-    assert set(rows) == set(names)
-    for name, r in rows.items():
-        assert r["self"] == 0 and r["miss"] == 0 and r["any_differ"] == 0, (name, r)
+    return offsets_rows(san, names, "2000", "7")
 
 
-def test_secondary_rays_1e5_per_shape(offsets_exes) -> None:
-    """1e5 hit points per example shape over scales 1e-3 .. 1e3, two secondary rays leave each."""
+@pytest.fixture(scope="module")
+def full_offsets(offsets_exes) -> dict[str, dict[str, float]]:
     _, fast, names = offsets_exes
-    out = run(fast, "100000", "12345", timeout=600)
-    rows = parse_offsets(out)
-    assert set(rows) == set(names)
-    for name, r in rows.items():
-        assert r["hits"] >= 99_000, (name, r)
-        assert r["self"] == 0, (name, r)
-        assert r["miss"] == 0, (name, r)
-        # shadow rays' yes/no query (unrefined roots) agrees with the closest-hit query
-        assert r["any_differ"] == 0 and r["any_checked"] >= 50_000, (name, r)
-        # what cannot be judged (grazing second hits inside the offset band, reference losing the root)
-        # must stay rare
-        assert r["ambiguous"] + r["lost"] + r["other"] <= 1e-3 * r["rays"], (name, r)
+    return offsets_rows(fast, names, "100000", "12345", timeout=600)
+
+
+# tracer_offsets.c measures (its arguments: hits per shape, seed) and prints a row per shape, judged here shape
+# by shape: one run each way, each shape reported by name
+@pytest.mark.parametrize("name", example_shapes())
+def test_secondary_rays_sanitized(sanitized_offsets, name) -> None:
+    """Fewer points, but under ASan/UBSan: the same code paths must be memory- and UB-clean."""
+    r = sanitized_offsets[name]
+    assert r["self"] == 0 and r["miss"] == 0 and r["any_differ"] == 0, (name, r)
+
+
+@pytest.mark.parametrize("name", example_shapes())
+def test_secondary_rays_1e5_per_shape(full_offsets, name) -> None:
+    """1e5 hit points per example shape over scales 1e-3 .. 1e3, two secondary rays leave each."""
+    r = full_offsets[name]
+    assert r["hits"] >= 99_000, (name, r)
+    assert r["self"] == 0, (name, r)
+    assert r["miss"] == 0, (name, r)
+    # shadow rays' yes/no query (unrefined roots) agrees with the closest-hit query
+    assert r["any_differ"] == 0 and r["any_checked"] >= 50_000, (name, r)
+    # what cannot be judged (grazing second hits inside the offset band, reference losing the root) must stay rare
+    assert r["ambiguous"] + r["lost"] + r["other"] <= 1e-3 * r["rays"], (name, r)

@@ -6,8 +6,9 @@
  *   int main(int argc, char **argv) { return ctest_main(CASES, CTEST_COUNT(CASES), argc, argv); }
  *
  * The driver, run with no argument, runs every case and prints "ok NAME" or "FAIL NAME" for each, a failing
- * case's messages ("  NAME: ...") before its verdict; with names, only those cases; with --list, the names.
- * Exit status 1 when a case fails, 2 for an unknown name. tests/cdriver.py reports each case to pytest by name.
+ * case's messages ("  NAME: ...") and any figures a case prints before its verdict; with names, only those
+ * cases; with --list, the names. Exit status 1 when a case fails, 2 for an unknown name. tests/cdriver.py
+ * reports each case to pytest by name.
  */
 #ifndef IMPLGEN_CTEST_H
 #define IMPLGEN_CTEST_H
@@ -54,6 +55,26 @@ static inline int ctest_check(ctest *t, int ok, const char *what, const char *fi
 /* CHECK(t, condition): a failure naming the condition and its line when it does not hold; the value of the
  * condition, so a case can stop where going on would only repeat the failure. */
 #define CHECK(t, cond) ctest_check((t), (cond) != 0, #cond, __FILE__, __LINE__)
+
+/* One failure of the running case at a file and line, with a message. */
+static inline void ctest_fail_at(ctest *t, const char *file, int line, const char *fmt, ...)
+{
+    va_list ap;
+    ++t->failures;
+    printf("  %s: %s:%d: ", t->name, file, line);
+    va_start(ap, fmt);
+    vprintf(fmt, ap);
+    va_end(ap);
+    printf("\n");
+}
+
+/* CHECKF(t, condition, format, ...): CHECK with a message of its own, the figures that failed; a statement, and
+ * the message's arguments are read only after the condition failed (so they show what it saw). */
+#define CHECKF(t, cond, ...)                                                                                           \
+    do {                                                                                                               \
+        if (!(cond))                                                                                                   \
+            ctest_fail_at((t), __FILE__, __LINE__, __VA_ARGS__);                                                       \
+    } while (0)
 
 static inline int ctest_run(const ctest_case *c)
 {

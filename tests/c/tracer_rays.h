@@ -1,9 +1,11 @@
-/* What the two files of the tracer's ray-level test share (tracer_rays.c: spheres, CSG, transforms, and main;
- * tracer_rays_optics.c: optics, shading, glass, the tracer's shortcuts): the failure count, CHECK, and small
- * scene helpers. */
+/* What the two files of the tracer's ray-level test share (tracer_rays.c: spheres, CSG, transforms, and main with
+ * the table of cases; tracer_rays_optics.c: optics, shading, glass, the tracer's shortcuts): the named-case
+ * harness (tests/c/ctest.h), small scene helpers, and the cases of tracer_rays_optics.c. tracer_render_rows.c
+ * uses the helpers too. */
 #ifndef IMPLGEN_TEST_TRACER_RAYS_H
 #define IMPLGEN_TEST_TRACER_RAYS_H
 
+#include "ctest.h"
 #include "tracer_internal.h"
 #include "sphere.h"
 #include "torus_z.h"
@@ -21,19 +23,6 @@
 #ifndef M_SQRT1_2
 #define M_SQRT1_2 0.70710678118654752440
 #endif
-
-/* failed checks so far (defined in tracer_rays.c) */
-extern int failures;
-
-#define CHECK(cond, ...)                                                                                               \
-    do {                                                                                                               \
-        if (!(cond)) {                                                                                                 \
-            ++failures;                                                                                                \
-            printf("FAIL %s:%d: ", __FILE__, __LINE__);                                                                \
-            printf(__VA_ARGS__);                                                                                       \
-            printf("\n");                                                                                              \
-        }                                                                                                              \
-    } while (0)
 
 static const double IDENTITY[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 
@@ -73,11 +62,19 @@ static inline void rot_axis(const double axis[3], double ang, double R[9])
     R[8] = c + z * z * (1 - c);
 }
 
-/* tracer_rays_optics.c */
-void test_optics(void);
-void test_unbounded_and_shading(void);
-void test_glass(void);
-void test_shortcuts(void);
-void test_plane_path(void);
+/* the cases of tracer_rays_optics.c */
+void snell_on_random_rays(ctest *t);
+void total_internal_reflection_beyond_the_critical_angle(ctest *t);
+void fresnel_at_normal_incidence_brewster_and_grazing(ctest *t);
+void mirror_reflection(ctest *t);
+void point_light_shading_and_shadow(ctest *t);
+void glass_ball_beer_lambert(ctest *t);
+void total_internal_reflection_traps_a_ray_in_a_ball(ctest *t);
+void index_matched_absorbing_csg_shell(ctest *t);
+void shadow_through_glass(ctest *t);
+void shortcuts_on_20000_random_rays(ctest *t);
+void checker_colour_beyond_2_53(ctest *t);
+void plane_path_against_long_double_and_the_general_solve(ctest *t);
+void plane_path_parallel_inside_and_beyond_far(ctest *t);
 
 #endif
