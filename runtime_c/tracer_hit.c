@@ -1,5 +1,6 @@
-/* Rays against a committed scene: the slab clip of a ray to a box, the closest-hit query (unbounded objects,
- * then the BVH), and finishing a hit (normal, orientation, the error bound of the hit point).
+/* Rays against a committed scene: the closest-hit query (unbounded objects, then the BVH), and finishing a hit
+ * (normal, orientation, the error bound of the hit point). The ray's set-up and its slab clip are
+ * tracer_internal.h's (rt_ray_init, rt_clip_box), shared with the CSG's spans.
  */
 #include "tracer_internal.h"
 
@@ -9,29 +10,6 @@
 #include <string.h>
 
 /* ------------------------------------------------------------------ rays and boxes */
-
-void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far)
-{
-    int a;
-    memcpy(r->o, o, sizeof r->o);
-    memcpy(r->d, d, sizeof r->d);
-    r->len = sqrt(rt_dot(d, d));
-    for (a = 0; a < 3; ++a)
-        r->inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
-    if (r->len > 0.0) {
-        for (a = 0; a < 3; ++a)
-            r->u[a] = d[a] / r->len;
-        r->far_t = far / r->len;
-    } else {
-        r->u[0] = r->u[1] = r->u[2] = 0.0;
-        r->far_t = INFINITY;
-    }
-}
-
-int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0, int *f1)
-{
-    return rt_clip_slabs(box, o, d, NULL, t0, t1, f0, f1);
-}
 
 /* The BVH's box test: rt_clip_box with the ray's precomputed inverse direction and no face codes. */
 static int ray_box(const double box[6], const rt_ray *r, double *t0, double *t1)
@@ -49,18 +27,6 @@ static int ray_box(const double box[6], const rt_ray *r, double *t0, double *t1)
 #ifndef RT_ERR_WORLD
 #define RT_ERR_WORLD 32.0 /* x eps x magnitude of the world-space computation */
 #endif
-
-void rt_expansion_noise(const ig_shape_expansion *ex, int deg, double s, double *sum, double *val)
-{
-    double tau = s - ex->ts, a = fabs(tau), su = 0.0, v = 0.0;
-    int k;
-    for (k = deg; k >= 0; --k) {
-        su = su * a + fabs(ex->c[k]);
-        v = v * tau + ex->c[k];
-    }
-    *sum = su;
-    *val = v;
-}
 
 /* Rounding noise of f near the hit as the root solver sees it. The solver expands f(o + t d) around a point
  * of the ray next to the object (shape.c's shift point: nearest the centre of the box's finite axes, else the

@@ -5,6 +5,10 @@
 #include "numerics.h"
 #include "tracer.h"
 
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
 typedef struct rt_node {
     int kind;        /* RT_LEAF, RT_UNION, RT_INTERSECTION, RT_DIFFERENCE */
     int left, right; /* children (CSG) */
@@ -124,17 +128,12 @@ void rt_xform_vector(const double m[12], const double v[3], double out[3]);
 /* The ray in a leaf's object space (a copy when the leaf's transform is the identity). */
 void rt_to_object(const rt_node *n, const double o[3], const double d[3], double oo[3], double od[3]);
 /* tracer_hit.c */
-void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far);
 int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
                      int skip, rt_pending *out);
-int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1, int *f0, int *f1);
 /* Fills hit (normal, object-space point, ...) for the pending hit of the ray o + t d. With lazy == NULL the
  * error bound hit->err too; otherwise hit->err is left for rt_hit_error, and lazy keeps what it needs. */
 void rt_finish_hit(const rt_scene *s, const rt_pending *p, const double o[3], const double d[3], rt_hit *hit,
                    rt_hit_lazy *lazy);
-/* The solver's view of f at the root s of the expansion ex (degree deg; see shape.h): Horner's running error
- * sum |c_k| |tau|^k and the expansion's value at tau = s - ex->ts, the root's offset from the shift point. */
-void rt_expansion_noise(const ig_shape_expansion *ex, int deg, double s, double *sum, double *val);
 /* Works out hit->err if rt_finish_hit left it pending (else does nothing): the same value either way. */
 void rt_hit_error(const rt_scene *s, rt_hit *hit, rt_hit_lazy *lazy);
 
@@ -192,6 +191,46 @@ static inline double rt_maxabs3(const double v[3])
 {
     double a = fabs(v[0]), b = fabs(v[1]), c = fabs(v[2]);
     return a > b ? (a > c ? a : c) : (b > c ? b : c);
+}
+
+/* The ray o + t d with its length, inverse direction, unit direction and where an unbounded object's solve stops
+ * (far / |d|). */
+static inline void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far)
+{
+    int a;
+    memcpy(r->o, o, sizeof r->o);
+    memcpy(r->d, d, sizeof r->d);
+    r->len = sqrt(rt_dot(d, d));
+    for (a = 0; a < 3; ++a)
+        r->inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
+    if (r->len > 0.0) {
+        for (a = 0; a < 3; ++a)
+            r->u[a] = d[a] / r->len;
+        r->far_t = far / r->len;
+    } else {
+        r->u[0] = r->u[1] = r->u[2] = 0.0;
+        r->far_t = INFINITY;
+    }
+}
+
+static inline int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1,
+                              int *f0, int *f1)
+{
+    return rt_clip_slabs(box, o, d, NULL, t0, t1, f0, f1);
+}
+
+/* The solver's view of f at the root s of the expansion ex (degree deg; see shape.h): Horner's running error
+ * sum |c_k| |tau|^k and the expansion's value at tau = s - ex->ts, the root's offset from the shift point. */
+static inline void rt_expansion_noise(const ig_shape_expansion *ex, int deg, double s, double *sum, double *val)
+{
+    double tau = s - ex->ts, a = fabs(tau), su = 0.0, v = 0.0;
+    int k;
+    for (k = deg; k >= 0; --k) {
+        su = su * a + fabs(ex->c[k]);
+        v = v * tau + ex->c[k];
+    }
+    *sum = su;
+    *val = v;
 }
 
 #endif
