@@ -16,8 +16,11 @@ $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
 
-# Dependencies once, then the package itself (non-editable, as a user gets it) whenever a source changes.
+# Dependencies once, then the package itself (non-editable, as a user gets it) whenever a source changes. setuptools
+# builds in build/ and keeps what it finds there: a module moved or removed since would be installed still, so
+# build/ goes first.
 $(STAMP): $(BIN)/python $(SOURCES)
+	rm -rf build
 	$(BIN)/python -m pip install -q ".[test]"
 	$(BIN)/python -m pip install -q --no-deps --force-reinstall .
 	@touch $@

@@ -17,7 +17,8 @@ from types import ModuleType
 import numpy as np
 
 from implgen.errors import UserError
-from implgen.roots import raycast, raysets_high
+from implgen.measure.cases import rays_high as raysets_high
+from implgen.roots import raycast
 
 SHAPES_DIR = Path("examples/shapes")
 
