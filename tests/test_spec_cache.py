@@ -24,6 +24,9 @@ ROOT = Path(__file__).resolve().parent.parent
 SHAPES = ROOT / "examples" / "shapes"
 BENCH_SCENES = ROOT / "bench" / "scenes"
 HEAVY = ("sympy", "matplotlib", "tqdm", "dask", "distributed", "imageio", "starlette", "uvicorn", "jinja2")
+# A still needs none of the batch or Dask side of `implgen render` (asyncio alone costs a cached still a third
+# of its start-up): animation/command.py imports them only for frames, tiles or Dask.
+HEAVY += ("asyncio", "implgen.animation.cluster", "implgen.animation.batch")
 
 
 @pytest.fixture
