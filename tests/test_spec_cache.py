@@ -24,6 +24,9 @@ ROOT = Path(__file__).resolve().parent.parent
 SHAPES = ROOT / "examples" / "shapes"
 BENCH_SCENES = ROOT / "bench" / "scenes"
 HEAVY = ("sympy", "matplotlib", "tqdm", "dask", "distributed", "imageio", "starlette", "uvicorn", "jinja2")
+# A still needs none of the batch or Dask side of `implgen render` (asyncio alone costs a cached still a third
+# of its start-up): animation/command.py imports them only for frames, tiles or Dask.
+HEAVY += ("asyncio", "implgen.animation.cluster", "implgen.animation.batch")
 
 
 @pytest.fixture
@@ -106,6 +109,24 @@ def test_a_new_implgen_misses(cache: Path, monkeypatch) -> None:
     assert speccache.parse_cached({"name": "plane", "equation": "y"}, "<a>").symbolic_part.deferred
     monkeypatch.setattr(speccache, "implgen_fingerprint", lambda: "another implgen")
     assert not speccache.parse_cached({"name": "plane", "equation": "y"}, "<a>").symbolic_part.deferred
+
+
+def test_the_fingerprint_is_every_source_and_template_in_path_order() -> None:
+    """implgen_fingerprint walks the tree with os.walk (a cached start computes it): the same files, names and
+    order as pathlib's rglob and sort, written out independently here."""
+    import hashlib
+
+    import implgen
+    from implgen.resources import templates_dir
+    from implgen.spec.fingerprint import implgen_fingerprint
+
+    h = hashlib.sha256()
+    pkg = Path(implgen.__file__).resolve().parent
+    files = sorted(pkg.rglob("*.py")) + sorted(templates_dir().rglob("*.j2"))
+    assert len(files) > 50 and any(p.suffix == ".j2" for p in files)
+    for p in files:
+        h.update(f"{p.parent.name}/{p.name}".encode() + b"\0" + p.read_bytes())
+    assert implgen_fingerprint() == h.hexdigest()
 
 
 BAD_SPECS = [

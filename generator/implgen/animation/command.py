@@ -2,7 +2,9 @@
 sequence, a video or a GIF; here, on a LocalCluster, or on a running Dask cluster.
 
 The output is checked before anything else, then the scene is loaded and every frame validated, and only
-then does anything render. A still scene without Dask options takes the path it always took (render.py).
+then does anything render. A still scene without Dask options takes the path it always took (render.py),
+and imports nothing of the batch or of Dask (asyncio and all): `cluster` and `batch` are imported where an
+animation, tiles or Dask first need them, so a cached still starts quickly (bench/startup.py).
 """
 
 from __future__ import annotations
@@ -11,10 +13,9 @@ import argparse
 import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from implgen import validate
-from implgen.animation import cluster
-from implgen.animation.batch import Runner, render_frames
 from implgen.animation.frameout import FrameOutput, plan_output
 from implgen.animation.frames import FrameOptions, Frames, load_frames, parse_range
 from implgen.args import ArgumentParser
@@ -22,6 +23,9 @@ from implgen.errors import UserError, printable
 from implgen.imagefile import write_png
 from implgen.scene.keys import MAX_FRAMES
 from implgen.scene.render import DEFAULT_FOLD, RenderInfo, image_options, render
+
+if TYPE_CHECKING:
+    from implgen.animation.batch import Runner
 
 MAX_RETRIES = 100
 
@@ -87,9 +91,7 @@ def _parser() -> ArgumentParser:
 def main(argv: Sequence[str]) -> int:
     args = _parser().parse_args(list(argv))
     validate.whole("--retries", "", args.retries, 0, MAX_RETRIES)
-    address = cluster.check_address(args.cluster) if args.cluster is not None else None
-    if args.local_workers is not None:
-        validate.whole("--local-workers", "", args.local_workers, 1, cluster.MAX_LOCAL_WORKERS)
+    address = _check_dask(args)
     plan_output(args.output, 1, MAX_FRAMES - 1, 2, 2)  # the path alone, before reading the scene
     frames = load_frames(args.scene)
     todo = parse_range(args.frames, frames.count) if args.frames is not None else range(frames.count)
@@ -103,9 +105,31 @@ def main(argv: Sequence[str]) -> int:
     distributed = args.local_workers is not None or address is not None
     if out.kind == "still" and args.tiles is None and not distributed:
         return _still(args, frames, todo[0], opts, out)
+    return _many(args, frames, todo, opts, out, address)
+
+
+def _check_dask(args: argparse.Namespace) -> str | None:
+    """The Dask options, checked before the scene is read; the scheduler's address, or None. Only they import
+    `cluster` (Dask's side: asyncio and all), so that a still does not."""
+    if args.cluster is None and args.local_workers is None:
+        return None
+    from implgen.animation import cluster
+
+    if args.local_workers is not None:
+        validate.whole("--local-workers", "", args.local_workers, 1, cluster.MAX_LOCAL_WORKERS)
+    return cluster.check_address(args.cluster) if args.cluster is not None else None
+
+
+def _many(
+    args: argparse.Namespace, frames: Frames, todo: range, opts: FrameOptions, out: FrameOutput, address: str | None
+) -> int:
+    """Frames, tiles or Dask: through the batch (animation/batch.py), imported only here."""
+    from implgen.animation import cluster
+    from implgen.animation.batch import Runner
+
     if args.local_workers is not None and args.threads is None:
         opts = dataclasses.replace(opts, threads=cluster.local_threads(args.local_workers))
-    if not distributed:
+    if args.local_workers is None and address is None:
         return _run(args, frames, todo, opts, out, Runner(retries=args.retries))
     with cluster.connect(args.local_workers, address) as client:
         label = "--cluster" if address is not None else "--local-workers"
@@ -148,6 +172,8 @@ def _still(args: argparse.Namespace, frames: Frames, frame: int, opts: FrameOpti
 def _run(
     args: argparse.Namespace, frames: Frames, todo: range, opts: FrameOptions, out: FrameOutput, runner: Runner
 ) -> int:
+    from implgen.animation.batch import render_frames
+
     tiles = args.tiles or 1
     report = render_frames(
         frames,

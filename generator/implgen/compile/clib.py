@@ -31,7 +31,6 @@ from functools import cache
 from pathlib import Path
 
 from implgen import cachedir
-from implgen.compile import cachesize
 from implgen.errors import UserError, out_of_files, out_of_files_error
 
 # The project's C standard and warnings, stated once: every build here, the tests' C drivers (tests/conftest.py)
@@ -80,10 +79,16 @@ def _digest(cc: str, parts: Sequence[str]):  # -> a hashlib sha256 object
     return h
 
 
-def _headers_into(h, include_dirs: Sequence[Path]) -> None:
-    for inc in include_dirs:
-        for header in sorted(Path(inc).glob("*.h")):
-            h.update(b"\0hdr\0" + header.name.encode() + b"\0" + header.read_bytes())
+def _headers_into(h, include_dirs: Sequence[Path], read: dict[Path, bytes]) -> None:
+    """Every header in `include_dirs` into the key: each one's name and text, in name order. `read` holds what
+    this build has read already, one entry per folder: the runtime's headers are in every object's key, and a
+    cached start reads them once, not once per source."""
+    for inc in map(Path, include_dirs):
+        if inc not in read:
+            read[inc] = b"".join(
+                b"\0hdr\0" + hd.name.encode() + b"\0" + hd.read_bytes() for hd in sorted(inc.glob("*.h"))
+            )
+        h.update(read[inc])
 
 
 @dataclass(frozen=True)
@@ -145,13 +150,20 @@ def _writable(folder: Path) -> None:
         )
 
 
-def _object_job(source: Path, include_dirs: Sequence[Path], extra_flags: Sequence[str], cc: str, folder: Path) -> Job:
+def _object_job(
+    source: Path,
+    include_dirs: Sequence[Path],
+    extra_flags: Sequence[str],
+    cc: str,
+    folder: Path,
+    read: dict[Path, bytes],
+) -> Job:
     """The cached object for one source, in `folder` (obj/): its key hashes the source text, every header in
-    `include_dirs`, the flags and the compiler."""
+    `include_dirs` (`read`: _headers_into), the flags and the compiler."""
     flags = [*BASE_FLAGS, *extra_flags]
     h = _digest(cc, flags)
     h.update(b"\0src\0" + Path(source).read_bytes())
-    _headers_into(h, include_dirs)
+    _headers_into(h, include_dirs, read)
     key = h.hexdigest()
     target = folder / f"{Path(source).stem}-{key[:32]}.o"
     includes = [f"-I{inc}" for inc in include_dirs]
@@ -162,8 +174,8 @@ def objects_present(jobs: Sequence[tuple[Path, Sequence[Path]]], extra_flags: Se
     """(how many of these sources' objects the build cache holds, how many sources): a build's progress, as a
     page can show it while the runtime is compiled for the first time. Looks at the files only (a build in
     progress renames each sealed object into place)."""
-    cc, folder = compiler(), cachedir.cache_dir("obj")
-    objects = [_object_job(src, inc, [*extra_flags], cc, folder) for src, inc in jobs]
+    cc, folder, read = compiler(), cachedir.cache_dir("obj"), {}
+    objects = [_object_job(src, inc, [*extra_flags], cc, folder, read) for src, inc in jobs]
     return sum(job.target.is_file() for job in objects), len(objects)
 
 
@@ -200,14 +212,16 @@ def build_jobs(
     """One shared library from C sources, each with the include folders it sees. A library whose seal
     verifies is returned at once (its objects are not looked at); otherwise the missing objects are compiled,
     the library linked and sealed, and the cache brought back within its bound (cachesize.evict)."""
-    cc, folder = compiler(), cachedir.cache_dir("obj")  # once per library: each is a few system calls
-    objects = [_object_job(src, inc, extra_flags, cc, folder) for src, inc in jobs]
+    cc, folder, read = compiler(), cachedir.cache_dir("obj"), {}  # once per library: each is a few system calls
+    objects = [_object_job(src, inc, extra_flags, cc, folder, read) for src, inc in jobs]
     lib = _library_job(objects, libs, tag)
     if cachedir.check_entry(lib.target, lib.key):
         return lib.target
     _build_all(objects)
     _writable(lib.target.parent)
     _run(lib)
+    from implgen.compile import cachesize  # only after a link: a cached start needs none of the eviction
+
     cachesize.evict(keep={*_in_use.keys(), lib.target})
     return lib.target
 

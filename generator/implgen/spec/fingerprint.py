@@ -9,21 +9,36 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from collections.abc import Mapping
 from functools import cache
-from pathlib import Path
 
 from implgen.resources import templates_dir
 
 
 @cache
 def implgen_fingerprint() -> str:
-    """Hash of the package's own Python sources and templates: generated code and parsed specs depend on them."""
+    """Hash of the package's own Python sources and templates: generated code and parsed specs depend on them.
+    Each file adds its folder's name, its own name and its bytes, in path order; every cached start computes
+    it, so the tree is walked with os.walk rather than Path.rglob (the same files in the same order)."""
     h = hashlib.sha256()
-    pkg = Path(__file__).resolve().parent.parent
-    for p in sorted(pkg.rglob("*.py")) + sorted(templates_dir().rglob("*.j2")):
-        h.update(str(p.relative_to(p.parents[1])).encode() + b"\0" + p.read_bytes())
+    pkg = os.path.dirname(os.path.dirname(os.path.realpath(__file__)))
+    for top, suffix in ((pkg, ".py"), (str(templates_dir()), ".j2")):
+        for _, folder, name in _files(top, suffix):
+            with open(os.path.join(folder, name), "rb") as fh:
+                h.update(f"{os.path.basename(folder)}/{name}".encode() + b"\0" + fh.read())
     return h.hexdigest()
+
+
+def _files(top: str, suffix: str) -> list[tuple[tuple[str, ...], str, str]]:
+    """(path parts below `top`, folder, name) of every file under `top` whose name ends in `suffix`, sorted by
+    the parts as pathlib sorts paths; folders that are symbolic links are not entered (as Path.rglob)."""
+    found = []
+    for folder, _, names in os.walk(top):
+        rel = os.path.relpath(folder, top)
+        parts = () if rel == "." else tuple(rel.split(os.sep))
+        found += [((*parts, n), folder, n) for n in names if n.endswith(suffix)]
+    return sorted(found)
 
 
 def code_key(
