@@ -24,9 +24,21 @@ BALLS_SCENE = {
 @contextmanager
 def view_server(*args: str, env: dict | None = None, session: bool = False, stderr=None):
     """`implgen view ARGS --no-browser --port 0` in a child process (`session`: in a session, and so a process
-    group, of its own, as a terminal's job is); yields (the process, its http:// address)."""
+    group, of its own, as a terminal's job is); yields (the process, its http:// address). SIGINT as in a
+    terminal whoever started the tests: a background job's (`make test &`) is ignored, and a Python started so
+    would never see Ctrl-C (implgen_proc._as_in_a_terminal)."""
+    from implgen_proc import _as_in_a_terminal
+
     cmd = [sys.executable, "-m", "implgen.cli", "view", *args, "--no-browser", "--port", "0"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=stderr, text=True, env=env, start_new_session=session)
+    proc = subprocess.Popen(
+        cmd,
+        stdout=subprocess.PIPE,
+        stderr=stderr,
+        text=True,
+        env=env,
+        start_new_session=session,
+        preexec_fn=_as_in_a_terminal,
+    )
     try:
         line = proc.stdout.readline()
         yield proc, "http://" + line.split("http://", 1)[1].split()[0]
