@@ -26,7 +26,7 @@ from implgen.measure.machine import load_average, write_results
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "bench" / "scenes"
-TARGET = 0.15  # seconds for a cached render, the whole process (issue 33)
+TARGET = 0.15  # seconds for a cached render, the whole process, spawn to exit
 HEAVY = ("sympy", "matplotlib", "tqdm", "dask", "distributed", "imageio", "starlette", "uvicorn", "jinja2")
 HEAVY += ("asyncio", "implgen.animation.cluster", "implgen.animation.batch")  # Dask's side: not a still's
 
