@@ -75,8 +75,7 @@ def _measure(cs: CScene, sc: Scene, args, threads: int) -> tuple[float, float, d
         return job.seconds, cpu, job.stats().rays
 
 
-def _prepared(path: Path, args, fold: bool = False) -> tuple[CScene, Scene]:
-    sc = load_scene(path)  # its options' ranges were checked before the report began (main)
+def _prepared(sc: Scene, fold: bool = False) -> tuple[CScene, Scene]:
     return CScene(sc, build_scene(sc, fold=fold)), sc
 
 
@@ -89,7 +88,7 @@ class _Report(list):
             self.append(line)
 
 
-def _scaling(scenes: list[Path], args, counts: list[int], out: _Report) -> None:
+def _scaling(scenes: dict[Path, Scene], args, counts: list[int], out: _Report) -> None:
     first, last = counts[0], counts[-1]
     out.add(
         f"| scene | {' | '.join(f'{c} thr. (s)' for c in counts)} | speed-up {first}→{last} | work | busy | "
@@ -97,8 +96,8 @@ def _scaling(scenes: list[Path], args, counts: list[int], out: _Report) -> None:
         "|---|" + "---:|" * (len(counts) + 7),
     )
     verdicts = []
-    for path in scenes:
-        cs, sc = _prepared(path, args)  # compiled before timing
+    for path, scene in scenes.items():
+        cs, sc = _prepared(scene)  # compiled before timing
         _measure(cs, sc, args, last)  # warm: pages touched, the threads' stacks mapped once
         wall: dict[int, list[float]] = {c: [] for c in counts}
         cpu: dict[int, list[float]] = {c: [] for c in counts}
@@ -131,10 +130,10 @@ def _scaling(scenes: list[Path], args, counts: list[int], out: _Report) -> None:
         )
 
 
-def _fold(scenes: list[Path], args, out: _Report) -> None:
+def _fold(scenes: dict[Path, Scene], args, out: _Report) -> None:
     rows = []
-    for path in scenes:
-        variants = {fold: _prepared(path, args, fold) for fold in (False, True)}
+    for path, scene in scenes.items():
+        variants = {fold: _prepared(scene, fold) for fold in (False, True)}
         times: dict[bool, list[float]] = {False: [], True: []}
         for k in range(max(1, args.runs)):
             for fold in (False, True) if k % 2 == 0 else (True, False):
@@ -170,11 +169,12 @@ def main(argv: Sequence[str]) -> int:
     args = ap.parse_args(list(argv))
     counts = _thread_counts(args.threads)
     check_output_file(args.output, "-o", (".md",))
-    scenes = args.scenes or _default_scenes()
-    if not scenes:
+    paths = args.scenes or _default_scenes()
+    if not paths:
         raise UserError("bench render", "no scenes given and none in ./bench/scenes or ./examples/scenes")
-    for path in scenes:  # a missing or bad scene, an option out of range: one line, before the report's first line
-        image_options(load_scene(path), width=args.width, height=args.height, spp=args.spp)
+    scenes = {path: load_scene(path) for path in paths}  # a bad scene: one line, before the report's first line
+    for sc in scenes.values():  # and an option out of range
+        image_options(sc, width=args.width, height=args.height, spp=args.spp)
     out = _Report()
     out.add(
         "# Render speed and thread scaling",
