@@ -1,11 +1,12 @@
 """The contract every backend keeps, and what their printers share.
 
 A backend (one folder under codegen/backends/, `<lang>/backend.py` defining BACKEND) is a `Backend`: its name
-(the `--lang` value), the folder of its templates under the top-level templates/, the files it writes, the
-SymPy printer that prints the derivation's blocks into them, and optionally a function of the derivation giving
-the templates more variables. emit.py has no per-language branches. Every printer writes only finite double
-constants: a constant beyond double range (from an equation's coefficients) raises ConstantRangeError, which
-generation turns into a one-line error naming the spec. How to add a language: README.md beside this file.
+(the `--lang` value, which also names its template folder under the top-level templates/), the files it
+writes, the SymPy printer that prints the derivation's blocks into them, and optionally a function of the
+derivation giving the templates more variables. emit.py has no per-language branches. Every printer writes
+only finite double constants: a constant beyond double range (from an equation's coefficients) raises
+ConstantRangeError, which generation turns into a one-line error naming the spec. How to add a language:
+README.md beside this file.
 """
 
 from __future__ import annotations
@@ -56,12 +57,11 @@ class FiniteConstants:
 class Backend:
     """One target language."""
 
-    name: str  # the --lang value
-    templates: str  # its folder under templates/ (the design card fixes templates/<lang>/)
+    name: str  # the --lang value, and the name of its folder under templates/ (the design card's templates/<lang>/)
     files: tuple[tuple[str, str], ...]  # (template in that folder, the file it writes: a pattern with {name})
     printer: type[CodePrinter]  # prints the derivation's blocks (each expression) in the target's syntax
     extra: Callable | None = None  # derivation -> more template variables (dict), or None
 
     def outputs(self) -> list[tuple[str, str]]:
         """(template path under templates/, file name pattern) of every file the backend writes."""
-        return [(f"{self.templates}/{template}", pattern) for template, pattern in self.files]
+        return [(f"{self.name}/{template}", pattern) for template, pattern in self.files]

@@ -20,4 +20,4 @@ class CPrinter(FiniteConstants, C99CodePrinter):
         return repr(finite_double(value)) if abs(value) < EXACT_INT else f"{finite_double(value):.17g}"
 
 
-BACKEND = Backend("c", "c", (("shape.h.j2", "{name}.h"), ("shape.c.j2", "{name}.c")), CPrinter)
+BACKEND = Backend("c", (("shape.h.j2", "{name}.h"), ("shape.c.j2", "{name}.c")), CPrinter)

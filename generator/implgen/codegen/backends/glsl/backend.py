@@ -7,4 +7,4 @@ from __future__ import annotations
 from implgen.codegen.backends.contract import Backend
 from implgen.codegen.backends.glsl.printer import GLSLPrinter, glsl_extra
 
-BACKEND = Backend("glsl", "glsl", (("shape.glsl.j2", "{name}.glsl"),), GLSLPrinter, glsl_extra)
+BACKEND = Backend("glsl", (("shape.glsl.j2", "{name}.glsl"),), GLSLPrinter, glsl_extra)

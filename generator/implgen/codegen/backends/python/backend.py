@@ -18,4 +18,4 @@ class PyPrinter(FiniteConstants, PythonCodePrinter):
         return str(value) if abs(value) < EXACT_INT else f"{finite_double(value):.17g}"
 
 
-BACKEND = Backend("python", "python", (("shape.py.j2", "{name}.py"),), PyPrinter)
+BACKEND = Backend("python", (("shape.py.j2", "{name}.py"),), PyPrinter)
