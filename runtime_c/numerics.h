@@ -5,6 +5,7 @@
  * - error-free transformations: a + b and a * b as an unevaluated sum of two doubles, exactly;
  * - Horner's rule, plain and compensated (as accurate as Horner in twice the working precision);
  * - one axis of the slab test of a ray against an axis-aligned box;
+ * - a vector's length and unit direction;
  * - affine 3x4 maps (row-major, as tracer.h): a point, a vector, the inverse, a ray's unit object-space
  *   direction, a normal, a box (the tracer and the Embree adapter move rays into object space, normals and
  *   boxes into world space with these, so both see the same numbers to the last bit);
@@ -154,13 +155,24 @@ static inline int ig_affine_invert(const double m[12], double inv[12])
     return 1;
 }
 
+/* The length L of v and, when L is positive and finite (the caller checks), the unit vector u = v / L. */
+static inline double ig_unit_vector(const double v[3], double u[3])
+{
+    double L = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    int i;
+    if (L > 0.0 && isfinite(L))
+        for (i = 0; i < 3; ++i)
+            u[i] = v[i] / L;
+    return L;
+}
+
 /* The ray o + t d in the object space of the map whose inverse is minv (NULL: the identity), as the solves take
  * it: the origin oo and the unit direction u. Returns the length L of the object-space direction (the solve's
  * parameter is s = t L); u is set only when L is positive and finite, which the caller checks. */
 static inline double ig_affine_unit_ray(const double *minv, const double o[3], const double d[3], double oo[3],
                                         double u[3])
 {
-    double od[3], L;
+    double od[3];
     int i;
     if (minv) {
         ig_affine_point(minv, o, oo);
@@ -171,12 +183,7 @@ static inline double ig_affine_unit_ray(const double *minv, const double o[3], c
             od[i] = d[i];
         }
     }
-    L = sqrt(od[0] * od[0] + od[1] * od[1] + od[2] * od[2]);
-    if (!(L > 0.0) || !isfinite(L))
-        return L;
-    for (i = 0; i < 3; ++i)
-        u[i] = od[i] / L;
-    return L;
+    return ig_unit_vector(od, u);
 }
 
 /* The unit world normal n = minv^T g / |minv^T g| of the object-space normal g (normals map by the inverse

@@ -28,7 +28,7 @@ static inline int leaf_roots_unit(const rt_node *n, const double oo[3], const do
  * an object scaled by 1e3 would otherwise hand the solver coefficients c_k ~ 1e-3k. */
 int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], double lo, double hi, double *r)
 {
-    double at[3], u[3], L = ig_affine_unit_ray(NULL, oo, od, at, u); /* already in object space */
+    double u[3], L = ig_unit_vector(od, u); /* oo, od: already in object space */
     if (!(L > 0.0) || !isfinite(L))
         return 0;
     return leaf_roots_unit(n, oo, u, L, lo, hi, r);
@@ -132,8 +132,7 @@ static int leaf_spans(const rt_scene *s, int k, const rt_ray *ray, double a, dou
     if (!(b > a))
         return 0;
     if (!n->identity) {
-        double at[3];
-        lr.L = ig_affine_unit_ray(NULL, lr.o, lr.d, at, lr.own_u); /* o, d: already in the leaf's object space */
+        lr.L = ig_unit_vector(lr.d, lr.own_u); /* o, d: already in the leaf's object space */
         lr.u = lr.own_u;
     }
     nr = (lr.L > 0.0 && isfinite(lr.L)) ? leaf_roots_unit(n, lr.o, lr.u, lr.L, a, b, r) : 0;

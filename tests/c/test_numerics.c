@@ -138,6 +138,14 @@ static void affine_invert_round_trips_and_refuses_singular_maps(ctest *t)
     }
 }
 
+static void unit_vector_gives_the_length_and_leaves_u_alone_without_one(ctest *t)
+{
+    double v[3] = {3, 0, -4}, u[3] = {9, 9, 9}, zero[3] = {0, 0, 0}, huge[3] = {1e300, 1e300, 0}, w[3] = {9, 9, 9};
+    CHECK(t, ig_unit_vector(v, u) == 5.0 && u[0] == 0.6 && u[1] == 0.0 && u[2] == -0.8);
+    CHECK(t, ig_unit_vector(zero, w) == 0.0 && w[0] == 9 && w[1] == 9 && w[2] == 9); /* no direction: untouched */
+    CHECK(t, isinf(ig_unit_vector(huge, w)) && w[0] == 9); /* |v|^2 overflows: untouched, the caller checks L */
+}
+
 static void affine_unit_ray_gives_the_object_space_length(ctest *t)
 {
     double inv[12], o[3] = {10, 20, 30}, d[3] = {0, 0, 8}, oo[3], u[3] = {9, 9, 9}, L;
@@ -264,6 +272,7 @@ static const ctest_case CASES[] = {
     CTEST_CASE(slab_orders_its_ends_and_says_when_it_swapped),
     CTEST_CASE(affine_point_and_vector_apply_the_map),
     CTEST_CASE(affine_invert_round_trips_and_refuses_singular_maps),
+    CTEST_CASE(unit_vector_gives_the_length_and_leaves_u_alone_without_one),
     CTEST_CASE(affine_unit_ray_gives_the_object_space_length),
     CTEST_CASE(affine_normal_maps_by_the_inverse_transpose),
     CTEST_CASE(affine_box_holds_the_corners_and_keeps_open_sides_open),
