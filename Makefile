@@ -10,7 +10,7 @@ SOURCES := pyproject.toml $(wildcard examples/shapes/*.yaml) \
                        -o -name '*.html' -o -name '*.js' -o -name '*.css' \) 2>/dev/null)
 C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c examples/embree/*.c)
 
-.PHONY: demo test check lint tools browser povray glslang embree embree-example embree-picture screenshot install regen gallery bench clean
+.PHONY: demo test check lint tools browser povray glslang embree embree-example embree-picture screenshot install regen gallery bench clean dist
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -93,6 +93,12 @@ screenshot: install browser
 	IMPLGEN_SCREENSHOT=docs/gallery/view.png $(BIN)/python -m pytest -q tests/test_view_browser.py
 	IMPLGEN_SHARE_SCREENSHOT=docs/gallery/share.png $(BIN)/python -m pytest -q tests/test_share_browser.py -k draws
 
+# An sdist and a wheel (built from the sdist) in dist/, checked by twine: what `pip install` takes elsewhere.
+dist: install
+	rm -rf dist
+	$(BIN)/python -m build --outdir dist .
+	$(BIN)/twine check --strict dist/*
+
 # Style, checked not changed: ruff (lint + format) for Python, clang-format (.clang-format) for the C runtime.
 lint: install
 	$(BIN)/ruff check generator tests bench
@@ -116,4 +122,4 @@ gallery: install
 	$(BIN)/python bench/surfaces.py
 
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) build dist *.egg-info

@@ -16,10 +16,11 @@ from implgen.codegen.emit import derivation_ops, generate
 from implgen.compile.clib import WARNING_FLAGS, build_shared
 from implgen.errors import UserError, printable
 from implgen.outputs import write_text_files
-from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, runtime_dir, runtime_sources
+from implgen.resources import SHAPE_SOURCES, SOLVER_SOURCES, gallery_dir, runtime_dir, runtime_sources
 from implgen.spec.entry import load_spec
 
 SHOWCASE = Path("examples/scenes/glassware.yaml")
+EXAMPLE_SHAPES = Path("examples/shapes")
 
 
 def _import(path: Path):
@@ -42,7 +43,7 @@ def _ray_fan(module, box) -> tuple[int, int]:
 
 
 EXAMPLES = (
-    ("what `make demo` runs, from the repository's root", "implgen demo"),
+    ("what `make demo` runs, in the repository's root (elsewhere: the shapes installed with it)", "implgen demo"),
     ("your own shapes, into another folder", "implgen demo --shapes my_shapes -o out/mine"),
 )
 
@@ -50,10 +51,15 @@ EXAMPLES = (
 def main(argv: Sequence[str]) -> int:
     parser = ArgumentParser(prog="implgen demo", description=__doc__, examples=EXAMPLES)
     parser.add_argument(
-        "--shapes", type=Path, default=Path("examples/shapes"), help="folder of shape specs (default: examples/shapes)"
+        "--shapes",
+        type=Path,
+        default=None,
+        help="folder of shape specs (default: examples/shapes, else the ones installed with implgen)",
     )
     parser.add_argument("-o", "--output", type=Path, default=Path("out"), help="output folder (default: out)")
     args = parser.parse_args(list(argv))
+    if args.shapes is None:  # from a clone, its examples; installed with pip anywhere else, the same specs
+        args.shapes = EXAMPLE_SHAPES if EXAMPLE_SHAPES.is_dir() else gallery_dir()
     specs = sorted(args.shapes.glob("*.yaml"))
     if not specs:
         raise UserError(args.shapes, "no *.yaml shape specs here (run `make demo` from the repository)")

@@ -53,11 +53,16 @@ KEY_FORMAT = "clib-2"  # part of every key: entries of an earlier layout are nev
 _in_use: weakref.WeakValueDictionary[Path, ctypes.CDLL] = weakref.WeakValueDictionary()
 
 
+# What needs a compiler (rendering, meshes, the C solvers behind generated Python) says which package brings one;
+# generating code and share pages need none (docs/dependencies.md#a-c-compiler-at-run-time)
+NO_COMPILER_HINT = "rendering and meshing need one: install gcc (Debian, Ubuntu: apt-get install gcc) or set CC"
+
+
 def compiler() -> str:
     """The C compiler: `$CC`, else `cc`."""
     cc = os.environ.get("CC", "cc")
     if shutil.which(cc) is None:
-        raise UserError("CC", f"no C compiler found (tried {cc!r}); install gcc or set CC")
+        raise UserError("CC", f"no C compiler found (tried {cc!r}); {NO_COMPILER_HINT}")
     return cc
 
 

@@ -18,18 +18,18 @@ import numpy as np
 
 from implgen.errors import UserError
 from implgen.measure.cases import rays_high as raysets_high
+from implgen.resources import gallery_dir
 from implgen.roots import raycast
 
 SHAPES_DIR = Path("examples/shapes")
 
 
 def find_shapes_dir(folder: str | Path | None = None) -> Path:
-    """The example shapes: folder if given, else ./examples/shapes, else the source tree's (running from a
-    checkout). UserError when there are none."""
+    """The example shapes: folder if given, else ./examples/shapes, else those installed (UserError if none)."""
     if folder is not None:
         candidates = [Path(folder)]
     else:
-        candidates = [SHAPES_DIR, Path(__file__).resolve().parents[2] / SHAPES_DIR]
+        candidates = [SHAPES_DIR, gallery_dir()]  # installed: the same specs (resources.gallery_dir)
     for cand in candidates:
         if cand.is_dir() and any(cand.glob("*.yaml")):
             return cand
