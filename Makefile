@@ -10,7 +10,7 @@ SOURCES := pyproject.toml $(wildcard examples/shapes/*.yaml) \
                        -o -name '*.html' -o -name '*.js' -o -name '*.css' \) 2>/dev/null)
 C_FILES := $(wildcard runtime_c/*.c runtime_c/*.h tests/c/*.c tests/c/*.h bench/c/*.c examples/embree/*.c)
 
-.PHONY: demo test check lint tools browser povray glslang embree embree-example embree-picture screenshot install regen gallery bench clean dist
+.PHONY: demo test check lint tools browser povray glslang embree embree-example embree-picture screenshot install regen gallery bench clean dist blender blender-addon
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -30,7 +30,7 @@ install: $(STAMP)
 demo: install
 	$(BIN)/implgen demo
 
-test: install browser povray glslang embree
+test: install browser povray glslang embree blender
 	$(BIN)/python -m pytest -q --durations=20 tests
 
 # The quick tier a developer runs while working (under two minutes on 2 cores): a few fast test files from every
@@ -59,6 +59,14 @@ debian_if = missing=; for p in $(2); do $(1) $$p >/dev/null 2>&1 || missing="$$m
 # Headless Chromium and its driver for the viewer's browser test.
 browser:
 	@$(call debian,chromium chromedriver,chromium chromium-driver,the browser tests will be skipped)
+
+# Debian's Blender (3.4) for the add-on's headless test (docs/blender.md).
+blender:
+	@$(call debian,blender,blender,the Blender add-on test will be skipped)
+
+# The Blender add-on as a zip to install (Edit > Preferences > Add-ons > Install; docs/blender.md).
+blender-addon:
+	$(PYTHON) blender/build_addon.py out/implgen_blender.zip
 
 # POV-Ray for the exporter's tests that render with it.
 povray:

@@ -27,6 +27,7 @@ PACKAGES = {
     "chromedriver": "chromium-driver",
     "povray": "povray",
     "glslangValidator": "glslang-tools",
+    "blender": "blender",
 }
 #: C libraries: the Debian package, a header the program includes, and an expression of the library it links
 LIBRARIES = {
