@@ -29,6 +29,7 @@ FLOORS = {
     "view": 7,
     "export": 7,
     "share": 7,
+    "notebook": 7,
     "mesh": 7,
     "measure": 7,
     "demo": 7,

@@ -157,6 +157,7 @@ def test_sdist_and_wheel_pass_twine_check_and_carry_the_license(dist):
     assert licence == (ROOT / "LICENSE").read_text()
     assert "\nLicense-Expression: MIT\n" in meta and "\nRequires-Python: >=3.11\n" in meta
     assert "implgen/runtime_c/roots.h" in names and "implgen/templates/c/shape.c.j2" in names
+    assert "implgen/notebook/static/widget.js" in names and "implgen/share/static/surface.js" in names
     assert not any(n.startswith("tests/") for n in names)
     assert sdist.stat().st_size > 0
 

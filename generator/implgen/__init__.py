@@ -6,6 +6,7 @@ The public Python API, stated once here (each name is imported from its module o
     from implgen import load_spec, parse_spec, generate, derive      # spec -> generated code
     from implgen import real_roots, first_root                      # the C root solvers
     from implgen import load_scene, parse_scene, render, write_png   # scenes -> pictures
+    from implgen import show                                         # a surface or scene in a notebook
     from implgen import UserError                                    # every bad input raises this
 """
 
@@ -32,6 +33,7 @@ _API: dict[str, str] = {
     "render": "implgen.scene.render",
     "RenderInfo": "implgen.scene.render",
     "write_png": "implgen.imagefile",
+    "show": "implgen.notebook.widget",
     "UserError": "implgen.errors",
 }
 __all__ = sorted(_API)
