@@ -18,6 +18,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import implgen
 from conftest import ROOT
@@ -61,6 +63,19 @@ def test_bad_params_are_one_line(text, message):
     with pytest.raises(surface.SurfaceError) as err:
         surface.parse_params(text)
     assert str(err.value) == message
+
+
+@settings(max_examples=200, deadline=None, derandomize=True)
+@given(st.text(alphabet=st.sampled_from("ab_1.=, -+e\tnaifx\u00e9\u2028\"'"), max_size=40) | st.text(max_size=40))
+def test_any_params_text_is_numbers_or_one_line(text):
+    """Whatever is typed into the Params field: finite numbers under identifiers, or one line saying what is
+    wrong -- never another exception."""
+    try:
+        values = surface.parse_params(text)
+    except surface.SurfaceError as err:
+        assert str(err).startswith("params: ") and "\n" not in str(err).replace("\\n", "")
+        return
+    assert all(surface.NAME.match(k) and np.isfinite(v) for k, v in values.items())
 
 
 def test_the_mesh_is_what_implgen_mesh_writes(tmp_path):
