@@ -109,8 +109,8 @@ dist: install
 
 # Style, checked not changed: ruff (lint + format) for Python, clang-format (.clang-format) for the C runtime.
 lint: install
-	$(BIN)/ruff check generator tests bench
-	$(BIN)/ruff format --check generator tests bench
+	$(BIN)/ruff check generator tests bench blender
+	$(BIN)/ruff format --check generator tests bench blender
 	@if [ -f .clang-format ]; then \
 	  $(MAKE) --no-print-directory tools || exit 1; \
 	  if command -v clang-format >/dev/null; then clang-format --dry-run --Werror $(C_FILES); fi; \
