@@ -153,3 +153,35 @@ def test_every_format_keeps_its_stated_precision(tmp_path):
             assert np.array_equal(got, want), (suffix, np.abs(got - want).max())
         else:
             assert np.array_equal(got, want.astype(np.float32).astype(np.float64)), suffix
+
+
+def _too_coarse_numbers(err: str) -> tuple[float, float, float]:
+    """(cell size, thickness, cells asked for) from the too-coarse line."""
+    import re
+
+    cell = float(re.search(r"cells are ([0-9.e+-]+) wide", err).group(1))
+    thick = float(re.search(r"find the solid ([0-9.e+-]+) thick", err).group(1))
+    need = float(re.search(r"about ([0-9.e+-]+) cells", err).group(1))
+    return cell, thick, need
+
+
+@pytest.mark.parametrize("half, cells_ok", [(1e6, False), (60.0, True)], ids=["1e6", "60"])
+def test_a_grid_too_coarse_for_its_box_says_so_and_by_how_much(tmp_path, half, cells_ok):
+    """A unit ball in a box of +-half along x (+-1.2 across) at 32 cells: at 1e6 no grid line comes near the ball
+    (cells of 62500), at 60 a few grid lines cross it between vertices. Either way the line says the grid is too
+    coarse, not that the surface has no real points: the cell size, the solid's thickness along probe lines
+    across the region (the ball's diameter 2, to within the probes' spacing) and the cells that would put grid
+    vertices in it (the box's length over half that thickness: 2e6, beyond the cap; 120, within it)."""
+    spec = tmp_path / "ball.yaml"
+    spec.write_text(
+        f"name: ball\nequation: x^2 + y^2 + z^2 - 1\nbounds: {{x: [-{half}, {half}], y: [-1.2, 1.2], z: [-1.2, 1.2]}}\n"
+    )
+    ran = implgen("mesh", spec, "-o", tmp_path / "b.stl", "--cells", "32", "--no-singular")
+    assert ran.code == 2 and ran.err.count("\n") == 1 and "Traceback" not in ran.err, ran.err
+    assert "no real points" not in ran.err and "--cells 32" in ran.err and "too coarse" in ran.err, ran.err
+    cell, thick, need = _too_coarse_numbers(ran.err)
+    assert abs(cell - 2 * half / 32) < 1e-9 * half
+    assert 1.9 < thick <= 2.0
+    assert 2 * half / 1.0 <= need <= 2 * half / 0.95 + 1
+    assert ("raise --cells" in ran.err) == cells_ok and ("more than the 256 allowed" in ran.err) != cells_ok
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ball.yaml"]

@@ -83,10 +83,10 @@ def unit(v: np.ndarray) -> np.ndarray:
     return u
 
 
-def line_points(lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, starts: np.ndarray):
-    """Every boundary point of the solid on the lines along `axis` starting at `starts` (L, 3): (line, t,
-    piece), t measured from the line's start, in order of line and, without clips, of t along it."""
-    length = grid.n[axis] * grid.h
+def line_points(lib: ShapeLib, clips: list[Clip], length: float, axis: int, starts: np.ndarray):
+    """Every boundary point of the solid on the lines along `axis` starting at `starts` (L, 3), up to `length`
+    along them: (line, t, piece), t measured from the line's start, in order of line and, without clips, of t
+    along it."""
     d = np.zeros(3)
     d[axis] = 1.0
     roots, counts = lib.roots(starts, d, 0.0, length)
@@ -136,7 +136,7 @@ def axis_crossings(
     base_idx = np.indices(tuple(1 if a == axis else s for a, s in enumerate(shape))).reshape(3, -1)
     base = np.ravel_multi_index(tuple(base_idx), shape)
     starts = grid.point(base)
-    line, t, piece = line_points(lib, clips, grid, axis, starts)
+    line, t, piece = line_points(lib, clips, grid.n[axis] * grid.h, axis, starts)
     step = np.clip(np.floor(t / grid.h).astype(np.int64), 0, shape[axis] - 2)
     key = base[line] + step * strides[axis]
     at = np.minimum(np.searchsorted(active, key), max(active.size - 1, 0))

@@ -13,10 +13,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from implgen.errors import UserError
-from implgen.mesh.budget import Budget, check_cells
+from implgen.mesh.budget import MAX_CELLS, Budget, check_cells
 from implgen.mesh.contour import Mesh, contour
 from implgen.mesh.crossings import clip_values
-from implgen.mesh.region import Clip, make_grid
+from implgen.mesh.probe import cells_to_see, probe_region
+from implgen.mesh.region import Clip, make_grid, region_box
 from implgen.mesh.shapelib import ShapeLib
 from implgen.mesh.singular import Singular, find_singular
 from implgen.spec.model import Spec
@@ -81,13 +82,8 @@ def mesh_spec(
     lib.budget = budget
     mesh = contour(lib, clips, grid)
     if len(mesh.faces) == 0:
-        hidden = mesh.stats["hidden_crossing_edges"]
-        if not hidden:
-            raise UserError(what or spec.source, "no real points of the surface in the region meshed: nothing to mesh")
-        raise UserError(
-            f"{cells_name} {cells}",
-            f"no grid vertex lies in the solid, so the mesh is empty ({hidden} grid edges hold crossings): raise it",
-        )
+        box = region_box(spec.box(dict(values)), user_clips, what or spec.source)
+        raise _empty(lib, clips, box, mesh, what or spec.source, cells_name, cells)
     t2 = time.perf_counter()
     sing = None
     if singular:
@@ -100,6 +96,28 @@ def mesh_spec(
     lib.budget = None  # the caller's own uses (normals) are not timed
     t3 = time.perf_counter()
     return Result(mesh, lib, clips, sing, {"build": t1 - t0, "mesh": t2 - t1, "singular": t3 - t2})
+
+
+def _empty(lib: ShapeLib, clips: list[Clip], box, mesh: Mesh, where: str, cells_name: str, cells: int) -> UserError:
+    """Why a mesh has no faces: no boundary point on the grid's lines nor on probe lines across the region (no
+    real points, naming `where`), or a grid too coarse for the region (naming the cells) -- its cell size, the
+    solid's thickness along the probes, and the cells that would put grid vertices in it."""
+    hidden = mesh.stats["hidden_crossing_edges"]
+    lo, hi = box
+    found = probe_region(lib, clips, lo, hi, mesh.grid)
+    if not hidden and not found.points:
+        return UserError(where, "no real points of the surface in the region meshed: nothing to mesh")
+    seen = f"{hidden} grid edges hold crossings" if hidden else "no grid line meets the solid"
+    text = f"no grid vertex lies in the solid, so the mesh is empty ({seen}): the grid is too coarse for the region"
+    text += f" (its cells are {mesh.grid.h:.3g} wide"
+    if found.thickness <= 0:
+        return UserError(f"{cells_name} {cells}", text + "): raise it")
+    need = max(cells_to_see(float((hi - lo).max()), found.thickness), cells + 1)
+    text += f"; {found.lines} lines across it find the solid {found.thickness:.3g} thick): about {need:.3g} cells"
+    if need <= MAX_CELLS:
+        return UserError(f"{cells_name} {cells}", text + f" would put grid vertices in it: raise {cells_name}")
+    tail = f" would, more than the {MAX_CELLS} allowed: shrink the spec's bounds or clip the region to the surface"
+    return UserError(f"{cells_name} {cells}", text + tail)
 
 
 def snap_to_singular(mesh: Mesh, points: np.ndarray, clips: list[Clip]) -> None:
