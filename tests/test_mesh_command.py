@@ -185,3 +185,31 @@ def test_a_grid_too_coarse_for_its_box_says_so_and_by_how_much(tmp_path, half, c
     assert 2 * half / 1.0 <= need <= 2 * half / 0.95 + 1
     assert ("raise --cells" in ran.err) == cells_ok and ("more than the 256 allowed" in ran.err) != cells_ok
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ball.yaml"]
+
+
+def test_cells_reported_as_asked_and_the_grid_beside_them(tmp_path):
+    """--cells N is the cells along the region's longest side (docs/mesh.md): the report's "cells" is N, the cell
+    size that side over N; the grid, with its margin of outside vertices, is "grid_cells"."""
+    rep_path = tmp_path / "r.json"
+    ran = implgen("mesh", TORUS, "-o", tmp_path / "t.stl", "--cells", "32", "--no-singular", "--report", rep_path)
+    assert ran.code == 0, ran.err
+    rep = json.loads(rep_path.read_text())
+    assert rep["cells"] == 32
+    assert abs(rep["cell_size"] * 32 - 2.5) < 1e-12  # torus_z's box: x and y in [-1.25, 1.25]
+    assert len(rep["grid_cells"]) == 3 and all(32 < n <= 36 for n in rep["grid_cells"][:2])
+
+
+@pytest.mark.parametrize(
+    "args, says",
+    [
+        (["--cells", "abc"], "implgen: error: --cells: expected a whole number, not 'abc'\n"),
+        (["--cells", "1.5"], "implgen: error: --cells: expected a whole number, not '1.5'\n"),
+        (["--cellz", "3"], "implgen: error: mesh: unrecognized arguments: --cellz 3\n"),
+    ],
+)
+def test_a_bad_option_names_the_command_once(tmp_path, args, says):
+    """argparse's own errors carry the command once ("mesh: ..."), not "implgen: error: implgen mesh: ..."; a
+    --cells that is no whole number is said as any bad value is."""
+    ran = implgen("mesh", TORUS, "-o", tmp_path / "t.stl", *args)
+    assert ran.code == 2 and ran.err == says
+    assert list(tmp_path.iterdir()) == []

@@ -42,6 +42,7 @@ EXAMPLES = (
 def _parser() -> ArgumentParser:
     ap = ArgumentParser(
         prog="implgen mesh",
+        label="mesh",
         description="A watertight triangle mesh of the solid f < 0 of a shape: every grid line is solved exactly "
         "for its crossings, one vertex per sheet of each cell (dual contouring on the exact points and normals), "
         "normals toward f > 0. An unbounded shape needs --clip; the cut is capped.",
@@ -50,7 +51,7 @@ def _parser() -> ArgumentParser:
     ap.add_argument("file", metavar="SPEC.yaml|SCENE.yaml")
     ap.add_argument("-o", "--output", required=True, help="the mesh: .stl (binary), .obj, .ply or .glb")
     cells_help = f"cells along the longest side ({MIN_CELLS}..{MAX_CELLS}, default {DEFAULT_CELLS})"
-    ap.add_argument("--cells", type=int, default=DEFAULT_CELLS, help=cells_help)
+    ap.add_argument("--cells", default=str(DEFAULT_CELLS), help=cells_help)
     ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a param's value (repeat)")
     ap.add_argument("--clip", help="sphere:R (the ball of radius R about the origin) or box:H (the cube [-H, H]^3)")
     ap.add_argument("--object", help="in a scene: the shape to mesh, by its name")
@@ -59,6 +60,12 @@ def _parser() -> ArgumentParser:
     limit_help = "stop, writing nothing, when meshing takes longer (reading the file not counted; default: none)"
     ap.add_argument("--time-limit", metavar="SECONDS", help=limit_help)
     return ap
+
+
+def _whole(text: str) -> int | str:
+    """A whole number written in decimal digits as an int; anything else as it was (validate.whole refuses it)."""
+    t = text.strip()
+    return int(t) if t.lstrip("+-").isdigit() and t.isascii() and len(t) <= 100 else text
 
 
 def _params(spec, pairs: Sequence[str]) -> dict[str, float]:
@@ -93,7 +100,9 @@ def _shape(path: Path, obj: str | None):
     return load_spec(path, cache=True), {}, None
 
 
-def report(result: Result, label: str, values: dict[str, float], verts: np.ndarray, faces: np.ndarray) -> dict:
+def report(
+    result: Result, label: str, values: dict[str, float], cells: int, verts: np.ndarray, faces: np.ndarray
+) -> dict:
     closed, euler = closed_and_euler(faces, len(verts))
     sing = result.singular
     pts = sing.points if sing is not None else np.zeros((0, 3))
@@ -101,8 +110,9 @@ def report(result: Result, label: str, values: dict[str, float], verts: np.ndarr
     return {
         "shape": label,
         "params": values,
-        "cells": list(result.mesh.grid.n),
+        "cells": cells,  # along the region's longest side, as asked
         "cell_size": result.mesh.grid.h,
+        "grid_cells": list(result.mesh.grid.n),  # the grid's, with its margin of outside vertices
         "vertices": len(verts),
         "triangles": len(faces),
         "closed": closed,
@@ -122,7 +132,7 @@ def main(argv: Sequence[str]) -> int:
     check_output_file(out, "-o", tuple(FORMATS))
     if args.report is not None:
         check_output_file(Path(args.report), "--report", (".json",))
-    validate.whole("--cells", "", args.cells, MIN_CELLS, MAX_CELLS)
+    args.cells = validate.whole("--cells", "", _whole(args.cells), MIN_CELLS, MAX_CELLS)
     limit = None
     if args.time_limit is not None:
         limit = validate.number("--time-limit", "", args.time_limit, 0.0, MAX_TIME_LIMIT, lo_open=True, text_ok=True)
@@ -144,7 +154,7 @@ def main(argv: Sequence[str]) -> int:
     normals = vertex_normals(result.lib, result.clips, verts)
     if matrix is not None:
         verts, faces, normals = place(matrix, verts, faces, normals)
-    rep = report(result, spec.name, {**spec.params, **values}, verts, faces)
+    rep = report(result, spec.name, {**spec.params, **values}, args.cells, verts, faces)
     write_mesh(out, verts, faces, normals)
     if args.report is not None:
         text = json.dumps(rep, indent=1) + "\n"

@@ -137,7 +137,7 @@ def _stats(clock: list[float], grid: Grid, cross: list[Crossings], cs: _Cells, f
     phases = ("signs", "crossings", "sheets", "qef", "projection", "faces")
     return {
         "seconds": {k: round(b - a, 4) for k, a, b in zip(phases, clock, clock[1:])},
-        "cells": list(grid.n),
+        "grid_cells": list(grid.n),
         "active_edges": int(sum(c.edges.size for c in cross)),
         "fallback_crossings": int(sum(c.fallback for c in cross)),
         "multi_sheet_cells": int((cs.count > 1).sum()),
