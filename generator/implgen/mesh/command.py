@@ -121,6 +121,7 @@ def report(
         "singular_points": None if sing is None else [[float(v) for v in p] for p in pts],
         "singular_in_clip": None if sing is None else int(inside.sum()),
         "singular_search_complete": None if sing is None else sing.complete,
+        "at_singular_points": None if sing is None else result.at_singular,  # what the mesh does at each
         "stats": result.mesh.stats,
         "seconds": {k: round(v, 4) for k, v in result.timings.items()},
     }
@@ -164,6 +165,13 @@ def main(argv: Sequence[str]) -> int:
         f"{len(sing)} singular point(s) in the box, {rep['singular_in_clip']} in the solid's region"
         + (": " + " ".join(f"({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g})" for p in sing[:65]) if sing else "")
     )  # fmt: skip
+    parted = rep["stats"]["touching_points"]
+    if parted:
+        sing_text += (
+            f"; {parted} point(s) where sheets touched: {rep['stats']['touching_vertices_split']} vertices moved "
+            f"{rep['stats']['split_distance']:.2g} apart, {rep['stats']['island_triangles_dropped']} triangles "
+            "of squashed islands dropped (the report says which)"
+        )
     hidden = rep["stats"]["hidden_crossing_edges"]
     hidden_text = (
         f"; {hidden} grid edges hold crossings their ends do not show (detail below the grid: raise --cells)"
