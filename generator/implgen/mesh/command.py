@@ -8,6 +8,7 @@ written through a temporary file and renamed.
 from __future__ import annotations
 
 import json
+import math
 import sys
 import time
 from collections.abc import Sequence
@@ -123,8 +124,30 @@ def report(
         "singular_search_complete": None if sing is None else sing.complete,
         "at_singular_points": None if sing is None else result.at_singular,  # what the mesh does at each
         "stats": result.mesh.stats,
+        "missed_resolve_cells": None
+        if not result.mesh.stats["missed_detail_edges"]
+        else resolve_cells(cells, result.mesh.grid.h, result.mesh.stats["missed_widest"]),
         "seconds": {k: round(v, 4) for k, v in result.timings.items()},
     }
+
+
+def resolve_cells(cells: int, cell_size: float, width: float) -> int:
+    """Cells along the region's longest side (cells x cell_size) whose size is half of `width`."""
+    return max(cells + 1, math.ceil(2 * cells * cell_size / width))
+
+
+def _missed_text(rep: dict) -> str:
+    """The warning of the stderr line: only when the exact crossings show detail the grid misses (missed.py)."""
+    st = rep["stats"]
+    if not st["missed_detail_edges"]:
+        return ""
+    at = ", ".join(f"{v:.3g}" for v in st["missed_at"])
+    need = rep["missed_resolve_cells"]
+    what = "raise --cells" if need <= MAX_CELLS else f"more than the {MAX_CELLS} allowed: clip the region to it"
+    return (
+        f"; the exact crossings show detail the grid misses on {st['missed_detail_edges']} grid edge(s), up to "
+        f"{st['missed_widest']:.2g} across, near ({at}): about {need} cells would put grid vertices in it ({what})"
+    )
 
 
 def main(argv: Sequence[str]) -> int:
@@ -172,12 +195,7 @@ def main(argv: Sequence[str]) -> int:
             f"{rep['stats']['split_distance']:.2g} apart, {rep['stats']['island_triangles_dropped']} triangles "
             "of squashed islands dropped (the report says which)"
         )
-    hidden = rep["stats"]["hidden_crossing_edges"]
-    hidden_text = (
-        f"; {hidden} grid edges hold crossings their ends do not show (detail below the grid: raise --cells)"
-        if hidden
-        else ""
-    )
+    hidden_text = _missed_text(rep)
     print(
         f"implgen mesh: {spec.name}: {rep['vertices']} vertices, {rep['triangles']} triangles, "
         f"{'closed' if rep['closed'] else 'NOT closed'}, Euler characteristic {rep['euler_characteristic']}; "

@@ -30,6 +30,8 @@ class Crossings:
     piece: np.ndarray
     fallback: int
     hidden: int  # edges whose two ends agree but that hold boundary points (a sheet poking through, a tangency)
+    inner_edge: np.ndarray | None = None  # per interval between two boundary points on one edge: the edge
+    inner_ends: np.ndarray | None = None  # (k, 2, 3): the interval's two boundary points
 
 
 def clip_values(clips: list[Clip], p: np.ndarray) -> np.ndarray:
@@ -145,6 +147,10 @@ def axis_crossings(
     run = np.flatnonzero(np.concatenate([[True], key[1:] != key[:-1]])) if key.size else np.zeros(0, dtype=np.int64)
     count = np.diff(np.append(run, key.size))
     hidden = int((~on[run]).sum())  # edges whose ends agree but that hold points
+    pair = np.flatnonzero(key[1:] == key[:-1]) if key.size else np.zeros(0, dtype=np.int64)
+    ends = np.repeat(starts[line[pair]][:, None, :], 2, axis=1)  # consecutive points of one edge: an interval
+    ends[:, 0, axis] += t[pair]
+    ends[:, 1, axis] += t[pair + 1]
     run, count = run[on[run]], count[on[run]]
     pick = run + count // 2  # an edge with several points: the middle one
     slot = at[run]
@@ -167,5 +173,6 @@ def axis_crossings(
         sel = np.flatnonzero(pieces == j)
         grad[sel] = piece_value_gradient(lib, clips, int(j), points[sel])[1]
     return Crossings(
-        edges=active, points=points, normals=unit(grad), piece=pieces, fallback=int(miss.size), hidden=hidden
-    )
+        edges=active, points=points, normals=unit(grad), piece=pieces, fallback=int(miss.size), hidden=hidden,
+        inner_edge=key[pair], inner_ends=ends,
+    )  # fmt: skip
