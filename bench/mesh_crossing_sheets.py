@@ -49,7 +49,7 @@ def edge_crossings(lib, clips, grid):
     for axis in range(3):
         base = np.indices(tuple(1 if a == axis else s for a, s in enumerate(shape))).reshape(3, -1).T
         starts = grid.origin + grid.h * base
-        line, t, _ = line_points(lib, clips, grid, axis, starts)
+        line, t, _ = line_points(lib, clips, grid.n[axis] * grid.h, axis, starts)
         step = np.clip(np.floor(t / grid.h).astype(np.int64), 0, shape[axis] - 2)
         for li, tt, st in zip(line, t, step):
             idx = base[li].copy()

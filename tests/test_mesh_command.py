@@ -125,3 +125,91 @@ def test_no_real_points_is_one_line_not_an_empty_file(tmp_path):
     assert ran.code == 2 and ran.err.count("\n") == 1 and "Traceback" not in ran.err
     assert ran.err == f"implgen: error: {spec}: no real points of the surface in the region meshed: nothing to mesh\n"
     assert list(tmp_path.iterdir()) == [spec]
+
+
+def test_every_format_keeps_its_stated_precision(tmp_path):
+    """Each format read back by trimesh against the doubles meshed: OBJ (17 significant digits) and PLY (binary
+    doubles) give every vertex back exactly; STL and glTF hold float32, so each coordinate is the double rounded
+    to float32 (within 2^-24 of its size). The vertices compared are those the report's order gives: the
+    written mesh's own, read without merging."""
+    from implgen.mesh.pipeline import mesh_spec
+    from implgen.mesh.write import vertex_normals, write_mesh
+    from implgen.spec.entry import load_spec
+
+    spec = load_spec(TORUS, cache=True)
+    result = mesh_spec(spec, {}, 16, [], singular=False)
+    verts, faces = result.mesh.vertices, result.mesh.faces
+    normals = vertex_normals(result.lib, result.clips, verts)
+    for suffix in (".obj", ".ply", ".stl", ".glb"):
+        out = tmp_path / f"t{suffix}"
+        write_mesh(out, verts, faces, normals)
+        back = trimesh.load(out, force="mesh", process=False)
+        got = np.asarray(back.vertices, dtype=np.float64)
+        want = verts[faces].reshape(-1, 3) if suffix == ".stl" else verts  # STL: three corners per triangle
+        if suffix == ".stl":
+            got = got[np.asarray(back.faces).reshape(-1)]
+        assert got.shape == want.shape, suffix
+        if suffix in (".obj", ".ply"):
+            assert np.array_equal(got, want), (suffix, np.abs(got - want).max())
+        else:
+            assert np.array_equal(got, want.astype(np.float32).astype(np.float64)), suffix
+
+
+def _too_coarse_numbers(err: str) -> tuple[float, float, float]:
+    """(cell size, thickness, cells asked for) from the too-coarse line."""
+    import re
+
+    cell = float(re.search(r"cells are ([0-9.e+-]+) wide", err).group(1))
+    thick = float(re.search(r"find the solid ([0-9.e+-]+) thick", err).group(1))
+    need = float(re.search(r"about ([0-9.e+-]+) cells", err).group(1))
+    return cell, thick, need
+
+
+@pytest.mark.parametrize("half, cells_ok", [(1e6, False), (60.0, True)], ids=["1e6", "60"])
+def test_a_grid_too_coarse_for_its_box_says_so_and_by_how_much(tmp_path, half, cells_ok):
+    """A unit ball in a box of +-half along x (+-1.2 across) at 32 cells: at 1e6 no grid line comes near the ball
+    (cells of 62500), at 60 a few grid lines cross it between vertices. Either way the line says the grid is too
+    coarse, not that the surface has no real points: the cell size, the solid's thickness along probe lines
+    across the region (the ball's diameter 2, to within the probes' spacing) and the cells that would put grid
+    vertices in it (the box's length over half that thickness: 2e6, beyond the cap; 120, within it)."""
+    spec = tmp_path / "ball.yaml"
+    spec.write_text(
+        f"name: ball\nequation: x^2 + y^2 + z^2 - 1\nbounds: {{x: [-{half}, {half}], y: [-1.2, 1.2], z: [-1.2, 1.2]}}\n"
+    )
+    ran = implgen("mesh", spec, "-o", tmp_path / "b.stl", "--cells", "32", "--no-singular")
+    assert ran.code == 2 and ran.err.count("\n") == 1 and "Traceback" not in ran.err, ran.err
+    assert "no real points" not in ran.err and "--cells 32" in ran.err and "too coarse" in ran.err, ran.err
+    cell, thick, need = _too_coarse_numbers(ran.err)
+    assert abs(cell - 2 * half / 32) < 1e-9 * half
+    assert 1.9 < thick <= 2.0
+    assert 2 * half / 1.0 <= need <= 2 * half / 0.95 + 1
+    assert ("raise --cells" in ran.err) == cells_ok and ("more than the 256 allowed" in ran.err) != cells_ok
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ball.yaml"]
+
+
+def test_cells_reported_as_asked_and_the_grid_beside_them(tmp_path):
+    """--cells N is the cells along the region's longest side (docs/mesh.md): the report's "cells" is N, the cell
+    size that side over N; the grid, with its margin of outside vertices, is "grid_cells"."""
+    rep_path = tmp_path / "r.json"
+    ran = implgen("mesh", TORUS, "-o", tmp_path / "t.stl", "--cells", "32", "--no-singular", "--report", rep_path)
+    assert ran.code == 0, ran.err
+    rep = json.loads(rep_path.read_text())
+    assert rep["cells"] == 32
+    assert abs(rep["cell_size"] * 32 - 2.5) < 1e-12  # torus_z's box: x and y in [-1.25, 1.25]
+    assert len(rep["grid_cells"]) == 3 and all(32 < n <= 36 for n in rep["grid_cells"][:2])
+
+
+@pytest.mark.parametrize(
+    "args, says",
+    [
+        (["--cells", "abc"], "implgen: error: --cells: expected a whole number, not 'abc'\n"),
+        (["--cells", "1.5"], "implgen: error: --cells: expected a whole number, not '1.5'\n"),
+        (["--cellz", "3"], "implgen: error: mesh: unrecognized arguments: --cellz 3\n"),
+    ],
+)
+def test_a_bad_option_names_the_command_once(tmp_path, args, says):
+    """argparse's own errors carry the command once ("mesh: ..."), not "implgen: error: implgen mesh: ..."; a
+    --cells that is no whole number is said as any bad value is."""
+    ran = implgen("mesh", TORUS, "-o", tmp_path / "t.stl", *args)
+    assert ran.code == 2 and ran.err == says
+    assert list(tmp_path.iterdir()) == []

@@ -8,6 +8,7 @@ written through a temporary file and renamed.
 from __future__ import annotations
 
 import json
+import math
 import sys
 import time
 from collections.abc import Sequence
@@ -42,6 +43,7 @@ EXAMPLES = (
 def _parser() -> ArgumentParser:
     ap = ArgumentParser(
         prog="implgen mesh",
+        label="mesh",
         description="A watertight triangle mesh of the solid f < 0 of a shape: every grid line is solved exactly "
         "for its crossings, one vertex per sheet of each cell (dual contouring on the exact points and normals), "
         "normals toward f > 0. An unbounded shape needs --clip; the cut is capped.",
@@ -50,7 +52,7 @@ def _parser() -> ArgumentParser:
     ap.add_argument("file", metavar="SPEC.yaml|SCENE.yaml")
     ap.add_argument("-o", "--output", required=True, help="the mesh: .stl (binary), .obj, .ply or .glb")
     cells_help = f"cells along the longest side ({MIN_CELLS}..{MAX_CELLS}, default {DEFAULT_CELLS})"
-    ap.add_argument("--cells", type=int, default=DEFAULT_CELLS, help=cells_help)
+    ap.add_argument("--cells", default=str(DEFAULT_CELLS), help=cells_help)
     ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a param's value (repeat)")
     ap.add_argument("--clip", help="sphere:R (the ball of radius R about the origin) or box:H (the cube [-H, H]^3)")
     ap.add_argument("--object", help="in a scene: the shape to mesh, by its name")
@@ -59,6 +61,12 @@ def _parser() -> ArgumentParser:
     limit_help = "stop, writing nothing, when meshing takes longer (reading the file not counted; default: none)"
     ap.add_argument("--time-limit", metavar="SECONDS", help=limit_help)
     return ap
+
+
+def _whole(text: str) -> int | str:
+    """A whole number written in decimal digits as an int; anything else as it was (validate.whole refuses it)."""
+    t = text.strip()
+    return int(t) if t.lstrip("+-").isdigit() and t.isascii() and len(t) <= 100 else text
 
 
 def _params(spec, pairs: Sequence[str]) -> dict[str, float]:
@@ -93,7 +101,9 @@ def _shape(path: Path, obj: str | None):
     return load_spec(path, cache=True), {}, None
 
 
-def report(result: Result, label: str, values: dict[str, float], verts: np.ndarray, faces: np.ndarray) -> dict:
+def report(
+    result: Result, label: str, values: dict[str, float], cells: int, verts: np.ndarray, faces: np.ndarray
+) -> dict:
     closed, euler = closed_and_euler(faces, len(verts))
     sing = result.singular
     pts = sing.points if sing is not None else np.zeros((0, 3))
@@ -101,8 +111,9 @@ def report(result: Result, label: str, values: dict[str, float], verts: np.ndarr
     return {
         "shape": label,
         "params": values,
-        "cells": list(result.mesh.grid.n),
+        "cells": cells,  # along the region's longest side, as asked
         "cell_size": result.mesh.grid.h,
+        "grid_cells": list(result.mesh.grid.n),  # the grid's, with its margin of outside vertices
         "vertices": len(verts),
         "triangles": len(faces),
         "closed": closed,
@@ -111,9 +122,32 @@ def report(result: Result, label: str, values: dict[str, float], verts: np.ndarr
         "singular_points": None if sing is None else [[float(v) for v in p] for p in pts],
         "singular_in_clip": None if sing is None else int(inside.sum()),
         "singular_search_complete": None if sing is None else sing.complete,
+        "at_singular_points": None if sing is None else result.at_singular,  # what the mesh does at each
         "stats": result.mesh.stats,
+        "missed_resolve_cells": None
+        if not result.mesh.stats["missed_detail_edges"]
+        else resolve_cells(cells, result.mesh.grid.h, result.mesh.stats["missed_widest"]),
         "seconds": {k: round(v, 4) for k, v in result.timings.items()},
     }
+
+
+def resolve_cells(cells: int, cell_size: float, width: float) -> int:
+    """Cells along the region's longest side (cells x cell_size) whose size is half of `width`."""
+    return max(cells + 1, math.ceil(2 * cells * cell_size / width))
+
+
+def _missed_text(rep: dict) -> str:
+    """The warning of the stderr line: only when the exact crossings show detail the grid misses (missed.py)."""
+    st = rep["stats"]
+    if not st["missed_detail_edges"]:
+        return ""
+    at = ", ".join(f"{v:.3g}" for v in st["missed_at"])
+    need = rep["missed_resolve_cells"]
+    what = "raise --cells" if need <= MAX_CELLS else f"more than the {MAX_CELLS} allowed: clip the region to it"
+    return (
+        f"; the exact crossings show detail the grid misses on {st['missed_detail_edges']} grid edge(s), up to "
+        f"{st['missed_widest']:.2g} across, near ({at}): about {need} cells would put grid vertices in it ({what})"
+    )
 
 
 def main(argv: Sequence[str]) -> int:
@@ -122,7 +156,7 @@ def main(argv: Sequence[str]) -> int:
     check_output_file(out, "-o", tuple(FORMATS))
     if args.report is not None:
         check_output_file(Path(args.report), "--report", (".json",))
-    validate.whole("--cells", "", args.cells, MIN_CELLS, MAX_CELLS)
+    args.cells = validate.whole("--cells", "", _whole(args.cells), MIN_CELLS, MAX_CELLS)
     limit = None
     if args.time_limit is not None:
         limit = validate.number("--time-limit", "", args.time_limit, 0.0, MAX_TIME_LIMIT, lo_open=True, text_ok=True)
@@ -144,7 +178,7 @@ def main(argv: Sequence[str]) -> int:
     normals = vertex_normals(result.lib, result.clips, verts)
     if matrix is not None:
         verts, faces, normals = place(matrix, verts, faces, normals)
-    rep = report(result, spec.name, {**spec.params, **values}, verts, faces)
+    rep = report(result, spec.name, {**spec.params, **values}, args.cells, verts, faces)
     write_mesh(out, verts, faces, normals)
     if args.report is not None:
         text = json.dumps(rep, indent=1) + "\n"
@@ -154,12 +188,14 @@ def main(argv: Sequence[str]) -> int:
         f"{len(sing)} singular point(s) in the box, {rep['singular_in_clip']} in the solid's region"
         + (": " + " ".join(f"({p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g})" for p in sing[:65]) if sing else "")
     )  # fmt: skip
-    hidden = rep["stats"]["hidden_crossing_edges"]
-    hidden_text = (
-        f"; {hidden} grid edges hold crossings their ends do not show (detail below the grid: raise --cells)"
-        if hidden
-        else ""
-    )
+    parted = rep["stats"]["touching_points"]
+    if parted:
+        sing_text += (
+            f"; {parted} point(s) where sheets touched: {rep['stats']['touching_vertices_split']} vertices moved "
+            f"{rep['stats']['split_distance']:.2g} apart, {rep['stats']['island_triangles_dropped']} triangles "
+            "of squashed islands dropped (the report says which)"
+        )
+    hidden_text = _missed_text(rep)
     print(
         f"implgen mesh: {spec.name}: {rep['vertices']} vertices, {rep['triangles']} triangles, "
         f"{'closed' if rep['closed'] else 'NOT closed'}, Euler characteristic {rep['euler_characteristic']}; "

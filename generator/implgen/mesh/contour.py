@@ -13,6 +13,7 @@ from implgen.mesh import cells
 from implgen.mesh.crossings import Crossings, axis_crossings, grid_flags, inside_flags
 from implgen.mesh.dual import CREASE, DROP, outside_pieces, project
 from implgen.mesh.faces import Quads, triangulate
+from implgen.mesh.missed import Missed, missed_detail
 from implgen.mesh.region import Clip, Grid
 from implgen.mesh.shapelib import ShapeLib
 
@@ -28,6 +29,7 @@ class Mesh:
     grid: Grid
     stats: dict = field(default_factory=dict)
     cell: np.ndarray | None = None  # per vertex, the flat index of its cell's lower corner (-1: added by faces.py)
+    missed: Missed | None = None  # detail the grid misses (missed.py)
 
 
 def _face_bits(lib, clips, grid: Grid, cell_idx: np.ndarray, config: np.ndarray) -> np.ndarray:
@@ -133,16 +135,20 @@ def _quads(grid: Grid, cross: list[Crossings], cs: _Cells, inside: np.ndarray, s
     return Quads(*(np.concatenate([p[i] for p in parts]) for i in range(6))), rowof
 
 
-def _stats(clock: list[float], grid: Grid, cross: list[Crossings], cs: _Cells, failed, split) -> dict:
+def _stats(clock: list[float], grid: Grid, cross: list[Crossings], cs: _Cells, failed, split, missed) -> dict:
     phases = ("signs", "crossings", "sheets", "qef", "projection", "faces")
+    wide = int(np.argmax(missed.width)) if missed.count else -1
     return {
         "seconds": {k: round(b - a, 4) for k, a, b in zip(phases, clock, clock[1:])},
-        "cells": list(grid.n),
+        "grid_cells": list(grid.n),
         "active_edges": int(sum(c.edges.size for c in cross)),
         "fallback_crossings": int(sum(c.fallback for c in cross)),
         "multi_sheet_cells": int((cs.count > 1).sum()),
         "vertices_at_a_crossing": int(failed.sum()),
         "hidden_crossing_edges": int(sum(c.hidden for c in cross)),
+        "missed_detail_edges": missed.count,
+        "missed_widest": float(missed.width[wide]) if missed.count else None,  # along its edge
+        "missed_at": [float(v) for v in missed.middle[wide]] if missed.count else None,
         "split_sides": split,
     }
 
@@ -155,6 +161,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     _check_outer_layer(inside)
     strides = np.array([inside.shape[1] * inside.shape[2], inside.shape[2], 1])
     cross: list[Crossings] = [axis_crossings(lib, clips, grid, a, inside, g) for a in range(3)]
+    missed = missed_detail(lib, clips, grid, inside, cross)
     clock.append(time.perf_counter())
     lib.check()  # the budget, between phases (budget.py)
     cs = _active_cells(lib, clips, grid, inside, strides)
@@ -169,4 +176,5 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     clock.append(time.perf_counter())
     cell = np.full(len(verts), -1, dtype=np.int64)
     cell[: cs.nverts] = np.repeat(cs.flat, cs.count)
-    return Mesh(vertices=verts, faces=faces, grid=grid, stats=_stats(clock, grid, cross, cs, failed, split), cell=cell)
+    stats = _stats(clock, grid, cross, cs, failed, split, missed)
+    return Mesh(vertices=verts, faces=faces, grid=grid, stats=stats, cell=cell, missed=missed)

@@ -30,6 +30,8 @@ class Crossings:
     piece: np.ndarray
     fallback: int
     hidden: int  # edges whose two ends agree but that hold boundary points (a sheet poking through, a tangency)
+    inner_edge: np.ndarray | None = None  # per interval between two boundary points on one edge: the edge
+    inner_ends: np.ndarray | None = None  # (k, 2, 3): the interval's two boundary points
 
 
 def clip_values(clips: list[Clip], p: np.ndarray) -> np.ndarray:
@@ -83,10 +85,10 @@ def unit(v: np.ndarray) -> np.ndarray:
     return u
 
 
-def line_points(lib: ShapeLib, clips: list[Clip], grid: Grid, axis: int, starts: np.ndarray):
-    """Every boundary point of the solid on the lines along `axis` starting at `starts` (L, 3): (line, t,
-    piece), t measured from the line's start, in order of line and, without clips, of t along it."""
-    length = grid.n[axis] * grid.h
+def line_points(lib: ShapeLib, clips: list[Clip], length: float, axis: int, starts: np.ndarray):
+    """Every boundary point of the solid on the lines along `axis` starting at `starts` (L, 3), up to `length`
+    along them: (line, t, piece), t measured from the line's start, in order of line and, without clips, of t
+    along it."""
     d = np.zeros(3)
     d[axis] = 1.0
     roots, counts = lib.roots(starts, d, 0.0, length)
@@ -136,7 +138,7 @@ def axis_crossings(
     base_idx = np.indices(tuple(1 if a == axis else s for a, s in enumerate(shape))).reshape(3, -1)
     base = np.ravel_multi_index(tuple(base_idx), shape)
     starts = grid.point(base)
-    line, t, piece = line_points(lib, clips, grid, axis, starts)
+    line, t, piece = line_points(lib, clips, grid.n[axis] * grid.h, axis, starts)
     step = np.clip(np.floor(t / grid.h).astype(np.int64), 0, shape[axis] - 2)
     key = base[line] + step * strides[axis]
     at = np.minimum(np.searchsorted(active, key), max(active.size - 1, 0))
@@ -145,6 +147,10 @@ def axis_crossings(
     run = np.flatnonzero(np.concatenate([[True], key[1:] != key[:-1]])) if key.size else np.zeros(0, dtype=np.int64)
     count = np.diff(np.append(run, key.size))
     hidden = int((~on[run]).sum())  # edges whose ends agree but that hold points
+    pair = np.flatnonzero(key[1:] == key[:-1]) if key.size else np.zeros(0, dtype=np.int64)
+    ends = np.repeat(starts[line[pair]][:, None, :], 2, axis=1)  # consecutive points of one edge: an interval
+    ends[:, 0, axis] += t[pair]
+    ends[:, 1, axis] += t[pair + 1]
     run, count = run[on[run]], count[on[run]]
     pick = run + count // 2  # an edge with several points: the middle one
     slot = at[run]
@@ -167,5 +173,6 @@ def axis_crossings(
         sel = np.flatnonzero(pieces == j)
         grad[sel] = piece_value_gradient(lib, clips, int(j), points[sel])[1]
     return Crossings(
-        edges=active, points=points, normals=unit(grad), piece=pieces, fallback=int(miss.size), hidden=hidden
-    )
+        edges=active, points=points, normals=unit(grad), piece=pieces, fallback=int(miss.size), hidden=hidden,
+        inner_edge=key[pair], inner_ends=ends,
+    )  # fmt: skip

@@ -13,12 +13,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from implgen.errors import UserError
-from implgen.mesh.budget import Budget, check_cells
+from implgen.mesh.budget import MAX_CELLS, Budget, check_cells
 from implgen.mesh.contour import Mesh, contour
 from implgen.mesh.crossings import clip_values
-from implgen.mesh.region import Clip, make_grid
+from implgen.mesh.probe import cells_to_see, probe_region
+from implgen.mesh.region import Clip, make_grid, region_box
 from implgen.mesh.shapelib import ShapeLib
 from implgen.mesh.singular import Singular, find_singular
+from implgen.mesh.unpinch import SPLIT, Unpinched, unpinch
 from implgen.spec.model import Spec
 
 
@@ -29,6 +31,7 @@ class Result:
     clips: list[Clip]
     singular: Singular | None
     timings: dict[str, float] = field(default_factory=dict)
+    at_singular: list[str] = field(default_factory=list)  # what the mesh does at each singular point
 
 
 def closed_and_euler(faces: np.ndarray, nverts: int) -> tuple[bool, int]:
@@ -81,13 +84,8 @@ def mesh_spec(
     lib.budget = budget
     mesh = contour(lib, clips, grid)
     if len(mesh.faces) == 0:
-        hidden = mesh.stats["hidden_crossing_edges"]
-        if not hidden:
-            raise UserError(what or spec.source, "no real points of the surface in the region meshed: nothing to mesh")
-        raise UserError(
-            f"{cells_name} {cells}",
-            f"no grid vertex lies in the solid, so the mesh is empty ({hidden} grid edges hold crossings): raise it",
-        )
+        box = region_box(spec.box(dict(values)), user_clips, what or spec.source)
+        raise _empty(lib, clips, box, mesh, what or spec.source, cells_name, cells)
     t2 = time.perf_counter()
     sing = None
     if singular:
@@ -97,9 +95,88 @@ def mesh_spec(
         sing = find_singular(lib, grid.origin, hi)
         if sing.complete:  # isolated points (a curve's sample would only crumple the mesh along it)
             snap_to_singular(mesh, sing.points, clips)
-    lib.budget = None  # the caller's own uses (normals) are not timed
     t3 = time.perf_counter()
-    return Result(mesh, lib, clips, sing, {"build": t1 - t0, "mesh": t2 - t1, "singular": t3 - t2})
+    budget.phase = "parting touching sheets"
+    through = _vertices_on(mesh.vertices, result_points(sing))
+    done = _unpinch(mesh, lib, clips)
+    lib.budget = None  # the caller's own uses (normals) are not timed
+    t4 = time.perf_counter()
+    seconds = {"build": t1 - t0, "mesh": t2 - t1, "singular": t3 - t2, "unpinch": t4 - t3}
+    return Result(mesh, lib, clips, sing, seconds, at_singular(result_points(sing), through, done, mesh.grid.h))
+
+
+def result_points(sing: Singular | None) -> np.ndarray:
+    """The singular points found, (k, 3); none when the search was skipped."""
+    return sing.points if sing is not None else np.zeros((0, 3))
+
+
+def _vertices_on(verts: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """How many vertices sit exactly on each point."""
+    if not len(points):
+        return np.zeros(0, dtype=np.int64)
+    at = {tuple(p): 0 for p in points.tolist()}
+    for v in verts[np.isin(verts[:, 0], points[:, 0])].tolist():
+        if tuple(v) in at:
+            at[tuple(v)] += 1
+    return np.array([at[tuple(p)] for p in points.tolist()], dtype=np.int64)
+
+
+def _unpinch(mesh: Mesh, lib: ShapeLib, clips: list[Clip]) -> Unpinched:
+    """Touching sheets apart, squashed islands dropped (unpinch.py); the mesh updated in place, its stats."""
+    verts, faces, used, done = unpinch(lib, clips, mesh.vertices, mesh.faces, mesh.grid.size, mesh.grid.h)
+    if used is not None:
+        mesh.vertices, mesh.faces = verts, faces
+        if mesh.cell is not None:
+            mesh.cell = mesh.cell[used]
+    mesh.stats["touching_points"] = len(done.points)
+    mesh.stats["touching_vertices_split"] = int(sum(done.moved))
+    mesh.stats["island_triangles_dropped"] = int(sum(done.dropped))
+    mesh.stats["split_off_surface"] = done.off_surface
+    mesh.stats["touching_left"] = done.left
+    mesh.stats["split_distance"] = SPLIT * mesh.grid.size
+    return done
+
+
+def at_singular(points: np.ndarray, through: np.ndarray, done: Unpinched, h: float) -> list[str]:
+    """What the mesh does at each singular point, in words: the sheets that touched there split apart, an island
+    dropped, or it passes through the point, or no vertex of it is there."""
+    said = []
+    centres = np.array(done.points).reshape(-1, 3)
+    for k, p in enumerate(points):
+        idx = np.flatnonzero(np.abs(centres - p).max(axis=1) <= h)  # the groups in the point's cell or next to it
+        moved = sum(done.moved[i] for i in idx)
+        dropped = sum(done.dropped[i] for i in idx)
+        parts = []
+        if dropped:
+            parts.append(f"an island of {dropped} triangles squashed onto it dropped")
+        if moved:
+            parts.append(f"{moved} sheets that touched there moved {SPLIT:.0e} of the region apart")
+        if not parts:
+            parts.append("the mesh passes through it" if through[k] else "no vertex on it (its cell holds none)")
+        said.append("; ".join(parts))
+    return said
+
+
+def _empty(lib: ShapeLib, clips: list[Clip], box, mesh: Mesh, where: str, cells_name: str, cells: int) -> UserError:
+    """Why a mesh has no faces: no boundary point on the grid's lines nor on probe lines across the region (no
+    real points, naming `where`), or a grid too coarse for the region (naming the cells) -- its cell size, the
+    solid's thickness along the probes, and the cells that would put grid vertices in it."""
+    hidden = mesh.stats["hidden_crossing_edges"]
+    lo, hi = box
+    found = probe_region(lib, clips, lo, hi, mesh.grid)
+    if not hidden and not found.points:
+        return UserError(where, "no real points of the surface in the region meshed: nothing to mesh")
+    seen = f"{hidden} grid edges hold crossings" if hidden else "no grid line meets the solid"
+    text = f"no grid vertex lies in the solid, so the mesh is empty ({seen}): the grid is too coarse for the region"
+    text += f" (its cells are {mesh.grid.h:.3g} wide"
+    if found.thickness <= 0:
+        return UserError(f"{cells_name} {cells}", text + "): raise it")
+    need = max(cells_to_see(float((hi - lo).max()), found.thickness), cells + 1)
+    text += f"; {found.lines} lines across it find the solid {found.thickness:.3g} thick): about {need:.3g} cells"
+    if need <= MAX_CELLS:
+        return UserError(f"{cells_name} {cells}", text + f" would put grid vertices in it: raise {cells_name}")
+    tail = f" would, more than the {MAX_CELLS} allowed: shrink the spec's bounds or clip the region to the surface"
+    return UserError(f"{cells_name} {cells}", text + tail)
 
 
 def snap_to_singular(mesh: Mesh, points: np.ndarray, clips: list[Clip]) -> None:

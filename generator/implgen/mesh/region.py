@@ -160,9 +160,8 @@ def spec_box_clips(box: list[float] | None, margin: float) -> list[Clip]:
     return box_clips(lo, hi)
 
 
-def make_grid(box: list[float] | None, user: list[Clip], cells: int, what: str) -> tuple[Grid, list[Clip]]:
-    """The grid over (spec box ∩ user clip), `cells` cells along its longest side, and every clip that bounds
-    the solid. A region open along some axis is a UserError naming `what`."""
+def region_box(box: list[float] | None, user: list[Clip], what: str) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi): the box of (spec box ∩ user clip). A region open along some axis is a UserError naming `what`."""
     lo = np.array(box[:3] if box else [-np.inf] * 3, dtype=np.float64)
     hi = np.array(box[3:] if box else [np.inf] * 3, dtype=np.float64)
     for c in user:
@@ -172,6 +171,13 @@ def make_grid(box: list[float] | None, user: list[Clip], cells: int, what: str) 
         raise UserError(what, "the shape is unbounded along some axis: give --clip sphere:R or --clip box:H")
     if not (hi > lo).all():
         raise UserError(what, "the clip and the shape's box do not overlap")
+    return lo, hi
+
+
+def make_grid(box: list[float] | None, user: list[Clip], cells: int, what: str) -> tuple[Grid, list[Clip]]:
+    """The grid over (spec box ∩ user clip), `cells` cells along its longest side, and every clip that bounds
+    the solid. A region open along some axis is a UserError naming `what`."""
+    lo, hi = region_box(box, user, what)
     ext = hi - lo
     h = float(ext.max()) / cells
     margin = 0.25 * h

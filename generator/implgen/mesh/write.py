@@ -1,6 +1,8 @@
-"""A mesh to a file, written by trimesh (binary STL, OBJ, binary PLY with doubles, glTF binary), atomically; the
-per-vertex normals the formats that hold them get: the gradient of the piece that bounds the solid there
-(f, or a clip), normalised; the faces' average where that gradient vanishes (a node)."""
+"""A mesh to a file, atomically: binary STL and glTF binary (float32, as those formats hold) written by trimesh;
+OBJ (every double in its shortest exact decimal form) and binary PLY (doubles) written here, both plain formats
+that trimesh's own writers would round (PLY to float32, OBJ to a fixed count of decimals). The per-vertex
+normals the formats that hold them get: the gradient of the piece that bounds the solid there (f, or a clip),
+normalised; the faces' average where that gradient vanishes (a node)."""
 
 from __future__ import annotations
 
@@ -55,10 +57,36 @@ def write_mesh(path: Path, verts: np.ndarray, faces: np.ndarray, normals: np.nda
 def mesh_bytes(kind: str, verts: np.ndarray, faces: np.ndarray, normals: np.ndarray | None) -> bytes:
     """The file's bytes, `kind` one of FORMATS' values."""
     mesh = to_trimesh(verts, faces, normals)
-    if kind == "obj":  # 17 significant digits: the doubles exactly (trimesh's default keeps 8 decimals)
-        data = mesh.export(file_type=kind, include_normals=True, digits=17)
-    elif kind == "ply":
-        data = mesh.export(file_type=kind, vertex_normal=True)
-    else:  # binary STL (float32, as the format holds), glTF binary (float32)
-        data = mesh.export(file_type=kind)
+    if kind == "obj":
+        return obj_bytes(np.asarray(mesh.vertices), faces, np.asarray(mesh.vertex_normals))
+    if kind == "ply":
+        return ply_bytes(np.asarray(mesh.vertices), faces, np.asarray(mesh.vertex_normals))
+    data = mesh.export(file_type=kind)  # binary STL (float32, as the format holds), glTF binary (float32)
     return data.encode("utf-8") if isinstance(data, str) else bytes(data)
+
+
+def obj_bytes(verts: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> bytes:
+    """Wavefront OBJ: `v` and `vn` lines, each double as Python's repr writes it (the shortest decimal that reads
+    back as the same double), and `f a//a b//b c//c` lines (1-based, the vertex's own normal)."""
+    lines = ["# implgen mesh"]
+    lines += map("v {!r} {!r} {!r}".format, *np.asarray(verts, dtype=np.float64).T.tolist())
+    lines += map("vn {!r} {!r} {!r}".format, *np.asarray(normals, dtype=np.float64).T.tolist())
+    lines += map("f {0}//{0} {1}//{1} {2}//{2}".format, *(np.asarray(faces, dtype=np.int64) + 1).T.tolist())
+    return ("\n".join(lines) + "\n").encode("ascii")
+
+
+PLY_VERTEX = np.dtype([(k, "<f8") for k in ("x", "y", "z", "nx", "ny", "nz")])
+PLY_FACE = np.dtype([("count", "u1"), ("index", "<i4", (3,))])
+
+
+def ply_bytes(verts: np.ndarray, faces: np.ndarray, normals: np.ndarray) -> bytes:
+    """Binary little-endian PLY: per vertex x, y, z and nx, ny, nz as doubles; per face a list of three ints."""
+    vert = np.empty(len(verts), dtype=PLY_VERTEX)
+    for k, name in enumerate(("x", "y", "z")):
+        vert[name], vert["n" + name] = verts[:, k], normals[:, k]
+    face = np.empty(len(faces), dtype=PLY_FACE)
+    face["count"], face["index"] = 3, faces
+    head = ["ply", "format binary_little_endian 1.0", "comment implgen mesh", f"element vertex {len(verts)}"]
+    head += [f"property double {name}" for name in PLY_VERTEX.names]
+    head += [f"element face {len(faces)}", "property list uchar int vertex_indices", "end_header"]
+    return ("\n".join(head) + "\n").encode("ascii") + vert.tobytes() + face.tobytes()
