@@ -1,7 +1,8 @@
 """`implgen.show` in a real JupyterLab, driven in headless Chromium (SwiftShader's WebGL2, as the shared page's
 browser tests): the notebook's cell runs in a kernel, the widget draws the ball with the generated GLSL, its
 disc as large as the camera's geometry says; the slider moves to r = 0.5 and the disc shrinks to a quarter; the
-kernel hears the new value; the browser's console holds no error."""
+kernel hears the new value; the orbit and the param set from Python move the view; the browser's console holds
+no error."""
 
 from __future__ import annotations
 
@@ -25,13 +26,15 @@ TOKEN = "implgen-test"
 CELLS = [
     'import implgen\nw = implgen.show("x^2 + y^2 + z^2 - r^2", r=1.0)\nw',
     "import json; print(json.dumps({'values': w.values, 'webgl': w.webgl}))",
+    "w.orbit = {**w.orbit, 'distance': w.orbit['distance'] / 2}; w.values = [1.0]",
 ]
 # the widget's canvas: pixels that are not the background (31, 31, 36)
-COVERED = """
+COVERED_FN = """() => {
 const r = document.querySelector('.implgen-widget').implgen.renderer; const p = r.readPixels(); let n = 0;
 const far = (i) => Math.abs(p[i] - 31) + Math.abs(p[i + 1] - 31) + Math.abs(p[i + 2] - 36) > 12;
 for (let i = 0; i < p.length; i += 4) if (far(i)) n++;
-return n;"""
+return n; }"""
+COVERED = f"return ({COVERED_FN})();"
 # the widget's state once it has drawn more than n frames and rests
 DRAWN = """const e = document.querySelector('.implgen-widget'); const s = e && e.implgen;
 return s && s.drawn > {n} && (!s.progressive || s.progressive.idle) ? {{drawn: s.drawn, mode: s.mode}} : null;"""
@@ -88,6 +91,14 @@ def wait(d, script: str, what: str):
     return value
 
 
+def run_cell(d, index: int) -> None:
+    d.execute_script(
+        "const nb = window.jupyterapp.shell.currentWidget.content; nb.activeCellIndex = arguments[0];"
+        "window.jupyterapp.commands.execute('notebook:run-cell');",
+        index,
+    )
+
+
 ACCEPT_KERNEL = """
 const b = document.querySelector('.jp-Dialog .jp-mod-accept'); if (b) { b.click(); return false; }
 const c = window.jupyterapp.shell.currentWidget && window.jupyterapp.shell.currentWidget.sessionContext;
@@ -104,7 +115,7 @@ def test_the_widget_draws_in_jupyterlab_and_the_slider_moves_it(lab):
         wait(d, "return !!(window.jupyterapp && document.querySelector('.jp-Notebook .jp-Cell'));", "JupyterLab")
         # JupyterLab may ask which kernel, in a dialog that comes late: the notebook's own, until it is idle
         wait(d, ACCEPT_KERNEL, "the kernel")
-        d.execute_script("window.jupyterapp.commands.execute('notebook:run-all-cells');")
+        run_cell(d, 0)
         state = wait(d, DRAWN.format(n=0), "the widget's drawing")
         assert state["mode"] == "gpu"
         before = d.execute_script(COVERED)
@@ -117,12 +128,19 @@ def test_the_widget_draws_in_jupyterlab_and_the_slider_moves_it(lab):
         home = {"fov": 40.0, "distance": 3.0 / math.sin(math.radians(20.0)) * 1.1}  # share.page.framing, unbounded
         assert before == pytest.approx(disc_area(1.0, home, 360), rel=0.03)
         assert after == pytest.approx(disc_area(0.5, home, 360), rel=0.05)
-        # the second cell again, alone: the kernel has the slider's value
-        d.execute_script(
-            "const nb = window.jupyterapp.shell.currentWidget.content; nb.activeCellIndex = 1;"
-            "window.jupyterapp.commands.execute('notebook:run-cell');"
-        )
+        # the second cell: the kernel has the slider's value
+        run_cell(d, 1)
         text = wait(d, LAST_OUTPUT, "the kernel's answer")
         assert json.loads(text) == {"values": [0.5], "webgl": "yes"}
+        # the third cell sets the orbit and the param from Python: the view follows
+        drawn = d.execute_script("return document.querySelector('.implgen-widget').implgen.drawn;")
+        run_cell(d, 2)
+        wait(d, DRAWN.format(n=drawn), "the redraw from Python")
+        near = {**home, "distance": home["distance"] / 2}
+        wait(
+            d,
+            f"return Math.abs(({COVERED_FN})() - {disc_area(1.0, near, 360)}) < {0.03 * disc_area(1.0, near, 360)};",
+            "the nearer, larger ball",
+        )
         errors = [e["message"] for e in d.get_log("browser") if e["level"] == "SEVERE"]
         assert not errors, errors

@@ -168,9 +168,13 @@ def test_the_venv_runs_the_installed_package_not_the_tree(venv, tour):
         run([venv / "bin" / "python", "-c", "import implgen, numpy; print(implgen.__file__)"], cwd=work, env=env)
     )
     assert Path(where.strip()).is_relative_to(venv), where
-    # what the tests alone install is not there
+    # what the tests alone install is not there; the notebook widget says which extra brings it
     gone = run([venv / "bin" / "python", "-c", "import pytest"], cwd=work, env=env)
     assert gone.returncode != 0
+    show = "import implgen\ntry:\n    implgen.show('x')\nexcept implgen.UserError as err:\n    print(err)"
+    assert ok(run([venv / "bin" / "python", "-c", show], cwd=work, env=env)).strip() == (
+        "implgen.show: needs anywidget: pip install 'implgen[notebook]'"
+    )
 
 
 def test_generate_c_python_glsl_and_use_the_python(venv, tour):

@@ -119,5 +119,5 @@ def show(spec_or_equation: str | Path, **params: float):
     """A widget drawing a spec file (a Path, or text ending in .yaml), a scene file, or an equation in x, y, z
     whose params are given as keywords: `implgen.show("x^2 + y^2 + z^2 - r^2", r=1)`. Bad input raises
     UserError, one line."""
-    shown = read(spec_or_equation, params)
-    return widget_class()(shown)
+    widget = widget_class()  # first: without anywidget, say so before any parsing
+    return widget(read(spec_or_equation, params))

@@ -107,7 +107,8 @@ function render({ model, el }) {
 
   const sync = (values) => {
     model.set("values", [...values]);
-    model.set("orbit", { yaw: orbit.yaw, pitch: orbit.pitch, distance: orbit.distance, target: orbit.target, fov: orbit.fov });
+    const { yaw, pitch, distance, fov } = orbit;
+    model.set("orbit", { yaw, pitch, distance, target: [...orbit.target], fov });
     model.save_changes();
   };
   const values = sliders(
@@ -120,6 +121,14 @@ function render({ model, el }) {
       sync(v);
     },
   );
+  // the orbit set from Python: the view follows (its own changes come back equal and are skipped)
+  model.on("change:orbit", () => {
+    const o = model.get("orbit");
+    const same = ["yaw", "pitch", "distance", "fov"].every((k) => o[k] === orbit[k]);
+    if (same && `${o.target}` === `${orbit.target}`) return;
+    Object.assign(orbit, { yaw: o.yaw, pitch: o.pitch, distance: o.distance, fov: o.fov, target: [...o.target] });
+    if (state.mode === "gpu") draw(values, orbit, false);
+  });
   orbit.attach(surface, (moving) => {
     if (state.mode === "gpu") draw(values, orbit, moving);
     if (!moving) sync(values);
