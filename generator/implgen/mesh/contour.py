@@ -136,7 +136,7 @@ def _quads(grid: Grid, cross: list[Crossings], cs: _Cells, inside: np.ndarray, s
 
 
 def _stats(clock: list[float], grid: Grid, cross: list[Crossings], cs: _Cells, failed, split, missed) -> dict:
-    phases = ("signs", "crossings", "sheets", "qef", "projection", "faces")
+    phases = ("signs", "crossings", "missed", "sheets", "qef", "projection", "faces")
     return {
         "seconds": {k: round(b - a, 4) for k, a, b in zip(phases, clock, clock[1:])},
         "grid_cells": list(grid.n),
@@ -158,6 +158,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     _check_outer_layer(inside)
     strides = np.array([inside.shape[1] * inside.shape[2], inside.shape[2], 1])
     cross: list[Crossings] = [axis_crossings(lib, clips, grid, a, inside, g) for a in range(3)]
+    clock.append(time.perf_counter())
     missed = missed_detail(lib, clips, grid, inside, cross)
     clock.append(time.perf_counter())
     lib.check()  # the budget, between phases (budget.py)
