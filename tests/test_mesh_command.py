@@ -73,6 +73,7 @@ def test_scene_object_placed_by_its_transform(tmp_path):
     [
         (["-o", "{d}/x.dxf"], "-o"),
         (["-o", "{d}/x.stl", "--cells", "2"], "--cells"),
+        (["-o", "{d}/x.stl", "--cells", "9" * 3000], "--cells: a number of about 1e3000 is outside [4, 256]"),
         (["-o", "{d}/x.stl", "--clip", "ball:3"], "--clip"),
         (["-o", "{d}/x.stl", "--clip", "sphere:-1"], "--clip"),
         (["-o", "{d}/x.stl", "--param", "q=1"], "--param"),

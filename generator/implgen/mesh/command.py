@@ -66,7 +66,7 @@ def _parser() -> ArgumentParser:
 def _whole(text: str) -> int | str:
     """A whole number written in decimal digits as an int; anything else as it was (validate.whole refuses it)."""
     t = text.strip()
-    return int(t) if t.lstrip("+-").isdigit() and t.isascii() and len(t) <= 100 else text
+    return int(t) if t.lstrip("+-").isdigit() and t.isascii() and len(t) <= 4000 else text
 
 
 def _params(spec, pairs: Sequence[str]) -> dict[str, float]:

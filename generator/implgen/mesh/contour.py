@@ -136,8 +136,7 @@ def _quads(grid: Grid, cross: list[Crossings], cs: _Cells, inside: np.ndarray, s
 
 
 def _stats(clock: list[float], grid: Grid, cross: list[Crossings], cs: _Cells, failed, split, missed) -> dict:
-    phases = ("signs", "crossings", "sheets", "qef", "projection", "faces")
-    wide = int(np.argmax(missed.width)) if missed.count else -1
+    phases = ("signs", "crossings", "missed", "sheets", "qef", "projection", "faces")
     return {
         "seconds": {k: round(b - a, 4) for k, a, b in zip(phases, clock, clock[1:])},
         "grid_cells": list(grid.n),
@@ -146,9 +145,7 @@ def _stats(clock: list[float], grid: Grid, cross: list[Crossings], cs: _Cells, f
         "multi_sheet_cells": int((cs.count > 1).sum()),
         "vertices_at_a_crossing": int(failed.sum()),
         "hidden_crossing_edges": int(sum(c.hidden for c in cross)),
-        "missed_detail_edges": missed.count,
-        "missed_widest": float(missed.width[wide]) if missed.count else None,  # along its edge
-        "missed_at": [float(v) for v in missed.middle[wide]] if missed.count else None,
+        **missed.stats(),
         "split_sides": split,
     }
 
@@ -161,6 +158,7 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     _check_outer_layer(inside)
     strides = np.array([inside.shape[1] * inside.shape[2], inside.shape[2], 1])
     cross: list[Crossings] = [axis_crossings(lib, clips, grid, a, inside, g) for a in range(3)]
+    clock.append(time.perf_counter())
     missed = missed_detail(lib, clips, grid, inside, cross)
     clock.append(time.perf_counter())
     lib.check()  # the budget, between phases (budget.py)

@@ -95,6 +95,9 @@ def mesh_spec(
         sing = find_singular(lib, grid.origin, hi)
         if sing.complete:  # isolated points (a curve's sample would only crumple the mesh along it)
             snap_to_singular(mesh, sing.points, clips)
+        if mesh.missed is not None:  # what the grid misses next to a node is the node's own
+            mesh.missed = mesh.missed.away_from(sing.points, 2 * grid.h)
+            mesh.stats.update(mesh.missed.stats())
     t3 = time.perf_counter()
     budget.phase = "parting touching sheets"
     through = _vertices_on(mesh.vertices, result_points(sing))
