@@ -144,14 +144,19 @@ def test_a_video_resumes_from_its_sidecar_frames(tmp_path, anim, capsys):
 
 
 def test_frames_share_one_library(tmp_path, anim, monkeypatch):
-    """The scene library is built once for the whole animation, not once per frame."""
-    from implgen.animation import batch
+    """The scene library is built, and loaded (its seal checked), once for the whole animation: not once per
+    frame."""
+    from implgen.animation import chunks
+    from implgen.compile import clib
 
-    calls = []
-    real = batch.build_scene
-    monkeypatch.setattr(batch, "build_scene", lambda *a, **k: calls.append(1) or real(*a, **k))
+    chunks.forget_renderers()
+    builds, loads = [], []
+    real_build, real_load = chunks.build_scene, clib.load
+    monkeypatch.setattr(chunks, "build_scene", lambda *a, **k: builds.append(1) or real_build(*a, **k))
+    monkeypatch.setattr(clib, "load", lambda *a, **k: loads.append(1) or real_load(*a, **k))
     assert cli_main(["render", str(anim), "-o", str(tmp_path / "f%d.png"), "-q"]) == 0
-    assert len(calls) == 1 and len(list(tmp_path.glob("*.png"))) == FRAMES
+    assert len(builds) == 1 and len(list(tmp_path.glob("*.png"))) == FRAMES
+    assert len(loads) == 1  # before: once more for every frame
 
 
 def test_the_example_animation_is_valid_on_every_frame():
@@ -161,3 +166,38 @@ def test_the_example_animation_is_valid_on_every_frame():
     b = [fr.scene(f).leaves()[1].params["b"] for f in range(48)]
     assert b[0] < 1.0 < b[-1] and all(x <= y for x, y in zip(b, b[1:]))  # the tube grows past a = 1
     assert os.path.getsize(path) < 4000
+
+
+def test_ctrl_c_in_this_process_stops_at_once_and_the_rerun_resumes(tmp_path):
+    """The frames render on a thread of their own and are written on others: Ctrl-C still ends the command
+    within 2 s, in one line, with every frame file whole and no temporary file left."""
+    import signal
+    import time
+
+    from implgen_proc import implgen, start
+
+    data = anim_scene(frames=40)
+    data["image"].update(width=160, height=120, spp=32)
+    scene = tmp_path / "anim.yaml"
+    scene.write_text(yaml.safe_dump(data))
+    out = tmp_path / "f" / "f%02d.png"
+    proc = start("render", scene, "-o", out, "-q", "--threads", "1")
+    try:
+        deadline = time.monotonic() + 90
+        while len(list(out.parent.glob("f*.png"))) < 2:
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.02)
+        proc.send_signal(signal.SIGINT)
+        t0 = time.monotonic()
+        _, err = proc.communicate(timeout=30)
+        seconds = time.monotonic() - t0
+    finally:
+        proc.kill()
+    assert proc.returncode == 130 and err == "implgen: interrupted\n", (proc.returncode, err[-2000:])
+    assert seconds < 2.0, seconds
+    kept = sorted(out.parent.glob("f*.png"))
+    assert 2 <= len(kept) < 40 and not list(out.parent.glob(".ig-*"))
+    for p in kept:
+        assert read(p).shape == (120, 160, 3)  # whole
+    ran = implgen("render", scene, "-o", out, "-q", "--frames", "0:2", timeout=120)
+    assert ran.code == 0 and "already there" in ran.out, ran.err

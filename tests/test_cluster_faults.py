@@ -276,13 +276,13 @@ def _slow_frame(log: str, *args):
     import os
     import time as t
 
-    from implgen.animation.frames import render_frame_png
+    from implgen.animation.chunks import render_chunk
 
     t0 = t.time()
     t.sleep(0.6)
     with open(Path(log) / f"{os.getpid()}-{t0:.6f}", "w") as fh:
         fh.write(f"{t0} {t.time()}")
-    return render_frame_png(*args)
+    return render_chunk(*args)
 
 
 def test_the_window_grows_with_workers_that_join_later(tmp_path):
