@@ -363,3 +363,41 @@ def test_the_window_follows_workers_that_join_and_leave():
     assert got == [(i, i * i) for i in range(40)]
     assert max(n for _, n in fake.most) == 12  # 3 per worker thread while 4 were there
     assert all(n <= 3 * max(1, threads) for threads, n in fake.most), fake.most
+
+
+class _InterruptedOnce:
+    """threading as distributed.utils sees it, with an Event whose first wait is cut by Ctrl-C, as when the
+    signal comes before the loop has started the call: Dask's cancel callback then fails on the loop."""
+
+    def __init__(self):
+        self.cut = False
+        outer = self
+
+        class Event(threading.Event):
+            def wait(self, timeout=None):
+                if not outer.cut:
+                    outer.cut = True
+                    raise KeyboardInterrupt
+                return super().wait(timeout)
+
+        self.Event = Event
+
+    def __getattr__(self, name):
+        return getattr(threading, name)
+
+
+def test_ctrl_c_at_the_start_of_a_dask_call_leaves_no_traceback(monkeypatch, caplog):
+    """Before: `Exception in callback functools.partial(<function sync.<locals>.cancel ...>)` and a NameError's
+    traceback after `implgen: interrupted`, now and then (the Ctrl-C tests above failed on it)."""
+    import distributed.utils
+
+    with local_cluster(0) as cl, cluster.connect(address=cl.scheduler_address) as client:
+        fake = _InterruptedOnce()
+        monkeypatch.setattr(distributed.utils, "threading", fake)
+        with caplog.at_level(logging.ERROR), pytest.raises(KeyboardInterrupt):
+            client.nthreads()
+        monkeypatch.undo()
+        assert fake.cut
+        time.sleep(0.5)  # the loop runs the cancel callback meanwhile
+        assert client.nthreads() == {}
+    assert not [r for r in caplog.records if "sync.<locals>.cancel" in r.getMessage()], caplog.text
