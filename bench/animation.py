@@ -1,7 +1,7 @@
 """Frames per second of an animation, in this process and on a LocalCluster, at a tiny and at a real size.
 
     .venv/bin/python bench/animation.py [--scene FILE] [--runs 3] [--workers 2] [--tasks 200]
-                                        [-o bench/results/animation.md] [--quick]
+                                        [-o bench/results/animation.md] [--throughput-only] [--quick]
 
 1. Throughput. The example animation (default examples/scenes/torus_opening.yaml) is rendered to PNG files as
    `implgen render` renders it, at two sizes: 200 frames at 32x24 (the scene's frame count raised to 200;
@@ -81,8 +81,8 @@ def _files(folder: Path) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in sorted(folder.glob("f_*.png"))}
 
 
-def throughput(args, tmp: Path) -> tuple[list[str], list[str]]:
-    """Section 1: the table's rows, and the targets' lines."""
+def throughput(args, tmp: Path) -> tuple[list[str], list[str], float]:
+    """Section 1: the table's rows, the targets' lines, and the mean PNG size of the largest frames."""
     import dataclasses
 
     from implgen.animation import cluster
@@ -99,6 +99,7 @@ def throughput(args, tmp: Path) -> tuple[list[str], list[str]]:
         cases.append((w, h, frames, range(n), "cluster", workers, args.workers))
     runs: dict[tuple, list[dict]] = {}
     same = True
+    sizes: list[int] = []
     for r in range(args.runs):
         serial_files = {}
         for w, h, frames, todo, how, opts, nw in cases:
@@ -107,11 +108,13 @@ def throughput(args, tmp: Path) -> tuple[list[str], list[str]]:
             files = got.pop("files")
             if how == "serial":
                 serial_files[w] = files
+                sizes += [len(b) for b in files.values()] if w == SIZES[-1][0] else []
             else:
                 same = same and files == serial_files[w] and len(files) == len(todo)
             runs.setdefault((w, how), []).append(got)
-            print(f"run {r + 1}/{args.runs} {w}x{h} {how}: {len(todo) / got['batch']:.1f} frames/s", flush=True)
-    return _rows(cases, runs, args.workers), _verdicts(cases, runs, same)
+            fps = len(todo) / got["batch"]
+            print(f"run {r + 1}/{args.runs} {w}x{h} {how}: {fps:.1f} frames/s, load {load_average()}", flush=True)
+    return _rows(cases, runs, args.workers), _verdicts(cases, runs, same), statistics.mean(sizes)
 
 
 def _rows(cases, runs, workers: int) -> list[str]:
@@ -159,19 +162,52 @@ def _verdicts(cases, runs, same: bool) -> list[str]:
     return out
 
 
-def round_trip(args) -> float:
-    """Section 2: seconds per empty task through cluster.ordered, 3 per worker in flight."""
-    from implgen.animation import cluster
+def task_costs(args) -> dict[str, float]:
+    """Section 2: seconds per task through cluster.ordered (3 per worker in flight), tasks that do nothing
+    and chunks of one 1x1 frame, on a warm LocalCluster; bytes a chunk sends per frame."""
+    import pickle
 
+    from implgen.animation import cluster
+    from implgen.animation.chunks import render_chunk
+    from implgen.animation.frames import FrameOptions, load_frames
+
+    frames = load_frames(args.scene)
+    sc = frames.first
+    one_px = FrameOptions(width=1, height=1, spp=1, max_depth=sc.max_depth, threads=1)
+    costs = {}
     with cluster.connect(local_workers=args.workers) as client:
         client.wait_for_workers(args.workers)
-        for _ in cluster.ordered(client, nothing, ((i, ()) for i in range(4)), retries=3, name="warm"):
+        warm = ((i, ((sc,), one_px)) for i in range(2 * args.workers))
+        for _ in cluster.ordered(client, render_chunk, warm, retries=3, name="warm"):
             pass
-        t0 = time.perf_counter()
-        jobs = ((i, ()) for i in range(args.tasks))
-        for _ in cluster.ordered(client, nothing, jobs, window=3 * args.workers, retries=3, name="bench"):
-            pass
-        return (time.perf_counter() - t0) / args.tasks
+        for label, fn, make in (
+            ("empty", nothing, lambda i: ()),
+            ("1x1", render_chunk, lambda i: ((frames.scene(i % frames.count),), one_px)),
+        ):
+            t0 = time.perf_counter()
+            jobs = ((i, make(i)) for i in range(args.tasks))
+            for _ in cluster.ordered(client, fn, jobs, window=3 * args.workers, retries=3, name="bench"):
+                pass
+            costs[label] = (time.perf_counter() - t0) / args.tasks
+    for n in (1, 20):
+        chunk = (tuple(frames.scene(f % frames.count) for f in range(n)), one_px, None, False, True)
+        costs[f"bytes{n}"] = len(pickle.dumps(chunk)) / n
+    return costs
+
+
+def _cost_rows(args, costs: dict[str, float], png_mean: float) -> list[str]:
+    return [
+        "| per task on a warm LocalCluster | value |",
+        "|---|---:|",
+        f"| scheduler round trip, tasks that do nothing ({args.tasks} tasks, {3 * args.workers} in flight) | "
+        f"{costs['empty'] * 1e3:.2f} ms |",
+        "| a chunk of one 1x1 frame (scene sent, library kept, tracer set up, PNG back) | "
+        f"{costs['1x1'] * 1e3:.2f} ms |",
+        f"| bytes sent per frame, chunk of 1 frame / of 20 frames (pickled scenes and options) | "
+        f"{costs['bytes1']:,.0f} B / {costs['bytes20']:,.0f} B |",
+        f"| bytes back per frame at {SIZES[-1][0]}x{SIZES[-1][1]} (PNG, mean) | {png_mean:,.0f} B |",
+        "",
+    ]
 
 
 def main() -> int:
@@ -182,6 +218,7 @@ def main() -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--max-frames", type=int, default=10_000, help="fewer frames per size (a smoke run)")
     ap.add_argument("-o", "--output", type=Path, default=ROOT / "bench" / "results" / "animation.md")
+    ap.add_argument("--throughput-only", action="store_true", help="section 1 alone (it runs on older implgen too)")
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args()
     if args.quick:
@@ -190,8 +227,8 @@ def main() -> int:
     t_start = time.perf_counter()
     load_before = load_average()
     with tempfile.TemporaryDirectory() as tmp:
-        rows, verdicts = throughput(args, Path(tmp))
-    per_task = round_trip(args)
+        rows, verdicts, png_mean = throughput(args, Path(tmp))
+    costs = None if args.throughput_only else task_costs(args)
     lines = [
         "# Frames per second: measured",
         "",
@@ -208,9 +245,7 @@ def main() -> int:
         "",
         *verdicts,
         "",
-        f"Scheduler round trip per task, tasks that do nothing ({args.tasks} tasks, {3 * args.workers} in "
-        f"flight): {per_task * 1e3:.2f} ms.",
-        "",
+        *([] if costs is None else _cost_rows(args, costs, png_mean)),
     ]
     text = "\n".join(lines)
     write_results(args.output, text)

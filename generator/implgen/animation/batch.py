@@ -19,12 +19,13 @@ from typing import Any
 import numpy as np
 
 from implgen.animation import cluster
-from implgen.animation.chunks import ChunkResult, Pace, Part, local_results, render_chunk
+from implgen.animation.chunks import ChunkResult, Pace, Part, lanes, local_results, render_chunk
 from implgen.animation.frameout import FrameOutput, Made
 from implgen.animation.frames import FrameOptions, Frames
 from implgen.animation.writer import OrderedWriter
 from implgen.errors import UserError
 from implgen.imagefile import decode_png
+from implgen.scene.render import usable_cores
 
 
 def _say(text: str) -> None:
@@ -43,6 +44,7 @@ class Runner:
     label: str = "--cluster"
     say: Callable[[str], None] = _say
     chunk: int | None = None
+    lanes: int = 1  # frames side by side in this process (set for each run: chunks.lanes)
     _threads: tuple[float, int] = field(default=(0.0, 1), init=False, repr=False)  # (when looked, threads then)
 
     def workers(self) -> int:
@@ -52,9 +54,10 @@ class Runner:
         return len(self.client.nthreads())
 
     def threads(self) -> int:
-        """Worker threads the scheduler has, looked up again at most every cluster.POLL seconds (1 here)."""
+        """Worker threads the scheduler has, looked up again at most every cluster.POLL seconds (here: the
+        frames that render side by side)."""
         if self.client is None:
-            return 1
+            return self.lanes
         when, n = self._threads
         if time.monotonic() - when >= cluster.POLL:
             n = cluster.slots(self.client)
@@ -63,7 +66,7 @@ class Runner:
 
     def results(self, jobs: Iterator[tuple[Any, tuple]], name: str) -> Iterator[tuple[Any, ChunkResult]]:
         if self.client is None:
-            return local_results(self.task, jobs)
+            return local_results(self.task, jobs, self.lanes)
         return cluster.ordered(self.client, self.task, jobs, retries=self.retries, name=name, say=self.say)
 
 
@@ -147,6 +150,8 @@ def _render_and_write(
 ) -> int:
     """The tasks' frames through the writer, in order; the PNG bytes that came back from Dask."""
     rows = [None] if tiles == 1 else bands(opts.height, tiles)
+    if runner.client is None:
+        runner.lanes, opts = lanes(opts, usable_cores())
     pace = Pace(fixed=runner.chunk)
     writer = OrderedWriter(out)
     results = runner.results(_jobs(frames, missing, rows, opts, runner, fold, pace), name="frame")

@@ -7,12 +7,15 @@ and keeps it for the frames of every chunk it is given afterwards (`renderer_for
 seal check per worker and library, not one per frame. `Pace` chooses the size of each chunk as the chunks are
 handed out, from what is left, the worker threads there are now and the render time measured so far.
 
-`local_results` runs chunks in this process on one render thread, a chunk ahead of the caller, which writes
-the frames meanwhile; Ctrl-C stops the frame in progress (`Stop`).
+`local_results` runs chunks in this process on render threads, a chunk ahead of the caller, which writes
+the frames meanwhile; Ctrl-C stops the frames in progress (`Stop`). Small frames render side by side, each
+on fewer tracer threads (`lanes`): a frame of a few thousand samples cut among many threads spends more
+on starting them and on its last row than on its pixels.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import threading
 import time
@@ -35,6 +38,7 @@ TARGET_SECONDS = 0.25  # a chunk's render time: a task's fixed cost (a few ms on
 SHARES = 2  # a chunk takes at most 1/(SHARES x worker threads) of the frames left: the last round is balanced
 MAX_CHUNK = 256  # frames
 KEEP_RENDERERS = 4  # scene libraries a process keeps loaded for the chunks to come
+SAMPLES_PER_THREAD = 20_000  # a tracer thread's least share of a frame here: smaller frames go side by side
 
 
 @dataclass(frozen=True)
@@ -85,26 +89,29 @@ class Stopped(Exception):
 
 
 class Stop:
-    """Stops the chunks rendering in this process: before the next frame, and the frame in progress (its
-    render context cancelled: the C threads end after their current row)."""
+    """Stops the chunks rendering in this process: before their next frame, and the frames in progress (their
+    render contexts cancelled: the C threads end after their current row)."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        self._job: RenderJob | None = None
+        self._jobs: set[RenderJob] = set()
         self.stopped = False
 
     def stop(self) -> None:
         with self._lock:
             self.stopped = True
-            if self._job is not None:
-                self._job.cancel()
-
-    def running(self, job: RenderJob | None) -> None:
-        """The job now rendering (None: none); a job started after stop() is cancelled at once."""
-        with self._lock:
-            self._job = job
-            if job is not None and self.stopped:
+            for job in self._jobs:
                 job.cancel()
+
+    def running(self, job: RenderJob, now: bool) -> None:
+        """A job starts (`now`) or ends rendering; one that starts after stop() is cancelled at once."""
+        with self._lock:
+            if now:
+                self._jobs.add(job)
+                if self.stopped:
+                    job.cancel()
+            else:
+                self._jobs.discard(job)
 
 
 class FrameRenderer:
@@ -124,12 +131,12 @@ class FrameRenderer:
             args = (opts.width, opts.height, opts.spp, opts.max_depth, threads, opts.seed)
             with RenderJob(cs, *args, rows=rows) as job:
                 if stop is not None:
-                    stop.running(job)
+                    stop.running(job, True)
                 try:
                     img = job.run()
                 finally:
                     if stop is not None:
-                        stop.running(None)
+                        stop.running(job, False)
         finally:
             cs.close()
         if img is None:
@@ -187,14 +194,25 @@ def render_chunk(
     return ChunkResult(images, time.perf_counter() - t0)
 
 
+def lanes(opts: Any, cores: int) -> tuple[int, Any]:
+    """How frames render in this process: (frames side by side, the options with each frame's tracer threads).
+    Threads set by the caller are kept, one frame at a time; otherwise a frame gets every core unless that
+    leaves a thread fewer than SAMPLES_PER_THREAD samples, and the cores left over render other frames."""
+    if opts.threads is not None:
+        return 1, opts
+    per_frame = max(1, min(cores, opts.width * opts.height * opts.spp // SAMPLES_PER_THREAD))
+    return max(1, cores // per_frame), dataclasses.replace(opts, threads=per_frame)
+
+
 def local_results(
-    fn: Callable[..., Any], jobs: Iterable[tuple[Any, tuple]], depth: int = 2
+    fn: Callable[..., Any], jobs: Iterable[tuple[Any, tuple]], lanes: int = 1
 ) -> Iterator[tuple[Any, Any]]:
-    """cluster.ordered's contract in this process: fn(*args, stop=...) for each (index, args) of `jobs` on one
-    render thread, `depth` jobs ahead of the caller, results yielded in order. When the caller stops early
-    (Ctrl-C, an error), the frame in progress is cancelled and the thread waited for."""
+    """cluster.ordered's contract in this process: fn(*args, stop=...) for each (index, args) of `jobs` on
+    `lanes` render threads, a job more than that ahead of the caller, results yielded in order. When the
+    caller stops early (Ctrl-C, an error), the frames in progress are cancelled and the threads waited for."""
+    depth = lanes + 1
     stop = Stop()
-    pool = ThreadPoolExecutor(1, thread_name_prefix="implgen-render")
+    pool = ThreadPoolExecutor(lanes, thread_name_prefix="implgen-render")
     pending: deque = deque()
     todo = iter(jobs)
     try:

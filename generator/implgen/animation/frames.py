@@ -32,8 +32,8 @@ from implgen.yamlfile import read_yaml
 MAX_OBJECT_FRAMES = 10_000_000
 MAX_KEYED_OBJECT_FRAMES = 100_000
 # Frames validated up front are kept for the render (not parsed again) while (keyed objects + 1) x frames is
-# at most this: a kept frame holds its camera and its keyed objects, about 1 kB each.
-KEEP_OBJECT_FRAMES = 50_000
+# at most this: a kept frame holds its camera and its keyed objects, about 1 kB each (20 MB at most).
+KEEP_OBJECT_FRAMES = 20_000
 
 
 @dataclass
