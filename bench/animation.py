@@ -12,8 +12,10 @@
    batch alone (what the command's `wrote N frames ... in T s` reports); a LocalCluster is started afresh
    for each run, so its workers load the scene library in the timed batch, and its start and close are
    timed on their own. Each cluster run's frames are compared byte for byte with the serial run's.
-2. The scheduler's round trip per task: `--tasks` tasks that do nothing, through the in-order submission
-   the render command uses (one task carries a chunk of frames; this is what a chunk amortizes).
+2. One-off and per-task costs: the scene library generated and compiled into an empty cache; on a warm
+   LocalCluster, the round trip per task of `--tasks` tasks that do nothing and of as many chunks of one 1x1
+   frame, through the in-order submission the render command uses (what a chunk of frames amortizes); the
+   bytes a chunk sends per frame, and the PNG bytes back per frame.
 
 Writes the report (the script, the machine and the load average before and after at its top) and prints
 it. --quick is a smoke run (20 and 4 frames, 1 run, 20 tasks) whose figures mean nothing.
@@ -162,6 +164,24 @@ def _verdicts(cases, runs, same: bool) -> list[str]:
     return out
 
 
+def cold_build(scene) -> float:
+    """Seconds to generate and compile a scene's library into an empty cache (what each worker pays once)."""
+    from implgen.scene.build import build_scene
+
+    saved = os.environ.get("IMPLGEN_CACHE")
+    with tempfile.TemporaryDirectory() as cold:
+        os.environ["IMPLGEN_CACHE"] = cold
+        try:
+            t0 = time.perf_counter()
+            build_scene(scene)
+            return time.perf_counter() - t0
+        finally:
+            if saved is None:
+                del os.environ["IMPLGEN_CACHE"]
+            else:
+                os.environ["IMPLGEN_CACHE"] = saved
+
+
 def task_costs(args) -> dict[str, float]:
     """Section 2: seconds per task through cluster.ordered (3 per worker in flight), tasks that do nothing
     and chunks of one 1x1 frame, on a warm LocalCluster; bytes a chunk sends per frame."""
@@ -174,7 +194,7 @@ def task_costs(args) -> dict[str, float]:
     frames = load_frames(args.scene)
     sc = frames.first
     one_px = FrameOptions(width=1, height=1, spp=1, max_depth=sc.max_depth, threads=1)
-    costs = {}
+    costs = {"cold": cold_build(sc)}
     with cluster.connect(local_workers=args.workers) as client:
         client.wait_for_workers(args.workers)
         warm = ((i, ((sc,), one_px)) for i in range(2 * args.workers))
@@ -197,8 +217,9 @@ def task_costs(args) -> dict[str, float]:
 
 def _cost_rows(args, costs: dict[str, float], png_mean: float) -> list[str]:
     return [
-        "| per task on a warm LocalCluster | value |",
+        "| one-off, or per task on a warm LocalCluster | value |",
         "|---|---:|",
+        f"| generate + compile the scene library, empty cache (each worker pays it once) | {costs['cold']:.2f} s |",
         f"| scheduler round trip, tasks that do nothing ({args.tasks} tasks, {3 * args.workers} in flight) | "
         f"{costs['empty'] * 1e3:.2f} ms |",
         "| a chunk of one 1x1 frame (scene sent, library kept, tracer set up, PNG back) | "

@@ -347,6 +347,9 @@ class _FakeClient:
             def done(self):
                 return True
 
+            def add_done_callback(self, fn):
+                fn(self)
+
             def release(self):
                 pass
 
@@ -401,3 +404,55 @@ def test_ctrl_c_at_the_start_of_a_dask_call_leaves_no_traceback(monkeypatch, cap
         time.sleep(0.5)  # the loop runs the cancel callback meanwhile
         assert client.nthreads() == {}
     assert not [r for r in caplog.records if "sync.<locals>.cancel" in r.getMessage()], caplog.text
+
+
+class _LateFuture:
+    """A task that ends `delay` seconds after it is submitted. Asked for its result with a timeout before then,
+    it fails as Dask's Future.result does now and then on a busy machine (its sync() wait cut short)."""
+
+    def __init__(self, value, delay: float):
+        self.value, self.callbacks = value, []
+        self.ended = threading.Event()
+        threading.Timer(delay, self._end).start()
+
+    def _end(self):
+        self.ended.set()
+        for fn in self.callbacks:
+            fn(self)
+
+    def done(self):
+        return self.ended.is_set()
+
+    def add_done_callback(self, fn):
+        self.callbacks.append(fn)
+        if self.done():
+            fn(self)
+
+    def result(self, timeout=None):
+        if timeout is not None and not self.done():
+            raise UnboundLocalError("cannot access local variable 'result' where it is not associated with a value")
+        assert self.done()
+        return self.value
+
+    def release(self):
+        pass
+
+    def cancel(self):
+        pass
+
+
+class _LateClient:
+    status = "running"
+
+    def nthreads(self):
+        return {"tcp://127.0.0.1:1": 1, "tcp://127.0.0.1:2": 1}
+
+    def submit(self, fn, *args, key, retries, pure):
+        return _LateFuture(fn(*args), 0.05)
+
+
+def test_results_are_awaited_without_dasks_timed_wait():
+    """Before: the run ended in Dask's UnboundLocalError (seen on a busy machine, in the benchmark)."""
+    jobs = [(i, (i,)) for i in range(12)]
+    got = list(cluster.ordered(_LateClient(), lambda i: i + 100, jobs, retries=0, poll=0.01))
+    assert got == [(i, i + 100) for i in range(12)]

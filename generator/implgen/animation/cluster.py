@@ -25,6 +25,7 @@ import asyncio
 import logging
 import re
 import secrets
+import threading
 import time
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
@@ -246,23 +247,25 @@ class _Window:
             if job is None:
                 self.more = False
                 return
-            self.pending.append((job[0], submit(*job)))
+            fut = submit(*job)
+            ready = threading.Event()  # set from Dask's callback thread when the task ends, however it ends
+            fut.add_done_callback(lambda _fut, ready=ready: ready.set())
+            self.pending.append((job[0], fut, ready))
 
 
 def _first_result(win: _Window) -> tuple[bool, Any]:
     """Wait up to `poll` for the oldest pending task: (True, its result), or (False, None) when it is not done
-    yet. Its own error is raised; a lost worker or scheduler in one line."""
+    yet. Its own error is raised; a lost worker or scheduler in one line. The wait is this module's, and the
+    result is asked of Dask only once the task has ended: Dask's own wait with a timeout (Future.result)
+    could, on a busy machine, end in its internal UnboundLocalError rather than a timeout."""
     from distributed import KilledWorker
     from distributed.client import FutureCancelledError
 
-    index, fut = win.pending[0]
-    was_done = fut.done()
+    index, fut, ready = win.pending[0]
+    if not ready.wait(win.poll) and not fut.done():
+        return False, None
     try:
-        return True, fut.result(timeout=None if was_done else win.poll)
-    except TimeoutError:
-        if was_done:  # the task's own error
-            raise
-        return False, None  # the wait's: not done yet (or done just now: the next call returns at once)
+        return True, fut.result()
     except KilledWorker:  # every retry lost its worker: one line, not Dask's traceback
         raise UserError(
             "render", f"task {tag_of(index)} lost its worker more often than the scheduler allows"
@@ -303,7 +306,7 @@ def ordered(
                 return
             done, result = _first_result(win)
             if done:
-                index, fut = win.pending.popleft()
+                index, fut, _ = win.pending.popleft()
                 fut.release()
             win.look()
             if done:
@@ -312,11 +315,5 @@ def ordered(
         win.pending.clear()  # gone with the scheduler: nothing to cancel
         raise
     finally:
-        for _, fut in win.pending:
+        for _, fut, _ in win.pending:
             fut.cancel()
-
-
-def serial(fn: Callable[..., Any], jobs: Iterable[tuple[Any, tuple]]) -> Iterator[tuple[Any, Any]]:
-    """The same contract in this process, one job after the other."""
-    for index, args in jobs:
-        yield index, fn(*args)

@@ -227,9 +227,6 @@ class FrameOutput:
     def prepare(self) -> None:
         self.folder.mkdir(parents=True, exist_ok=True)
 
-    def write(self, frame: int, png: bytes) -> None:
-        self.commit(frame, self.stage(png))
-
     def stage(self, image: bytes | np.ndarray) -> Path:
         """A frame (PNG bytes, or 8-bit RGB encoded here) written to a temporary name in the folder and
         flushed to the disk: a complete file, for `commit` to rename into place (any thread may stage)."""
