@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import pickle
 import time
+from collections import deque
 from pathlib import Path
 
 import numpy as np
@@ -170,3 +171,43 @@ def test_a_frame_that_cannot_be_written_is_one_line(tmp_path):
     writer.abandon()
     assert str(err.value).endswith("cannot write frame 0: No space left on device")
     assert "\n" not in str(err.value) and Path(tmp_path).exists()
+
+
+class _CutDeque(deque):
+    """A deque whose first append is cut by Ctrl-C: the frame's staging has been handed to a thread already."""
+
+    cut = False
+
+    def append(self, item):
+        if not self.cut:
+            self.cut = True
+            raise KeyboardInterrupt
+        super().append(item)
+
+
+def test_ctrl_c_anywhere_in_the_writer_leaves_no_temporary_file(tmp_path):
+    """Before: a frame staged while Ctrl-C came was left as a temporary file, and a frame renamed just before
+    it was renamed again, which failed ('cannot write frame 1: No such file or directory', status 2)."""
+    out = plan_output(tmp_path / "f_%02d.png", 4, 3, 4, 3)
+    out.prepare()
+    writer = OrderedWriter(out)
+    writer.pending = _CutDeque()
+    with pytest.raises(KeyboardInterrupt):
+        writer.put(0, np.zeros((3, 4, 3), dtype=np.uint8))
+    writer.abandon()
+    assert list(tmp_path.iterdir()) == []
+
+    real_commit = out.commit
+
+    def commit_then_cut(frame, tmp):
+        real_commit(frame, tmp)
+        raise KeyboardInterrupt
+
+    out.commit = commit_then_cut
+    writer = OrderedWriter(out)
+    with pytest.raises(KeyboardInterrupt):
+        for f in range(4):
+            writer.put(f, np.full((3, 4, 3), f, dtype=np.uint8))
+        writer.close()
+    writer.abandon()
+    assert [p.name for p in tmp_path.iterdir()] == ["f_00.png"]  # in place whole, and nothing else

@@ -161,7 +161,7 @@ def _render_and_write(
             moved += nbytes
             wrote(writer.put(f, image))
         wrote(writer.close())
-    except (cluster.SchedulerLost, KeyboardInterrupt):
+    except cluster.SchedulerLost:
         wrote(writer.close())  # the frames that came back are whole: they are kept
         raise
     finally:

@@ -11,8 +11,10 @@ frames or `max_bytes` of pixels and PNGs not yet in place; beyond that `put` wai
 
 from __future__ import annotations
 
+import threading
 from collections import deque
 from concurrent.futures import Future, ThreadPoolExecutor
+from pathlib import Path
 
 from implgen.animation.frameout import FrameOutput
 from implgen.errors import UserError
@@ -31,12 +33,20 @@ class OrderedWriter:
         self.pool = ThreadPoolExecutor(threads, thread_name_prefix="implgen-write")
         self.pending: deque[tuple[int, Future, int]] = deque()
         self.held = 0  # bytes of the pending frames
+        self.staged: set[Path] = set()  # temporary files made and not renamed yet, whatever `pending` says
+        self._lock = threading.Lock()
 
     def put(self, frame: int, image) -> list[int]:
         size = len(image) if isinstance(image, bytes) else image.nbytes
-        self.pending.append((frame, self.pool.submit(self.out.stage, image), size))
+        self.pending.append((frame, self.pool.submit(self._stage, image), size))
         self.held += size
         return self._commit(final=False)
+
+    def _stage(self, image) -> Path:
+        tmp = self.out.stage(image)
+        with self._lock:
+            self.staged.add(tmp)
+        return tmp
 
     def close(self) -> list[int]:
         """Every frame put, in place; then the threads end."""
@@ -45,15 +55,17 @@ class OrderedWriter:
         return done
 
     def abandon(self) -> None:
-        """After an error or an interrupt: the staging in progress waited for, and every staged frame not in
-        place removed (a crash would have left them as temporary files, never taken for frames)."""
+        """After an error or an interrupt (which may have come at any point of `put`): the staging in progress
+        waited for, and every staged frame not in place removed (a crash would have left them as temporary
+        files, never taken for frames)."""
         for _, fut, _ in self.pending:
             fut.cancel()
         self.pool.shutdown(wait=True)
-        while self.pending:
-            _, fut, _ = self.pending.popleft()
-            if fut.done() and not fut.cancelled() and fut.exception() is None:
-                fut.result().unlink(missing_ok=True)
+        self.pending.clear()
+        with self._lock:
+            left, self.staged = self.staged, set()
+        for tmp in left:
+            tmp.unlink(missing_ok=True)  # missing: renamed into place just before the interrupt
 
     def _commit(self, final: bool) -> list[int]:
         """Rename the staged frames at the head into place: all of them when `final`, else those ready and as
@@ -67,6 +79,8 @@ class OrderedWriter:
             try:
                 tmp = fut.result()
                 self.out.commit(frame, tmp)
+                with self._lock:
+                    self.staged.discard(tmp)
             except OSError as err:  # a full disk, a folder removed meanwhile: one line, the frames so far kept
                 raise UserError(f"-o {self.out.target}", f"cannot write frame {frame}: {err.strerror or err}") from None
             self.pending.popleft()
