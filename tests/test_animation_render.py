@@ -3,6 +3,7 @@ and every frame equal to that frame rendered alone."""
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from pathlib import Path
 
@@ -84,13 +85,14 @@ def test_a_rerun_renders_only_the_missing_frames(tmp_path, anim, alone, capsys):
     pattern = str(tmp_path / "f_%02d.png")
     assert cli_main(["render", str(anim), "-o", pattern, "-q"]) == 0
     capsys.readouterr()
-    before = {p.name: p.stat().st_ino for p in tmp_path.iterdir()}
+    before = {p.name: (p.stat().st_ino, p.stat().st_mtime_ns) for p in tmp_path.iterdir()}  # a freed inode
+    # number may come back for a new file: the time it was written tells them apart
     (tmp_path / "f_01.png").unlink()
     (tmp_path / "f_04.png").unlink()
     (tmp_path / ".ig-0123456789ab.tmp").write_bytes(b"half a frame")  # what a crash mid-write leaves
     assert cli_main(["render", str(anim), "-o", pattern, "-q"]) == 0
     assert "wrote 2 frames, 4 already there" in capsys.readouterr().out
-    after = {p.name: p.stat().st_ino for p in tmp_path.iterdir() if p.suffix == ".png"}
+    after = {p.name: (p.stat().st_ino, p.stat().st_mtime_ns) for p in tmp_path.iterdir() if p.suffix == ".png"}
     assert {n for n in after if after[n] == before.get(n)} == {f"f_{i:02d}.png" for i in (0, 2, 3, 5)}
     for f in (1, 4):
         assert np.array_equal(read(tmp_path / f"f_{f:02d}.png"), alone[f])
@@ -144,14 +146,19 @@ def test_a_video_resumes_from_its_sidecar_frames(tmp_path, anim, capsys):
 
 
 def test_frames_share_one_library(tmp_path, anim, monkeypatch):
-    """The scene library is built once for the whole animation, not once per frame."""
-    from implgen.animation import batch
+    """The scene library is built, and loaded (its seal checked), once for the whole animation: not once per
+    frame."""
+    from implgen.animation import chunks
+    from implgen.compile import clib
 
-    calls = []
-    real = batch.build_scene
-    monkeypatch.setattr(batch, "build_scene", lambda *a, **k: calls.append(1) or real(*a, **k))
+    chunks.forget_renderers()
+    builds, loads = [], []
+    real_build, real_load = chunks.build_scene, clib.load
+    monkeypatch.setattr(chunks, "build_scene", lambda *a, **k: builds.append(1) or real_build(*a, **k))
+    monkeypatch.setattr(clib, "load", lambda *a, **k: loads.append(1) or real_load(*a, **k))
     assert cli_main(["render", str(anim), "-o", str(tmp_path / "f%d.png"), "-q"]) == 0
-    assert len(calls) == 1 and len(list(tmp_path.glob("*.png"))) == FRAMES
+    assert len(builds) == 1 and len(list(tmp_path.glob("*.png"))) == FRAMES
+    assert len(loads) == 1  # before: once more for every frame
 
 
 def test_the_example_animation_is_valid_on_every_frame():
@@ -161,3 +168,56 @@ def test_the_example_animation_is_valid_on_every_frame():
     b = [fr.scene(f).leaves()[1].params["b"] for f in range(48)]
     assert b[0] < 1.0 < b[-1] and all(x <= y for x, y in zip(b, b[1:]))  # the tube grows past a = 1
     assert os.path.getsize(path) < 4000
+
+
+@pytest.mark.parametrize(
+    "frames, size, threads",
+    [(40, (160, 120, 32), ["--threads", "1"]), (300, (40, 30, 24), [])],  # one frame at a time; side by side
+)
+def test_ctrl_c_in_this_process_stops_at_once_and_the_rerun_resumes(tmp_path, frames, size, threads):
+    """The frames render on threads of their own and are written on others: Ctrl-C still ends the command
+    within 2 s, in one line, with every frame file whole and no temporary file left."""
+    import signal
+    import time
+
+    from implgen_proc import implgen, start
+
+    data = anim_scene(frames=frames)
+    data["image"].update(width=size[0], height=size[1], spp=size[2])
+    scene = tmp_path / "anim.yaml"
+    scene.write_text(yaml.safe_dump(data))
+    out = tmp_path / "f" / "f%03d.png"
+    proc = start("render", scene, "-o", out, "-q", *threads)
+    try:
+        deadline = time.monotonic() + 90
+        while len(list(out.parent.glob("f*.png"))) < 2:
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.02)
+        proc.send_signal(signal.SIGINT)
+        t0 = time.monotonic()
+        _, err = proc.communicate(timeout=30)
+        seconds = time.monotonic() - t0
+    finally:
+        proc.kill()
+    assert proc.returncode == 130 and err == "implgen: interrupted\n", (proc.returncode, err[-2000:])
+    assert seconds < 2.0, seconds
+    kept = sorted(out.parent.glob("f*.png"))
+    assert 2 <= len(kept) < frames and not list(out.parent.glob(".ig-*"))
+    for p in kept:
+        assert read(p).shape == (size[1], size[0], 3)  # whole
+    ran = implgen("render", scene, "-o", out, "-q", "--frames", "0:2", timeout=120)
+    assert ran.code == 0 and "already there" in ran.out, ran.err
+
+
+def test_small_frames_render_side_by_side_on_fewer_threads():
+    from implgen.animation.chunks import SAMPLES_PER_THREAD, lanes
+    from implgen.animation.frames import FrameOptions
+
+    small = FrameOptions(width=32, height=24, spp=2, max_depth=4)
+    assert lanes(small, 16) == (16, FrameOptions(32, 24, 2, 4, threads=1))
+    big = FrameOptions(width=640, height=480, spp=2, max_depth=4)
+    assert lanes(big, 16) == (1, FrameOptions(640, 480, 2, 4, threads=16))
+    assert lanes(big, 2)[0] == 1
+    middle = FrameOptions(width=100, height=100, spp=1, max_depth=4)  # 10,000 samples a thread on 1 core
+    assert lanes(middle, 16)[0] == 16 and 10_000 < SAMPLES_PER_THREAD
+    assert lanes(dataclasses.replace(small, threads=3), 16) == (1, dataclasses.replace(small, threads=3))

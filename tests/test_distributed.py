@@ -83,7 +83,7 @@ def _dies_once(marker: str, *args):
     its worker process, once: no cleanup and no exception, as a crash or `kill -9` would."""
     import os
 
-    from implgen.animation.frames import render_frame_png
+    from implgen.animation.chunks import render_chunk
 
     started = Path(marker).with_suffix(".started")
     started.mkdir(exist_ok=True)
@@ -98,7 +98,7 @@ def _dies_once(marker: str, *args):
             os.write(fd, str(os.getpid()).encode())
             os.close(fd)
             os._exit(1)
-    return render_frame_png(*args)
+    return render_chunk(*args)
 
 
 def test_a_worker_killed_mid_task_still_ends_with_every_frame(tmp_path, client, frames, alone):
@@ -117,6 +117,50 @@ def test_a_worker_killed_mid_task_still_ends_with_every_frame(tmp_path, client, 
         assert np.array_equal(read(out.path(f)), alone[f]), f
     client.wait_for_workers(2, timeout=120)  # the nanny started a new worker process in its place
     assert killed not in worker_pids(client)
+
+
+def test_chunks_of_frames_from_the_workers_are_the_serial_files_byte_for_byte(tmp_path, client, frames):
+    serial = plan_output(tmp_path / "here" / "f_%02d.png", FRAMES, FRAMES - 1, 48, 36)
+    render_frames(frames, range(FRAMES), opts_of(frames), serial, Runner())
+    for chunk in (None, 4):  # chosen as the run goes, and 4 frames a task (the last one 2)
+        out = plan_output(tmp_path / f"dask{chunk}" / "f_%02d.png", FRAMES, FRAMES - 1, 48, 36)
+        report = render_frames(frames, range(FRAMES), opts_of(frames), out, Runner(client=client, chunk=chunk))
+        assert report.written == list(range(FRAMES))
+        for f in range(FRAMES):
+            assert out.path(f).read_bytes() == serial.path(f).read_bytes(), (chunk, f)
+
+
+def _dies_with_its_chunk(marker: str, *args):
+    """The chunk task, except that the first chunk of several frames to finish kills its worker process
+    before it hands them back, once: every frame of it is lost and must be rendered again elsewhere."""
+    import os
+
+    from implgen.animation.chunks import render_chunk
+
+    result = render_chunk(*args)
+    if len(args[0]) > 1:
+        try:
+            fd = os.open(marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+        except FileExistsError:
+            return result
+        os.write(fd, str(os.getpid()).encode())
+        os.close(fd)
+        os._exit(1)
+    return result
+
+
+def test_a_worker_killed_with_a_chunk_done_still_ends_with_every_frame(tmp_path, client, frames, alone):
+    marker = tmp_path / "killed"
+    out = plan_output(tmp_path / "out" / "f_%02d.png", FRAMES, FRAMES - 1, 48, 36)
+    runner = Runner(client=client, task=functools.partial(_dies_with_its_chunk, str(marker)), chunk=3)
+    report = render_frames(frames, range(FRAMES), opts_of(frames), out, runner)
+    assert marker.exists(), "the fault was not injected"
+    assert report.written == list(range(FRAMES))
+    names = sorted(p.name for p in (tmp_path / "out").iterdir())
+    assert names == [".f_%02d.png.implgen.json"] + [f"f_{f:02d}.png" for f in range(FRAMES)]
+    for f in range(FRAMES):
+        assert np.array_equal(read(out.path(f)), alone[f]), f
+    client.wait_for_workers(2, timeout=120)
 
 
 def test_the_cluster_command_on_a_running_scheduler(tmp_path, client, frames, alone, capsys):

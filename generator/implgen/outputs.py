@@ -127,18 +127,28 @@ def check_output_folder(path: Path, option: str) -> None:
     _check_names(label, ancestor, [name for name in missing if name not in ("", ".")])
 
 
-def atomic_write(path: Path, write: Callable[[object], None]) -> None:
-    """Create `path` through `write(binary_file)`: a temporary file in the same folder, renamed into place."""
-    path = Path(path)
-    tmp = _folder_of(path) / _temp_name()
+def staged(folder: Path, write: Callable[[object], None]) -> Path:
+    """A new temporary file in `folder` (`.ig-*.tmp`, never taken for an output) written through
+    `write(binary_file)`; the caller renames it into place. A failure removes it."""
+    tmp = Path(folder) / _temp_name()
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # the umask applies, as for any file
     try:
         with os.fdopen(fd, "wb") as fh:
             write(fh)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return tmp
+
+
+def atomic_write(path: Path, write: Callable[[object], None]) -> None:
+    """Create `path` through `write(binary_file)`: a temporary file in the same folder, renamed into place."""
+    path = Path(path)
+    tmp = staged(_folder_of(path), write)
+    try:
         os.replace(tmp, path)
     except BaseException:
-        if tmp.exists():
-            tmp.unlink()
+        tmp.unlink(missing_ok=True)
         raise
 
 

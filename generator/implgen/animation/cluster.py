@@ -25,6 +25,7 @@ import asyncio
 import logging
 import re
 import secrets
+import threading
 import time
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
@@ -121,12 +122,29 @@ def _quiet_dask():
             log.disabled = was
 
 
+class _InterruptedSyncNoise(logging.Filter):
+    """Ctrl-C in a Dask call made from this thread (distributed.utils.sync) before its coroutine has started
+    leaves a cancel callback that fails on the event loop (NameError: its `future` is not bound yet), and
+    tornado logs it with a traceback after `implgen: interrupted`. Only that record is dropped."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        err = record.exc_info[1] if record.exc_info else None
+        return not (isinstance(err, NameError) and "sync.<locals>.cancel" in record.getMessage())
+
+
+def _drop_interrupted_sync_noise() -> None:
+    log = logging.getLogger("tornado.application")
+    if not any(isinstance(f, _InterruptedSyncNoise) for f in log.filters):
+        log.addFilter(_InterruptedSyncNoise())
+
+
 @contextmanager
 def connect(local_workers: int | None = None, address: str | None = None):
     """A dask.distributed Client: to the scheduler at `address` (probed first), or to a LocalCluster of
     `local_workers` processes (one task at a time each). Closed, with the local cluster, on exit."""
     from dask.distributed import Client, LocalCluster
 
+    _drop_interrupted_sync_noise()
     if address is not None:
         probe(address)
         with _quiet_dask():
@@ -150,18 +168,16 @@ def connect(local_workers: int | None = None, address: str | None = None):
     try:
         with Client(cluster) as client:
             yield client
-    except KeyboardInterrupt:
+    finally:
         with _quiet_dask():  # the connections the kill cuts are expected, not news
             _kill_local_workers(cluster)
             cluster.close()
-        raise
-    finally:
-        cluster.close()  # a second close does nothing
 
 
 def _kill_local_workers(cluster: Any) -> None:
-    """Ctrl-C: end this LocalCluster's worker processes at once. Their nannies stop a worker in the middle
-    of a task in about 2 s (measured on 2 cores); killed first, the cluster closes in a few ms."""
+    """End this LocalCluster's worker processes at once, at the end of a run as on Ctrl-C: they hold nothing
+    (frames are written here), and their nannies stop them one by one, in 1 to 2 s on 2 cores (in the middle
+    of a task after Ctrl-C, about 2 s); killed first, the cluster closes in a few ms."""
     import os
     import signal
 
@@ -231,23 +247,25 @@ class _Window:
             if job is None:
                 self.more = False
                 return
-            self.pending.append((job[0], submit(*job)))
+            fut = submit(*job)
+            ready = threading.Event()  # set from Dask's callback thread when the task ends, however it ends
+            fut.add_done_callback(lambda _fut, ready=ready: ready.set())
+            self.pending.append((job[0], fut, ready))
 
 
 def _first_result(win: _Window) -> tuple[bool, Any]:
     """Wait up to `poll` for the oldest pending task: (True, its result), or (False, None) when it is not done
-    yet. Its own error is raised; a lost worker or scheduler in one line."""
+    yet. Its own error is raised; a lost worker or scheduler in one line. The wait is this module's, and the
+    result is asked of Dask only once the task has ended: Dask's own wait with a timeout (Future.result)
+    could, on a busy machine, end in its internal UnboundLocalError rather than a timeout."""
     from distributed import KilledWorker
     from distributed.client import FutureCancelledError
 
-    index, fut = win.pending[0]
-    was_done = fut.done()
+    index, fut, ready = win.pending[0]
+    if not ready.wait(win.poll) and not fut.done():
+        return False, None
     try:
-        return True, fut.result(timeout=None if was_done else win.poll)
-    except TimeoutError:
-        if was_done:  # the task's own error
-            raise
-        return False, None  # the wait's: not done yet (or done just now: the next call returns at once)
+        return True, fut.result()
     except KilledWorker:  # every retry lost its worker: one line, not Dask's traceback
         raise UserError(
             "render", f"task {tag_of(index)} lost its worker more often than the scheduler allows"
@@ -288,7 +306,7 @@ def ordered(
                 return
             done, result = _first_result(win)
             if done:
-                index, fut = win.pending.popleft()
+                index, fut, _ = win.pending.popleft()
                 fut.release()
             win.look()
             if done:
@@ -297,11 +315,5 @@ def ordered(
         win.pending.clear()  # gone with the scheduler: nothing to cancel
         raise
     finally:
-        for _, fut in win.pending:
+        for _, fut, _ in win.pending:
             fut.cancel()
-
-
-def serial(fn: Callable[..., Any], jobs: Iterable[tuple[Any, tuple]]) -> Iterator[tuple[Any, Any]]:
-    """The same contract in this process, one job after the other."""
-    for index, args in jobs:
-        yield index, fn(*args)

@@ -33,10 +33,14 @@ import struct
 from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from implgen.errors import UserError
-from implgen.imagefile import decode_png
-from implgen.outputs import atomic_write, check_output_file, check_output_folder
+from implgen.imagefile import decode_png, encode_png
+from implgen.outputs import atomic_write, check_output_file, check_output_folder, staged
+
+if TYPE_CHECKING:
+    import numpy as np
 
 VIDEO = (".mp4", ".webm")
 GIF = ".gif"
@@ -223,8 +227,19 @@ class FrameOutput:
     def prepare(self) -> None:
         self.folder.mkdir(parents=True, exist_ok=True)
 
-    def write(self, frame: int, png: bytes) -> None:
-        atomic_write(self.path(frame), lambda fh: _write_synced(fh, png))
+    def stage(self, image: bytes | np.ndarray) -> Path:
+        """A frame (PNG bytes, or 8-bit RGB encoded here) written to a temporary name in the folder and
+        flushed to the disk: a complete file, for `commit` to rename into place (any thread may stage)."""
+        png = image if isinstance(image, bytes) else encode_png(image)
+        return staged(self.folder, lambda fh: _write_synced(fh, png))
+
+    def commit(self, frame: int, tmp: Path) -> None:
+        """A staged frame renamed into place: from now on it is frame `frame`, whole."""
+        try:
+            os.replace(tmp, self.path(frame))
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
 
     def finish(self, frames: Sequence[int], fps: float, keep_frames: bool = False) -> None:
         """Encode a video or GIF from the frame PNGs (all present), atomically; then drop the sidecar."""

@@ -6,8 +6,9 @@ at each frame goes through the same range checks as a still value, and the check
 frame. A still scene (no keyed value, no orbit) is parsed once and is its own single frame.
 
 The set of shapes is the same on every frame (keyed values are numbers only), so the scene library is
-built once (scene/build.py) and each frame only hands its numbers to the tracer. `render_frame_png` is the
-unit of work of a frame or tile, run in this process or on a Dask worker (scene/cluster.py).
+built once (scene/build.py) and each frame only hands its numbers to the tracer. The frames validated up
+front are kept (within KEEP_OBJECT_FRAMES), so the render does not parse them again. `render_frame_png`
+renders one frame (or tile) alone; the chunks of a run (chunks.py) give the same bytes.
 """
 
 from __future__ import annotations
@@ -30,6 +31,9 @@ from implgen.yamlfile import read_yaml
 # frames), and keyed objects x frames (parsed and validated anew on every frame, ~50 us each).
 MAX_OBJECT_FRAMES = 10_000_000
 MAX_KEYED_OBJECT_FRAMES = 100_000
+# Frames validated up front are kept for the render (not parsed again) while (keyed objects + 1) x frames is
+# at most this: a kept frame holds its camera and its keyed objects, about 1 kB each (20 MB at most).
+KEEP_OBJECT_FRAMES = 20_000
 
 
 @dataclass
@@ -41,6 +45,7 @@ class Frames:
     first: Scene
     memo: dict = field(default_factory=dict)
     params_vary: bool = False  # some shape param changes from frame to frame
+    kept: list[Scene] = field(default_factory=list)  # every frame as validated, when few enough to keep
 
     @property
     def count(self) -> int:
@@ -58,6 +63,8 @@ class Frames:
     def scene(self, frame: int) -> Scene:
         if frame == 0 or not self.animated:
             return self.first
+        if self.kept:
+            return self.kept[frame]
         return parse_scene(self.data, self.source, frame=frame, memo=self.memo)
 
     def digest(self) -> str:
@@ -96,6 +103,8 @@ def frames_from_data(data: dict, source: str | Path = "<scene>") -> Frames:
                 f"animation.frames: {fr.count} frames of {n} {what}objects is more than {limit:,} {what}"
                 "object-frames to check; split the animation into several scene files",
             )
+    keep = (keyed + 1) * fr.count <= KEEP_OBJECT_FRAMES
+    kept = [first]
     for f in range(1, fr.count):
         try:
             sc = parse_scene(data, source, frame=f, memo=memo)
@@ -104,6 +113,9 @@ def frames_from_data(data: dict, source: str | Path = "<scene>") -> Frames:
         for a, b in zip(leaves0, sc.leaves()):
             assert a.spec is b.spec  # keyed values are numbers: the shapes are the same objects
             fr.params_vary |= a.params != b.params
+        if keep:
+            kept.append(sc)
+    fr.kept = kept if keep else []
     return fr
 
 

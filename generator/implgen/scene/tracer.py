@@ -70,16 +70,23 @@ def bind(lib: ctypes.CDLL) -> ctypes.CDLL:
     return lib
 
 
+def load_bound(built: BuildResult) -> ctypes.CDLL:
+    """The scene library of `built`, checked against its seal, loaded and bound: what a CScene renders with.
+    Many scenes may share one (the frames of an animation: CScene's `lib`)."""
+    return bind(clib.load(built.library))
+
+
 def darr(values) -> ctypes.Array:
     vals = [float(v) for v in values]
     return (ctypes.c_double * max(1, len(vals)))(*vals)
 
 
 class CScene:
-    """A committed rt_scene in a loaded scene library; freed with the object."""
+    """A committed rt_scene in a loaded scene library; freed with the object. `lib`: that library as
+    `load_bound(built)` gave it, when the caller has it already (else it is loaded and checked here)."""
 
-    def __init__(self, scene: Scene, built: BuildResult):
-        self.lib = bind(clib.load(built.library))
+    def __init__(self, scene: Scene, built: BuildResult, lib: ctypes.CDLL | None = None):
+        self.lib = lib if lib is not None else load_bound(built)
         self.ptr = self.lib.rt_scene_new()
         if not self.ptr:
             raise MemoryError("rt_scene_new failed")
