@@ -69,14 +69,11 @@ def runner(egl: bool):
 
 def host_line(egl: bool, renderer: str) -> str:
     if egl:
-        return (
-            f"Host: desktop OpenGL 4.5 through EGL (moderngl), renderer `{renderer}`"
-            + (
-                ": **llvmpipe runs the shader on the CPU**. Its pixels are a float32 GPU's; its frame times are "
-                "indicative only (this machine's 2 cores were shared with other work)."
-                if "llvmpipe" in renderer
-                else "."
-            )
+        return f"Host: desktop OpenGL 4.5 through EGL (moderngl), renderer `{renderer}`" + (
+            ": **llvmpipe runs the shader on the CPU**. Its pixels are a float32 GPU's; its frame times are "
+            "indicative only (this machine's 2 cores were shared with other work)."
+            if "llvmpipe" in renderer
+            else "."
         )
     return (
         f"Browser: headless Chromium ({' '.join(FLAGS)}), WebGL renderer `{renderer}`: **SwiftShader is a CPU "
