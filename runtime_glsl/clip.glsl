@@ -9,6 +9,8 @@
 
 const float IG_OPEN = 1.0e30;
 const float IG_CLIP_REL = 1.9073486328125e-6; // 2^-19
+const float IG_CLIP_IN_REL = 4.76837158203125e-7; // 2^-21: 8 units, over a slab t's 4.5 (a subtraction,
+                                                  // 1 / d within 2.5 units in GLSL ES, a product)
 
 float ig_widen_down(float t)
 {
@@ -44,17 +46,17 @@ bool ig_clip_box(vec3 o, vec3 d, vec3 lo, vec3 hi, inout float t0, inout float t
 
 float ig_narrow_up(float t)
 {
-    return abs(t) < ig_inf() ? t + IG_CLIP_REL * abs(t) : t;
+    return abs(t) < ig_inf() ? t + IG_CLIP_IN_REL * abs(t) : t;
 }
 
 float ig_narrow_down(float t)
 {
-    return abs(t) < ig_inf() ? t - IG_CLIP_REL * abs(t) : t;
+    return abs(t) < ig_inf() ? t - IG_CLIP_IN_REL * abs(t) : t;
 }
 
 // One axis of ig_clip_box_inner: the bounds moved inward by 8 units of their own (a bound computed from
-// params carries a few roundings; the sum's own rounding is within them) and by the origin's error e, the slab's t narrowed by IG_CLIP_REL (the
-// quotient's few roundings).
+// params carries a few roundings; the sum's own rounding is within them) and by the origin's error e, the
+// slab's t narrowed by IG_CLIP_IN_REL (the quotient's roundings).
 bool ig_clip_slab_inner(float o, float d, float e, float lo, float hi, inout float t0, inout float t1)
 {
     float lo_in = lo + (8.0 * IG_ULP * abs(lo) + e);

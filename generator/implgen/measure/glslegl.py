@@ -36,6 +36,7 @@ class Egl:
             raise RuntimeError(f"no OpenGL 4.5 context through EGL: {exc}") from exc
         tri = np.array([-1.0, -1.0, 3.0, -1.0, -1.0, 3.0], np.float32)
         self.vbo = self.ctx.buffer(tri.tobytes())
+        self.programs: dict[str, object] = {}  # the last few programs by their text: a second run draws warm
 
     def __enter__(self) -> Egl:
         return self
@@ -45,6 +46,9 @@ class Egl:
 
     def close(self) -> None:
         if self.ctx is not None:
+            for prog in self.programs.values():
+                prog.release()
+            self.programs.clear()
             self.ctx.release()
             self.ctx = None
 
@@ -53,11 +57,18 @@ class Egl:
         return self.ctx.info["GL_VERSION"], self.ctx.info["GL_RENDERER"]
 
     def compile(self, fragment: str):
-        """The linked program (VERTEX and `fragment`); raises RuntimeError with the compiler's log."""
+        """The linked program (VERTEX and `fragment`), kept for the next run of the same text (a driver compiles
+        on the first draw: that draw's time holds the compile); raises RuntimeError with the compiler's log."""
+        if fragment in self.programs:
+            return self.programs[fragment]
         try:
-            return self.ctx.program(vertex_shader=VERTEX, fragment_shader=fragment)
+            prog = self.ctx.program(vertex_shader=VERTEX, fragment_shader=fragment)
         except Exception as exc:  # moderngl.Error
             raise RuntimeError(f"the shader did not compile:\n{exc}") from exc
+        if len(self.programs) >= 4:
+            self.programs.pop(next(iter(self.programs))).release()
+        self.programs[fragment] = prog
+        return prog
 
     def _texture(self, data: np.ndarray, unit: int):
         h, w = data.shape[:2]
@@ -91,7 +102,7 @@ class Egl:
         read back). origins, dirs: (h, w, 4), bound as ig_test_orig and ig_test_dir."""
         prog = self.compile(fragment)
         w, h = size
-        held = [prog]
+        held = []
         try:
             if origins is not None:
                 held += [self._texture(origins, 0), self._texture(dirs, 1)]
