@@ -113,6 +113,7 @@ struct IgRay {
     float ra, rb; // refinement bracket: sign known at ra, the other sign at rb
     float bracket_a; // where the bracket started: the first root is in [bracket_a, the root found]
     float bracket_b; // where it ended: a root is certified in [bracket_a, bracket_b]
+    float s_after;   // after a hit: a place past the root where f has the other sign (to look for the next root)
     float in0, in1;  // the part of [s0, s1] certainly inside the box and [tmin, tmax] (in0 > in1: none)
     float blur;   // how well float can place a root on this ray (s units)
     int refine_left;
@@ -154,6 +155,7 @@ void ig_ray_stop(inout IgRay ray, bool hit, float s)
     bool unsure = ray.unsure || (!hit && (ray.doubt || ray.far_doubt));
     ray.status = (hit ? IG_HIT : 0) | (unsure ? IG_UNSURE : 0) | (hit && ray.earlier && !unsure ? IG_EARLIER : 0);
     ray.s_hit = s;
+    ray.s_after = ray.mode == IG_REFINE ? max(ray.bracket_b, s) : s;
     ray.mode = IG_DONE;
 }
 
@@ -191,6 +193,7 @@ IgRay ig_ray_begin(vec3 o, vec3 d, float tmin, float tmax, vec3 lo, vec3 hi)
     ray.index = 0;
     ray.status = 0;
     ray.s_hit = 0.0;
+    ray.s_after = 0.0;
     ray.refine_left = IG_REFINE_STEPS;
     float t0 = tmin;
     float t1 = tmax;
@@ -234,8 +237,22 @@ void ig_ray_query(IgRay ray, out vec3 x, out vec3 y, out vec3 z)
     z = ig_raa_var(m.z, h.z, e.z);
 }
 
+// A certified root in [ra, rb]: bisection from its middle. The origin moves there first (o + m d, its rounding
+// added to the coordinates' error), so s stays small and bisection resolves t to float's resolution near the
+// root, not to that of the whole working interval (an unbounded shape's is IG_FAR long); everything kept in s
+// moves with it, the ends of the bracket outward and the inner part of the box inward by their rounding.
 void ig_ray_refine(inout IgRay ray, float ra, float rb)
 {
+    float m = 0.5 * (ra + rb);
+    vec3 md = m * ray.d;
+    vec3 o = ray.o + md;
+    ray.e0 = (ray.e0 + IG_ULP * (abs(md) + abs(o))) * (1.0 + IG_UP_REL) + IG_TINY;
+    ray.o = o;
+    ray.tc += m;
+    ra = (ra - m) - IG_U * abs(ra - m);
+    rb = (rb - m) + IG_U * abs(rb - m);
+    ray.in0 = (ray.in0 - m) + IG_U * abs(ray.in0 - m);
+    ray.in1 = (ray.in1 - m) - IG_U * abs(ray.in1 - m);
     ray.bracket_a = ra;
     ray.bracket_b = rb;
     ray.ra = ra;

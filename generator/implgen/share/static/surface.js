@@ -58,8 +58,8 @@ out vec4 ig_page_colour;
 // the one call of IG_SHAPE_NORMAL: the shape's tree is in the program once, as in a program that calls
 // IG_SHAPE_HIT once (the GLSL test harness's). A compiler inlines every call: with a call of IG_SHAPE_HIT for
 // the camera and one for the shadows, and f at points in three more places, the page held the tree eight
-// times, and a large tree (a Chebyshev form of degree 16 to 24) drew 9-13 times slower than in the harness
-// on a GPU.
+// times. That was the difference found between the two programs when a large tree (a Chebyshev form of
+// degree 16 to 24) drew 9-13 times slower in the page than in the harness on a GPU (docs/share.md).
 
 const int IG_PAGE_DONE = 0;
 const int IG_PAGE_CAMERA_SIDE = 1; // f's sign where the camera ray enters the cut clip
