@@ -1,13 +1,16 @@
 """The generated GLSL in headless Chromium against the C solvers and the exact judge, per surface and per degree.
 
     .venv/bin/python bench/glsl_compare.py [--size 640x480] [--judge 3000] [-o bench/results/glsl.md] [--quick]
+                                           [--egl] [--only NAME,...]
 
-For every case of implgen.measure.glslcases (the example shapes through a camera, Chmutov surfaces of degree 12,
-16, 20 and 24 nested and in power form, torus_y seen from 1e3 units, grazing rays over torus_z) it
+For every case of implgen.measure.glslcases (every shape the project ships, examples/shapes/ -- the gallery --,
+through a camera; Chmutov surfaces of degree 12, 16, 20 and 24 nested and in power form; torus_y seen from
+1e3 units; grazing rays over torus_z) it
   1. runs the generated shader in headless Chromium's WebGL2 (ANGLE on SwiftShader, a CPU emulation of a
-     GPU) over the case's float32 rays, and reads back status (IG_HIT, IG_UNSURE, IG_EARLIER), t and the
-     number of shape evaluations per ray; the draw time is the frame time (indicative only: CPU emulation,
-     on a machine shared with other work);
+     GPU), or with --egl on desktop OpenGL 4.5 through EGL (implgen.measure.glslegl: Mesa's llvmpipe without a
+     GPU, the GPU's driver with one), over the case's float32 rays, and reads back status (IG_HIT,
+     IG_UNSURE, IG_EARLIER), t and the number of shape evaluations per ray; the draw time is the frame time
+     (indicative only on a CPU, on a machine shared with other work);
   2. runs the C solvers on the same rays (the generated first_hit, double precision);
   3. decides exactly (implgen.roots.exactray) every pixel where the two disagree and every pixel the GLSL
      flagged, up to --judge of them per case (a random sample beyond that: those counts are extrapolated
@@ -26,7 +29,7 @@ ROOT = Path(__file__).resolve().parent.parent
 SHAPES = ROOT / "examples" / "shapes"
 
 from implgen.measure import glslcases, glslcheck, machine  # noqa: E402
-from implgen.measure.webgl import FLAGS, WebGL  # noqa: E402
+from implgen.measure.webgl import FLAGS  # noqa: E402
 
 
 def parse_args(argv):
@@ -36,18 +39,47 @@ def parse_args(argv):
     ap.add_argument("--silhouette", type=int, default=300, help="agreed silhouette pixels judged per case")
     ap.add_argument("-o", "--out", type=Path, default=ROOT / "bench" / "results" / "glsl.md")
     ap.add_argument("--quick", action="store_true", help="160x120, 300 verdicts: a smoke test")
+    ap.add_argument("--egl", action="store_true", help="desktop OpenGL through EGL (moderngl) instead of Chromium")
+    ap.add_argument("--only", default="", help="comma-separated case labels: only these cases")
     args = ap.parse_args(argv)
     w, h = (160, 120) if args.quick else tuple(int(v) for v in args.size.lower().split("x"))
     return args, (w, h), (300 if args.quick else args.judge)
 
 
-def all_cases(size):
+def all_cases(size, only: str = ""):
     cases = [(c, "example") for c in glslcases.example_cases(SHAPES, size)]
     cases += [(c, "nested") for c in glslcases.high_degree_cases(size, (True,))]
     cases += [(c, "power form") for c in glslcases.high_degree_cases(size, (False,))]
     cases.append((glslcases.far_torus_case(SHAPES, size), "far"))
     cases.append((glslcases.grazing_case(SHAPES, size[0]), "grazing"))
-    return cases
+    wanted = {w for w in only.split(",") if w}
+    return [(c, k) for c, k in cases if not wanted or c.label in wanted]
+
+
+def runner(egl: bool):
+    """The GLSL's host: headless Chromium (WebGL2 on SwiftShader) or OpenGL 4.5 through EGL."""
+    if egl:
+        from implgen.measure.glslegl import Egl
+
+        return Egl()
+    from implgen.measure.webgl import WebGL
+
+    return WebGL()
+
+
+def host_line(egl: bool, renderer: str) -> str:
+    if egl:
+        return f"Host: desktop OpenGL 4.5 through EGL (moderngl), renderer `{renderer}`" + (
+            ": **llvmpipe runs the shader on the CPU**. Its pixels are a float32 GPU's; its frame times are "
+            "indicative only (this machine's 2 cores were shared with other work)."
+            if "llvmpipe" in renderer
+            else "."
+        )
+    return (
+        f"Browser: headless Chromium ({' '.join(FLAGS)}), WebGL renderer `{renderer}`: **SwiftShader is a CPU "
+        "emulation of a GPU**. Its pixels are what float arithmetic on a GPU gives; its frame times are not a "
+        "GPU's and are indicative only (this machine's 2 cores were shared with other work)."
+    )
 
 
 def measure(gl, cases, judge: int, silhouette: int) -> list[tuple[glslcheck.Comparison, str]]:
@@ -144,7 +176,7 @@ def degree_table(drows) -> list[str]:
     return out
 
 
-def report(rows, size, judge: int, renderer: str, seconds: float, argv) -> str:
+def report(rows, size, judge: int, host: str, seconds: float, argv, load_before: str) -> str:
     w, h = size
     stable = degree_rows(rows, {"example", "nested", "far"})
     everything = degree_rows(rows, {"example", "nested", "power form", "far"})
@@ -152,12 +184,10 @@ def report(rows, size, judge: int, renderer: str, seconds: float, argv) -> str:
         "# GLSL against the C solvers and the exact judge",
         "",
         f"Written by `.venv/bin/python bench/glsl_compare.py{' ' + ' '.join(argv) if argv else ''}` on "
-        f"{machine.describe()}, {time.strftime('%Y-%m-%d')}. Load average before: {machine.load_average()}. "
-        f"Whole run {seconds / 60:.0f} min.",
+        f"{machine.describe()}, {time.strftime('%Y-%m-%d')}. Load average before: {load_before}, "
+        f"after: {machine.load_average()}. Whole run {seconds / 60:.0f} min.",
         "",
-        f"Browser: headless Chromium ({' '.join(FLAGS)}), WebGL renderer `{renderer}`: **SwiftShader is a CPU "
-        "emulation of a GPU**. Its pixels are what float arithmetic on a GPU gives; its frame times are not a "
-        "GPU's and are indicative only (this machine's 2 cores were shared with other work).",
+        host,
         "",
         f"Camera cases at {w}×{h}, one float32 ray per pixel, given alike to the GLSL, to the C solvers "
         "(double) and to the exact judge. Object pixels: where the exact answer is a hit (C's answer where no "
@@ -196,11 +226,12 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     args, size, judge = parse_args(argv)
     t0 = time.perf_counter()
-    with WebGL() as gl:
+    load_before = machine.load_average()
+    with runner(args.egl) as gl:
         _, renderer = gl.info()
         print(f"{renderer}; {size[0]}x{size[1]}")
-        rows = measure(gl, all_cases(size), judge, 0 if args.quick else args.silhouette)
-    text = report(rows, size, judge, renderer, time.perf_counter() - t0, argv)
+        rows = measure(gl, all_cases(size, args.only), judge, 0 if args.quick else args.silhouette)
+    text = report(rows, size, judge, host_line(args.egl, renderer), time.perf_counter() - t0, argv, load_before)
     machine.write_results(args.out, text)
     print("wrote", args.out)
     return 0

@@ -39,6 +39,10 @@
 //      box fills the picture; on a far ray, about as close as float can place a point), the hit is flagged
 //      IG_EARLIER: certain, but the first root may lie before t by more than that.
 //   5. Everything is bounded: IG_MAX_STEPS shape evaluations per ray; a ray that runs out is flagged.
+//   6. The working interval is the clip rounded outward (clip.glsl), a little longer than the ray's part in
+//      the box and in [tmin, tmax]. A certified root whose bracket reaches past the part that is certainly
+//      inside both (ig_clip_box_inner) may lie in that margin, outside the box, where the exact answer is a
+//      miss: such a hit is flagged IG_UNSURE.
 //
 // What is certified is the ray as given in float (o, d): the shift's rounding is in the coordinates' error.
 
@@ -108,6 +112,9 @@ struct IgRay {
     float s_hit;
     float ra, rb; // refinement bracket: sign known at ra, the other sign at rb
     float bracket_a; // where the bracket started: the first root is in [bracket_a, the root found]
+    float bracket_b; // where it ended: a root is certified in [bracket_a, bracket_b]
+    float s_after;   // after a hit: a place past the root where f has the other sign (to look for the next root)
+    float in0, in1;  // the part of [s0, s1] certainly inside the box and [tmin, tmax] (in0 > in1: none)
     float blur;   // how well float can place a root on this ray (s units)
     int refine_left;
     int steps;
@@ -148,7 +155,24 @@ void ig_ray_stop(inout IgRay ray, bool hit, float s)
     bool unsure = ray.unsure || (!hit && (ray.doubt || ray.far_doubt));
     ray.status = (hit ? IG_HIT : 0) | (unsure ? IG_UNSURE : 0) | (hit && ray.earlier && !unsure ? IG_EARLIER : 0);
     ray.s_hit = s;
+    ray.s_after = ray.mode == IG_REFINE ? max(ray.bracket_b, s) : s;
     ray.mode = IG_DONE;
+}
+
+// ray.in0, ray.in1: the part of [tmin, tmax] in the box taken exactly, certainly, in s = t - tc. The box is
+// clipped from the shifted origin, with its rounding e0 (ig_clip_box_inner), so the margin is of the size of
+// the coordinates' own error even for a far origin; tmin and tmax are moved into s with the subtraction's
+// rounding counted inward.
+void ig_ray_inner(inout IgRay ray, float tmin, float tmax, vec3 lo, vec3 hi)
+{
+    float i0 = abs(tmin) < ig_inf() ? (tmin - ray.tc) + IG_U * (abs(tmin) + abs(ray.tc)) : tmin;
+    float i1 = abs(tmax) < ig_inf() ? (tmax - ray.tc) - IG_U * (abs(tmax) + abs(ray.tc)) : tmax;
+    if (!ig_clip_box_inner(ray.o, ray.d, ray.e0, lo, hi, i0, i1)) {
+        i0 = 1.0;
+        i1 = -1.0;
+    }
+    ray.in0 = i0;
+    ray.in1 = i1;
 }
 
 IgRay ig_ray_begin(vec3 o, vec3 d, float tmin, float tmax, vec3 lo, vec3 hi)
@@ -169,6 +193,7 @@ IgRay ig_ray_begin(vec3 o, vec3 d, float tmin, float tmax, vec3 lo, vec3 hi)
     ray.index = 0;
     ray.status = 0;
     ray.s_hit = 0.0;
+    ray.s_after = 0.0;
     ray.refine_left = IG_REFINE_STEPS;
     float t0 = tmin;
     float t1 = tmax;
@@ -189,6 +214,7 @@ IgRay ig_ray_begin(vec3 o, vec3 d, float tmin, float tmax, vec3 lo, vec3 hi)
     float pad = IG_U * (abs(t0) + abs(t1) + abs(ray.tc));
     ray.s0 = (t0 - ray.tc) - pad;
     ray.s1 = (t1 - ray.tc) + pad;
+    ig_ray_inner(ray, tmin, tmax, lo, hi);
     ray.a = ray.s0;
     ray.b = ray.s1;
     ray.finest = (ray.s1 - ray.s0) * ig_ray_scale(IG_MAX_DEPTH);
@@ -211,9 +237,24 @@ void ig_ray_query(IgRay ray, out vec3 x, out vec3 y, out vec3 z)
     z = ig_raa_var(m.z, h.z, e.z);
 }
 
+// A certified root in [ra, rb]: bisection from its middle. The origin moves there first (o + m d, its rounding
+// added to the coordinates' error), so s stays small and bisection resolves t to float's resolution near the
+// root, not to that of the whole working interval (an unbounded shape's is IG_FAR long); everything kept in s
+// moves with it, the ends of the bracket outward and the inner part of the box inward by their rounding.
 void ig_ray_refine(inout IgRay ray, float ra, float rb)
 {
+    float m = 0.5 * (ra + rb);
+    vec3 md = m * ray.d;
+    vec3 o = ray.o + md;
+    ray.e0 = (ray.e0 + IG_ULP * (abs(md) + abs(o))) * (1.0 + IG_UP_REL) + IG_TINY;
+    ray.o = o;
+    ray.tc += m;
+    ra = (ra - m) - IG_U * abs(ra - m);
+    rb = (rb - m) + IG_U * abs(rb - m);
+    ray.in0 = (ray.in0 - m) + IG_U * abs(ray.in0 - m);
+    ray.in1 = (ray.in1 - m) - IG_U * abs(ray.in1 - m);
     ray.bracket_a = ra;
+    ray.bracket_b = rb;
     ray.ra = ra;
     ray.rb = rb;
     ig_ray_ask_point(ray, 0.5 * (ra + rb), IG_REFINE);
@@ -347,6 +388,8 @@ void ig_ray_on_refine(inout IgRay ray, vec3 f)
     bool resolved = ray.rb - ray.ra <= 2.0 * IG_U * max(abs(ray.ra), abs(ray.rb)) || m == ray.ra || m == ray.rb;
     if (ray.refine_left <= 0 || resolved) {
         ray.earlier = ray.earlier || m - ray.bracket_a > ray.blur;
+        // NaN-safe: a bracket not shown to be inside is flagged
+        ray.unsure = ray.unsure || !(ray.bracket_a >= ray.in0 && ray.bracket_b <= ray.in1);
         ig_ray_stop(ray, true, m);
         return;
     }

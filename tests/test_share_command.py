@@ -244,7 +244,7 @@ BAD = [
     (["{torus}", "--clip-size", "0", "-o", "{tmp}/page.html"], "outside"),
     (["{torus}", "--clip-size", "x", "-o", "{tmp}/page.html"], "finite number"),
     (["{torus}", "--object", "torus_y", "-o", "{tmp}/page.html"], "is a shape spec, not a scene"),
-    (["{scene}", "-o", "{tmp}/page.html"], "--object NAME"),
+    (["{scene}", "--param", "a=1", "-o", "{tmp}/page.html"], "applies to a shape"),
     (["{scene}", "--object", "cube", "-o", "{tmp}/page.html"], "no shape of that name"),
 ]
 

@@ -99,7 +99,8 @@ def glsl_text(spec) -> str:
 def run_glsl(gl, case: Case, defines: dict[str, str] | None = None, band: int = 32) -> dict:
     """The generated GLSL over the case's rays in the browser: status, t, steps per ray, and draw time (ms)."""
     prefix = glsl_name(case.spec.name)
-    frag = program([glsl_text(case.spec)], RAY_MAIN, "es", {**shape_defines(prefix), **(defines or {})})
+    dialect = getattr(gl, "dialect", "es")  # implgen.measure.glslegl's desktop GL takes GLSL 4.50
+    frag = program([glsl_text(case.spec)], RAY_MAIN, dialect, {**shape_defines(prefix), **(defines or {})})
     orig = np.concatenate([case.origins, case.tmin[..., None]], -1)
     dirs = np.concatenate([case.dirs, case.tmax[..., None]], -1)
     uniforms = {f"{prefix}_params": list(case.params.values())} if case.params else {}

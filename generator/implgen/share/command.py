@@ -1,6 +1,7 @@
 """`implgen share SPEC.yaml -o page.html [--param NAME=VALUE ...] [--range NAME=LO:HI ...] [--clip KIND]
-[--clip-size S]`, or `implgen share SCENE.yaml --object NAME -o page.html`: one HTML file that draws the shape
-in any WebGL2 browser, from disk, with no server and no network (docs/share.md).
+[--clip-size S]`, `implgen share SCENE.yaml -o page.html` (the whole scene, share/scenepage.py), or
+`implgen share SCENE.yaml --object NAME -o page.html`: one HTML file that draws the shape or the scene in any
+WebGL2 browser, from disk, with no server and no network (docs/share.md).
 
 The output path is checked first, then the options against the shape; the page is made in memory and written
 under a temporary name, then renamed: bad input leaves nothing behind.
@@ -33,6 +34,7 @@ EXAMPLES = (
         "Barth's sextic (unbounded) in a box",
         "implgen share examples/shapes/barth6.yaml --clip box --clip-size 1.5 -o barth.html",
     ),
+    ("a whole scene: glass, CSG, shadows", "implgen share examples/scenes/glassware.yaml -o glassware.html"),
     ("one object of a scene", "implgen share examples/scenes/torus_shadow.yaml --object torus_y -o torus.html"),
 )
 
@@ -75,15 +77,13 @@ def sliders(
     return out
 
 
-def _scene_object(path: Path, name: str | None) -> tuple[Spec, dict[str, float], Look]:
+def _scene_object(path: Path, name: str) -> tuple[Spec, dict[str, float], Look]:
     """The first object of the scene whose shape is called `name`: its spec, its params, its colours."""
     from implgen.scene.load import load_scene
 
     scene = load_scene(path)
     leaves = scene.leaves()
     names = list(dict.fromkeys(leaf.spec.name for leaf in leaves))
-    if name is None:
-        raise UserError(path, f"is a scene: say which shape with --object NAME (its shapes: {', '.join(names)})")
     for leaf in leaves:
         if leaf.spec.name == name:
             look = Look(background=tuple(scene.background))
@@ -104,7 +104,12 @@ def _parser() -> ArgumentParser:
         "decide (docs/share.md).",
         examples=EXAMPLES,
     )
-    p.add_argument("file", type=Path, metavar="SPEC.yaml", help="a shape spec, or a scene with --object")
+    p.add_argument(
+        "file",
+        type=Path,
+        metavar="SPEC.yaml",
+        help="a shape spec, or a scene (the whole scene, or with --object one shape)",
+    )
     p.add_argument("-o", "--output", type=Path, required=True, metavar="PAGE.html", help="the page to write")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="a param's starting value")
     p.add_argument(
@@ -134,6 +139,8 @@ def main(argv: Sequence[str]) -> int:
     if args.clip_size is not None:
         clip_size = validate.number("--clip-size", "", args.clip_size, 1e-6, 1e6, text_ok=True)
     data = read_yaml(args.file, what="spec or scene")
+    if isinstance(data, dict) and "objects" in data and args.object is None:
+        return _scene_page(args)
     if isinstance(data, dict) and "objects" in data:
         spec, start, look = _scene_object(args.file, args.object)
     else:
@@ -152,14 +159,42 @@ def main(argv: Sequence[str]) -> int:
         background=look.background,
     )
     html = render_page(spec, slider_list, look, args.file.name, orbit)
+    size = _write(args.output, html)
+    if not args.quiet:
+        print(f"{spec.name:<14} degree {spec.degree:>2}  {size:6.1f} kB -> {printable(str(args.output))}")
+    return 0
+
+
+def _write(path: Path, html: str) -> float:
+    """The page written whole (a temporary name renamed into place); its size in kB."""
     data_bytes = html.encode("utf-8")
     try:
-        atomic_write(args.output, lambda fh: fh.write(data_bytes))
+        atomic_write(path, lambda fh: fh.write(data_bytes))
     except OSError as err:
-        raise UserError(f"-o {args.output}", f"cannot write: {err.strerror or err}") from None
+        raise UserError(f"-o {path}", f"cannot write: {err.strerror or err}") from None
+    return len(data_bytes) / 1024
+
+
+def _scene_page(args) -> int:
+    """The whole scene as a page (share/scenepage.py); the shape's options do not apply."""
+    from implgen.scene.load import load_scene
+    from implgen.share.scenepage import render_scene_page
+
+    for option, given in (
+        ("--param", args.param),
+        ("--range", args.range),
+        ("--clip", args.clip),
+        ("--clip-size", args.clip_size),
+        ("--cut", args.cut),
+    ):
+        if given:
+            raise UserError(option, f"applies to a shape; {args.file} is a scene (give --object NAME for one shape)")
+    scene = load_scene(args.file)
+    size = _write(args.output, render_scene_page(scene, args.file.name))
     if not args.quiet:
-        size = len(data_bytes) / 1024
-        print(f"{spec.name:<14} degree {spec.degree:>2}  {size:6.1f} kB -> {printable(str(args.output))}")
+        print(
+            f"{args.file.name:<14} scene, {len(scene.objects)} objects  {size:6.1f} kB -> {printable(str(args.output))}"
+        )
     return 0
 
 

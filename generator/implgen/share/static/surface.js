@@ -51,21 +51,79 @@ uniform int ig_page_mark;        // 1: pixels flagged IG_UNSURE get the magenta 
 uniform int ig_page_output;      // 0: the colour; 1: the status (red: hit, green: not sure)
 out vec4 ig_page_colour;
 
-// The sign of f where the ray enters the clip, certified (+1 outside the solid, -1 inside, 0 float cannot
-// tell); outside the shape's box the solid is not there (a leaf is its solid cut by its box).
-int ig_page_side(vec3 o, vec3 d, float t0, out float guess)
+// One loop per pixel (ig_page_run) asks the shape everything the pixel needs, one question after the other:
+// the sign of f where the camera ray enters the cut clip, the camera ray, the places a shadow ray may start
+// from, each light's cut and shadow ray. Its inner loop evaluates f over a point or over the current ray's
+// segments and points (ray.glsl) in its one call of IG_SHAPE_RAA, and the camera's hit gets its normal from
+// the one call of IG_SHAPE_NORMAL: the shape's tree is in the program once, as in a program that calls
+// IG_SHAPE_HIT once (the GLSL test harness's). A compiler inlines every call: with a call of IG_SHAPE_HIT for
+// the camera and one for the shadows, and f at points in three more places, the page held the tree eight
+// times. That was the difference found between the two programs when a large tree (a Chebyshev form of
+// degree 16 to 24) drew 9-13 times slower in the page than in the harness on a GPU (docs/share.md).
+
+const int IG_PAGE_DONE = 0;
+const int IG_PAGE_CAMERA_SIDE = 1; // f's sign where the camera ray enters the cut clip
+const int IG_PAGE_CAMERA = 2;      // the camera ray
+const int IG_PAGE_START = 3;       // f's sign where the shadow rays would start
+const int IG_PAGE_SHADOW_SIDE = 4; // f's sign where a shadow ray enters the cut clip
+const int IG_PAGE_SHADOW = 5;      // a shadow ray
+// the questions a pixel asks at most: two for the camera (the cut, the ray), three places for shadow rays to
+// start from, two for each light (the cut, the shadow ray)
+const int IG_PAGE_JOBS = 5 + 2 * IG_PAGE_MAX_LIGHTS;
+
+IgCamera ig_page_cam;
+vec3 ig_page_dir;      // the camera ray's direction
+int ig_page_phase;
+int ig_page_status;    // the pixel's status bits
+vec3 ig_page_rgb;
+IgRay ig_page_ray;     // the ray being traced: from ig_page_ro along ig_page_rd over [ig_page_t0, ig_page_t1]
+vec3 ig_page_ro;
+vec3 ig_page_rd;
+float ig_page_t0;
+float ig_page_t1;
+vec3 ig_page_q;        // the point asked about, and its coordinates' error
+vec3 ig_page_qe;
+int ig_page_camera_unsure; // IG_UNSURE when the camera ray's side at the clip was a guess
+// shading the camera's hit
+vec3 ig_page_base;
+vec3 ig_page_p;
+vec3 ig_page_nf;
+vec3 ig_page_u;
+float ig_page_off;
+vec3 ig_page_start;    // where shadow rays leave
+int ig_page_tries;
+int ig_page_light_i;   // the light whose shadow ray is traced
+
+// The sign of f at the point o + t0 d where a ray enters the clip is asked next (phase); outside the shape's
+// box the solid is not there (a leaf is its solid cut by its box), and no question is needed: false.
+bool ig_page_ask_side(vec3 o, vec3 d, float t0, int phase)
 {
     vec3 p = o + t0 * d;
     vec3 lo, hi;
     IG_SHAPE_BOUNDS(lo, hi);
-    guess = 1.0;
     if (any(lessThan(p, lo)) || any(greaterThan(p, hi))) {
-        return 1;
+        return false;
     }
-    vec3 e = (IG_ULP * (abs(t0 * d) + abs(p))) * (1.0 + IG_UP_REL) + IG_TINY;
-    vec3 f = IG_SHAPE_RAA(ig_raa_var(p.x, 0.0, e.x), ig_raa_var(p.y, 0.0, e.y), ig_raa_var(p.z, 0.0, e.z));
-    guess = f.x;
-    return ig_raa_sign(f);
+    ig_page_q = p;
+    ig_page_qe = (IG_ULP * (abs(t0 * d) + abs(p))) * (1.0 + IG_UP_REL) + IG_TINY;
+    ig_page_phase = phase;
+    return true;
+}
+
+void ig_page_ask_start()
+{
+    ig_page_q = ig_page_start;
+    ig_page_qe = IG_ULP * abs(ig_page_start) * (1.0 + IG_UP_REL) + IG_TINY;
+    ig_page_phase = IG_PAGE_START;
+}
+
+void ig_page_trace(vec3 o, vec3 d, float t0, float t1, int phase)
+{
+    ig_page_ro = o;
+    ig_page_rd = d;
+    ig_page_t0 = t0;
+    ig_page_t1 = t1;
+    ig_page_phase = phase;
 }
 
 vec3 ig_page_clip_normal(vec3 p)
@@ -88,112 +146,215 @@ bool ig_page_clip_ray(vec3 o, vec3 d, inout float t0, inout float t1)
     return t0 <= t1;
 }
 
-// Whether what the picture shows blocks o + t d for t in (0, tmax]: the surface inside the clip, or (cut
-// solid) the solid where the ray enters the clip. status gets IG_UNSURE when float could not tell.
-bool ig_page_blocked(vec3 o, vec3 d, float tmax, inout int status)
+// Towards light i from the hit point: its direction (unnormalised), or length 0 when it does not light the side
+// seen.
+vec3 ig_page_towards(int i)
 {
-    float t0 = 0.0;
-    float t1 = tmax;
-    if (!ig_page_clip_ray(o, d, t0, t1)) {
-        return false;
-    }
-    if (ig_page_cut == 1 && ig_page_clip != 0 && t0 > 0.0) {
-        float guess;
-        int side = ig_page_side(o, d, t0, guess);
-        if (side < 0 || (side == 0 && guess < 0.0)) {
-            status |= side == 0 ? IG_UNSURE : 0;
-            return true;
-        }
-    }
-    float t;
-    vec3 n;
-    int s = IG_SHAPE_HIT(o, d, t0, t1, t, n);
-    status |= s & IG_UNSURE;
-    return (s & IG_HIT) != 0;
+    vec4 lp = ig_page_light[i];
+    vec3 l = lp.w > 0.5 ? lp.xyz - ig_page_p : lp.x * ig_page_cam.u + lp.y * ig_page_cam.v + lp.z * ig_page_cam.w;
+    float ll = length(l);
+    return ll > 0.0 && dot(ig_page_nf, l) / ll > 0.0 ? l : vec3(0.0);
 }
 
-// Whether f's sign at the point q is certain in float (its coordinates' rounding counted): a shadow ray that
-// starts there does not start inside the surface's rounding noise.
-bool ig_page_certain(vec3 q)
+// Two-sided shading as the C tracer's (runtime_c/tracer_shade.c): light i's Lambert and Blinn-Phong terms times
+// its colour, added when nothing blocks it.
+void ig_page_add_light(int i)
 {
-    vec3 e = IG_ULP * abs(q) * (1.0 + IG_UP_REL) + IG_TINY;
-    return ig_raa_sign(IG_SHAPE_RAA(ig_raa_var(q.x, 0.0, e.x), ig_raa_var(q.y, 0.0, e.y), ig_raa_var(q.z, 0.0, e.z))) != 0;
+    vec3 l = ig_page_towards(i);
+    float ll = length(l);
+    float ndl = dot(ig_page_nf, l) / ll;
+    vec3 hv = normalize(l / ll - ig_page_u);
+    float ndh = dot(ig_page_nf, hv);
+    float spec = ndh > 0.0 ? ig_page_material.z * pow(ndh, ig_page_material.w) : 0.0;
+    ig_page_rgb += ig_page_light_colour[i] * (ig_page_material.y * ig_page_base * ndl + spec);
 }
 
-// Two-sided shading as the C tracer's (runtime_c/tracer_shade.c): ambient, then for each light that faces the
-// side seen, Lambert and a Blinn-Phong highlight times the light's colour (0 in shadow).
-vec3 ig_page_shade(vec3 front, vec3 back, vec3 n, vec3 d, vec3 p, IgCamera cam, inout int status)
+// The lights from ig_page_light_i on: each that lights the side seen is added, or (shadows) its shadow ray is
+// asked for -- what the picture shows blocks it: the surface inside the clip, or (cut solid) the solid where
+// the ray enters the clip.
+void ig_page_next_light()
 {
-    vec3 u = normalize(d);
-    bool behind = !(dot(n, u) < 0.0);
-    vec3 nf = behind ? -n : n;
-    vec3 base = behind ? back : front;
-    vec3 colour = ig_page_material.x * base;
-    // shadow rays leave a little off the surface (the float hit point is only that accurate), and further, up to
-    // 64 times, until f's sign is certain there (a high degree's rounding noise is wide)
-    float off = 4.0e-4 * (length(p) + length(p - cam.eye)) + 1.0e-6;
-    vec3 start = p + nf * off;
-    for (int k = 0; k < 3 && ig_page_shadows != 0 && !ig_page_certain(start); ++k) {
-        off *= 4.0;
-        start = p + nf * off;
-    }
     for (int i = 0; i < IG_PAGE_MAX_LIGHTS; ++i) {
-        if (i >= ig_page_nlights) {
+        int k = ig_page_light_i;
+        if (k >= ig_page_nlights) {
             break;
         }
-        vec4 lp = ig_page_light[i];
-        vec3 l = lp.w > 0.5 ? lp.xyz - p : lp.x * cam.u + lp.y * cam.v + lp.z * cam.w;
-        float ll = length(l);
-        if (!(ll > 0.0)) {
+        vec3 l = ig_page_towards(k);
+        if (!(length(l) > 0.0)) {
+            ig_page_light_i += 1;
             continue;
         }
-        float ndl = dot(nf, l) / ll;
-        if (ndl <= 0.0) {
+        if (ig_page_shadows == 0) {
+            ig_page_add_light(k);
+            ig_page_light_i += 1;
             continue;
         }
-        if (ig_page_shadows != 0) {
-            vec3 towards = lp.w > 0.5 ? lp.xyz - start : l;
-            if (ig_page_blocked(start, towards, lp.w > 0.5 ? 1.0 : ig_inf(), status)) {
-                continue;
-            }
+        bool point = ig_page_light[k].w > 0.5;
+        vec3 towards = point ? ig_page_light[k].xyz - ig_page_start : l;
+        float t0 = 0.0;
+        float t1 = point ? 1.0 : ig_inf();
+        if (!ig_page_clip_ray(ig_page_start, towards, t0, t1)) {
+            ig_page_add_light(k);
+            ig_page_light_i += 1;
+            continue;
         }
-        vec3 hv = normalize(l / ll - u);
-        float ndh = dot(nf, hv);
-        float spec = ndh > 0.0 ? ig_page_material.z * pow(ndh, ig_page_material.w) : 0.0;
-        colour += ig_page_light_colour[i] * (ig_page_material.y * base * ndl + spec);
+        ig_page_ro = ig_page_start;
+        ig_page_rd = towards;
+        ig_page_t0 = t0;
+        ig_page_t1 = t1;
+        bool cut = ig_page_cut == 1 && ig_page_clip != 0 && t0 > 0.0;
+        if (!(cut && ig_page_ask_side(ig_page_start, towards, t0, IG_PAGE_SHADOW_SIDE))) {
+            ig_page_trace(ig_page_start, towards, t0, t1, IG_PAGE_SHADOW);
+        }
+        return;
     }
-    return colour;
+    ig_page_phase = IG_PAGE_DONE;
+}
+
+// The camera's hit (or the cut face) at p with normal n: ambient, then the lights. Shadow rays leave a little
+// off the surface (the float hit point is only that accurate), and further, up to 64 times, until f's sign is
+// certain there (a high degree's rounding noise is wide).
+void ig_page_shade(vec3 front, vec3 back, vec3 n, vec3 p)
+{
+    ig_page_u = normalize(ig_page_dir);
+    bool behind = !(dot(n, ig_page_u) < 0.0);
+    ig_page_nf = behind ? -n : n;
+    ig_page_base = behind ? back : front;
+    ig_page_rgb = ig_page_material.x * ig_page_base;
+    ig_page_p = p;
+    ig_page_off = 4.0e-4 * (length(p) + length(p - ig_page_cam.eye)) + 1.0e-6;
+    ig_page_start = p + ig_page_nf * ig_page_off;
+    ig_page_light_i = 0;
+    ig_page_tries = 0;
+    if (ig_page_shadows != 0) {
+        ig_page_ask_start();
+    } else {
+        ig_page_next_light();
+    }
+}
+
+// f's sign at the point asked about: its answer.
+void ig_page_on_point(int sg, float guess)
+{
+    bool solid = sg < 0 || (sg == 0 && guess < 0.0); // where the ray enters the cut clip
+    int unsure = sg == 0 ? IG_UNSURE : 0;
+    if (ig_page_phase == IG_PAGE_CAMERA_SIDE) {
+        if (solid) { // the cut face: the solid's inside, flat on the clip
+            ig_page_status = IG_HIT | unsure;
+            vec3 p = ig_page_cam.eye + ig_page_t0 * ig_page_dir;
+            ig_page_shade(ig_page_inside, ig_page_inside, ig_page_clip_normal(p), p);
+        } else {
+            ig_page_camera_unsure = unsure;
+            ig_page_trace(ig_page_ro, ig_page_rd, ig_page_t0, ig_page_t1, IG_PAGE_CAMERA);
+        }
+    } else if (ig_page_phase == IG_PAGE_START) {
+        ig_page_tries += 1;
+        if (sg == 0 && ig_page_tries < 3) {
+            ig_page_off *= 4.0;
+            ig_page_start = ig_page_p + ig_page_nf * ig_page_off;
+            ig_page_ask_start();
+            return;
+        }
+        if (sg == 0) { // the fourth place is taken unasked
+            ig_page_start = ig_page_p + ig_page_nf * (4.0 * ig_page_off);
+        }
+        ig_page_next_light();
+    } else if (ig_page_phase == IG_PAGE_SHADOW_SIDE) {
+        if (solid) {
+            ig_page_status |= unsure;
+            ig_page_light_i += 1;
+            ig_page_next_light();
+        } else {
+            ig_page_trace(ig_page_ro, ig_page_rd, ig_page_t0, ig_page_t1, IG_PAGE_SHADOW);
+        }
+    }
+}
+
+// The traced ray is finished: the camera's hit shaded, or a light blocked or added.
+void ig_page_on_ray()
+{
+    float t;
+    int s = ig_ray_finish(ig_page_ray, t);
+    if (ig_page_phase == IG_PAGE_CAMERA) {
+        ig_page_status = s | ig_page_camera_unsure;
+        if ((s & IG_HIT) == 0) {
+            ig_page_phase = IG_PAGE_DONE;
+            return;
+        }
+        vec3 n = IG_SHAPE_NORMAL(ig_ray_point(ig_page_ray));
+        ig_page_shade(ig_page_outside, ig_page_inside, n, ig_page_cam.eye + t * ig_page_dir);
+        return;
+    }
+    ig_page_status |= s & IG_UNSURE;
+    if ((s & IG_HIT) == 0) {
+        ig_page_add_light(ig_page_light_i);
+    }
+    ig_page_light_i += 1;
+    ig_page_next_light();
+}
+
+// Everything the pixel asks of the shape, one question (a ray, or a point) after the other; the inner loop is
+// the one that evaluates the shape, as a shape's own IG_SHAPE_HIT does.
+void ig_page_run()
+{
+    for (int job = 0; job < IG_PAGE_JOBS && ig_page_phase != IG_PAGE_DONE; ++job) {
+        bool ray = ig_page_phase == IG_PAGE_CAMERA || ig_page_phase == IG_PAGE_SHADOW;
+        if (ray) {
+            vec3 lo, hi;
+            IG_SHAPE_BOUNDS(lo, hi);
+            ig_page_ray = ig_ray_begin(ig_page_ro, ig_page_rd, ig_page_t0, ig_page_t1, lo, hi);
+        }
+        vec3 f = vec3(0.0);
+        for (int i = 0; i < IG_MAX_STEPS && !(ray && ig_page_ray.mode == IG_DONE); ++i) {
+            vec3 x, y, z;
+            if (ray) {
+                ig_ray_query(ig_page_ray, x, y, z);
+            } else {
+                x = ig_raa_var(ig_page_q.x, 0.0, ig_page_qe.x);
+                y = ig_raa_var(ig_page_q.y, 0.0, ig_page_qe.y);
+                z = ig_raa_var(ig_page_q.z, 0.0, ig_page_qe.z);
+            }
+            f = IG_SHAPE_RAA(x, y, z);
+            if (!ray) {
+                break;
+            }
+            ig_ray_answer(ig_page_ray, f);
+        }
+        if (ray) {
+            ig_page_on_ray();
+        } else {
+            ig_page_on_point(ig_raa_sign(f), f.x);
+        }
+    }
+    if (ig_page_phase != IG_PAGE_DONE) {
+        ig_page_status |= IG_UNSURE; // out of questions (not reached: IG_PAGE_JOBS counts them all)
+    }
 }
 
 void main()
 {
     vec2 pixel = vec2(gl_FragCoord.x, ig_page_size.y - gl_FragCoord.y);
-    IgCamera cam = ig_camera(ig_page_eye, ig_page_look, ig_page_up, ig_page_fov, ig_page_size);
-    vec3 d = ig_camera_dir(cam, pixel, ig_page_size);
+    ig_page_cam = ig_camera(ig_page_eye, ig_page_look, ig_page_up, ig_page_fov, ig_page_size);
+    ig_page_dir = ig_camera_dir(ig_page_cam, pixel, ig_page_size);
     float t0 = 0.0;
     float t1 = ig_inf();
-    bool open = ig_page_clip_ray(cam.eye, d, t0, t1);
-    int status = 0;
-    vec3 rgb = ig_page_background;
-    if (open) {
-        int side = 1;
-        float guess = 1.0;
-        if (ig_page_cut == 1 && ig_page_clip != 0 && t0 > 0.0) {
-            side = ig_page_side(cam.eye, d, t0, guess);
-        }
-        if (side < 0 || (side == 0 && guess < 0.0)) { // the cut face: the solid's inside, flat on the clip
-            status = IG_HIT | (side == 0 ? IG_UNSURE : 0);
-            vec3 p = cam.eye + t0 * d;
-            rgb = ig_page_shade(ig_page_inside, ig_page_inside, ig_page_clip_normal(p), d, p, cam, status);
-        } else {
-            float t;
-            vec3 n;
-            status = IG_SHAPE_HIT(cam.eye, d, t0, t1, t, n) | (side == 0 ? IG_UNSURE : 0);
-            if ((status & IG_HIT) != 0) {
-                rgb = ig_page_shade(ig_page_outside, ig_page_inside, n, d, cam.eye + t * d, cam, status);
-            }
+    ig_page_status = 0;
+    ig_page_camera_unsure = 0;
+    ig_page_rgb = ig_page_background;
+    ig_page_phase = IG_PAGE_DONE;
+    if (ig_page_clip_ray(ig_page_cam.eye, ig_page_dir, t0, t1)) {
+        ig_page_ro = ig_page_cam.eye;
+        ig_page_rd = ig_page_dir;
+        ig_page_t0 = t0;
+        ig_page_t1 = t1;
+        bool cut = ig_page_cut == 1 && ig_page_clip != 0 && t0 > 0.0;
+        if (!(cut && ig_page_ask_side(ig_page_cam.eye, ig_page_dir, t0, IG_PAGE_CAMERA_SIDE))) {
+            ig_page_trace(ig_page_cam.eye, ig_page_dir, t0, t1, IG_PAGE_CAMERA);
         }
     }
+    ig_page_run();
+    int status = ig_page_status;
+    vec3 rgb = ig_page_rgb;
     if (ig_page_output == 1) {
         ig_page_colour = vec4((status & IG_HIT) != 0 ? 1.0 : 0.0, (status & IG_UNSURE) != 0 ? 1.0 : 0.0, 0.0, 1.0);
         return;
