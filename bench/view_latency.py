@@ -445,7 +445,8 @@ def work_lines(work: dict) -> list[str]:
         f"{QUIET_ONE} s (the 1-sample picture at 640×480 on a quiet 2-core machine) times the ratio to the "
         "1-sample render before.",
         "",
-        "| size | way | → half size | → 1 spp | → 2 spp | → 3 spp | → 4 spp | quiet estimate: 1 spp, 4 spp (s) |",
+        "| size | way | → half size | → 1 spp | → 2 spp | → 3 spp | → 4 spp | "
+        "quiet estimate: half size, 1 spp, 4 spp (s) |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for w, h in GLASS_SIZES:
@@ -454,7 +455,9 @@ def work_lines(work: dict) -> list[str]:
         for way in ("before", "ladder"):
             m = work[w, h, way]
             cells = [_median(m[k]) if k in m else "–" for k in ("quarter", "one", "more2", "more3", "full")]
-            est = f"{statistics.median(m['one']) * scale:.2f}, {statistics.median(m['full']) * scale:.2f}"
+            est = ", ".join(
+                f"{statistics.median(m[k]) * scale:.2f}" if k in m else "–" for k in ("quarter", "one", "full")
+            )
             lines.append(f"| {w}×{h} | {way} | " + " | ".join(cells) + f" | {est} |")
     return lines + [""]
 
@@ -493,8 +496,11 @@ def glass_lines(out: dict, rounds: int, compare: Path | None, load: tuple[float,
     lines.append("")
     for (tree, (w, h)), m in out.items():  # one message of each kind, its figures as the last round had them
         said = {re.sub(r"[0-9.]+ ms", "N ms", e): e for e in m["error"] if e}
-        name = "this tree" if tree == "new" else f"`{compare}`"
-        lines += [f"Stopped, {w}×{h}, {name} ({sum(map(bool, m['error']))} of {rounds}): `{e}`" for e in said.values()]
+        if said:
+            name = "this tree" if tree == "new" else f"`{compare}`"
+            stopped = sum(map(bool, m["error"]))
+            lines.append(f"- {w}×{h}, {name}: stopped by the budget in {stopped} of {rounds} rounds, saying")
+            lines += [f"  `{e}`" for e in said.values()]
     return lines + ["", GLASS_END]
 
 

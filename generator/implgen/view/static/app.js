@@ -6,13 +6,15 @@
   const $ = (id) => document.getElementById(id);
   const canvas = $("view");
   const ctx2d = canvas.getContext("2d");
-  const HEADER = 12; // seq (u32), kind (u8), flags (u8), 2 spare bytes, width (u16), height (u16)
+  const HEADER = 12; // seq (u32), kind (u8), flags (u8), samples (u16: a KIND_MORE frame's), width (u16), height (u16)
   const KIND_COARSE = 0, KIND_FULL = 1, KIND_SAVE = 2, KIND_ONE = 3, KIND_MESH = 4, KIND_QUARTER = 5, KIND_MORE = 6;
   // a better frame of the same request wins: the refinement's half-size picture, 1 sample, more (their count in
   // the header's spare bytes), all samples
   const RANK = { [KIND_COARSE]: 0, [KIND_QUARTER]: 1, [KIND_ONE]: 2, [KIND_MORE]: 2, [KIND_FULL]: 1000 };
   const KIND_NAME = { [KIND_COARSE]: "coarse", [KIND_QUARTER]: "half size, 1 sample", [KIND_ONE]: "full, 1 sample",
     [KIND_FULL]: "full" };
+  const KIND_MARK = { [KIND_COARSE]: "coarse", [KIND_QUARTER]: "quarter", [KIND_ONE]: "one", [KIND_MORE]: "more",
+    [KIND_FULL]: "full" }; // the canvas's data-kind, for tests
   const FLAG_EMPTY = 1; // the frame shows nothing but the background
   // the GPU preview (gpu.js): draws the live picture in this browser where it can, else null or inactive
   const gpu = window.ImplgenGpu ? ImplgenGpu.create({ stage: $("stage"), view: canvas, note: $("gpu-note"),
@@ -299,9 +301,7 @@
     ctx2d.drawImage(bitmap, 0, 0, canvas.width, canvas.height);
     lastBitmap = bitmap;
     drawnSeq = fseq; drawnKind = rank; frames += 1;
-    canvas.dataset.seq = fseq;
-    canvas.dataset.kind = { [KIND_FULL]: "full", [KIND_ONE]: "one", [KIND_MORE]: "more", [KIND_QUARTER]: "quarter" }[kind]
-      || "coarse";
+    canvas.dataset.seq = fseq; canvas.dataset.kind = KIND_MARK[kind];
     canvas.dataset.frames = frames;
     const sent = sentAt.get(fseq);
     const ms = sent === undefined ? "" : ` ${Math.round(performance.now() - sent.t)} ms`;
