@@ -3,6 +3,7 @@
     .venv/bin/python bench/view_latency.py [--rounds N] [--orbit-frames N] [--neighbour-seconds S] [-o FILE]
     .venv/bin/python bench/view_latency.py --neighbours-only     # the last measure alone, printed, not written
     nice .venv/bin/python bench/view_latency.py --drag-only [--compare /work/main]   # the drags alone
+    nice .venv/bin/python bench/view_latency.py --glass [--compare /work/main]   # the glassware refinement alone
 
 Starts `implgen view --no-browser --port 0` in its own process with an empty build cache, connects as the page
 does, and for every example shape of degree <= 8, interleaved round by round, measures:
@@ -17,6 +18,11 @@ coarse frames a second that arrive, the longest gap between two, and from the re
 the last view) to the refined frame. With --compare TREE, the same drags against a server run from another
 source tree (PYTHONPATH=TREE/generator: the code before the change), interleaved case by case and round by
 round, so both see the same load.
+With --glass (its own section of the results file): the glassware scene at 640 x 480 and 1280 x 800, a drag then
+the release, interleaved size by size and round by round (and with --compare, tree by tree): from the release to
+the half-size picture, the full size at 1 sample and at 4, how long the drag's last frame, when smaller than a
+quarter of the picture, stays on the page (from its arrival to the first picture of a quarter or more), and the
+server's CPU time from the release to the 4-sample picture.
 Then, with heavy neighbours: one page orbits while three other pages keep sending
 `(x+y+z+a+b+1)^15` with a new constant each time (seconds of SymPy, then a build), and the orbiting page's
 frames per second and its longest wait for a frame are measured.
@@ -28,6 +34,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import statistics
 import subprocess
 import sys
@@ -43,7 +50,16 @@ from implgen.measure.machine import describe as machine
 from implgen.measure.machine import write_results
 from implgen.spec.entry import load_spec
 from implgen.view.dump import spec_mapping
-from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_ONE, MAX_RENDERS_PER_SECOND
+from implgen.view.session import (
+    HEADER,
+    KIND_COARSE,
+    KIND_FULL,
+    KIND_MORE,
+    KIND_ONE,
+    KIND_QUARTER,
+    MAX_RENDERS_PER_SECOND,
+    SAMPLES,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 SHAPES = ROOT / "examples" / "shapes"
@@ -54,8 +70,9 @@ WIDTH, HEIGHT = 640, 480
 class Page:
     """The page's side of the protocol, with a clock."""
 
-    def __init__(self, url: str):
+    def __init__(self, url: str, width: int = WIDTH, height: int = HEIGHT):
         self.ws = connect(url, max_size=64 * 2**20)
+        self.width, self.height = width, height
         self.hello = json.loads(self.ws.recv())
         self.seq = 0
         self.orbit = dict(self.hello["orbit"])
@@ -85,8 +102,8 @@ class Page:
                 "type": "render",
                 "seq": self.seq,
                 "refine": refine,
-                "width": WIDTH,
-                "height": HEIGHT,
+                "width": self.width,
+                "height": self.height,
                 "values": self.values,
                 "orbit": self.orbit,
                 "options": self.options,
@@ -176,20 +193,19 @@ def drag_page(url: str, shape: dict | None, orbit: dict, clip: str | None) -> Pa
     return page
 
 
-def drag(page: Page, seconds: float = DRAG_SECONDS) -> dict[str, float]:
-    """Mouse moves every MOVE_GAP for `seconds` (sent whatever comes back), then the release: coarse frames a
-    second, the longest gap without a frame, the median coarse frame's width, release to refined frame."""
+def moves(page: Page, seconds: float) -> tuple[list[float], list[tuple[int, int]]]:
+    """Mouse moves every MOVE_GAP for `seconds`, sent whatever comes back: the start, the coarse frames' arrival
+    times, the end; the coarse frames' sizes."""
     stop = threading.Event()
-    last = [0]
 
     def mover() -> None:
         while not stop.is_set():
             page.orbit["yaw"] = (page.orbit["yaw"] + 1.0) % 360.0
-            last[0] = page.render(False)
+            page.render(False)
             time.sleep(MOVE_GAP)
 
     start = time.perf_counter()
-    arrivals, widths = [start], []
+    arrivals, sizes = [start], []
     sender = threading.Thread(target=mover, daemon=True)
     sender.start()
     while time.perf_counter() - start < seconds:
@@ -198,32 +214,69 @@ def drag(page: Page, seconds: float = DRAG_SECONDS) -> dict[str, float]:
         except TimeoutError:
             break
         if isinstance(msg, bytes):
-            _, k, _, w, _ = HEADER.unpack(msg[: HEADER.size])
+            _, k, _, w, h = HEADER.unpack(msg[: HEADER.size])
             if k == KIND_COARSE:
                 arrivals.append(time.perf_counter())
-                widths.append(w)
+                sizes.append((w, h))
     stop.set()
     sender.join()
-    end = time.perf_counter()
-    arrivals.append(end)
-    t0 = time.perf_counter()
-    seq = page.render(True)  # the release: the same view as the last move
-    sharp = full = None
-    while full is None:  # the full-size frame at 1 sample (when the server sends one), then at 4
-        msg = page.ws.recv()
-        if isinstance(msg, bytes):
-            s, k, _, _, _ = HEADER.unpack(msg[: HEADER.size])
-            if s == seq and k == KIND_ONE:
-                sharp = time.perf_counter() - t0
-            elif s == seq and k == KIND_FULL:
-                full = time.perf_counter() - t0
+    return arrivals + [time.perf_counter()], sizes
+
+
+RELEASE_KINDS = {KIND_QUARTER: "quarter", KIND_ONE: "one", KIND_FULL: "full"}
+
+
+def release(page: Page, guard: float = 120.0, pid: int | None = None) -> dict:
+    """The release (a refined request for the last move's view): seconds from it to the first picture of each
+    kind (RELEASE_KINDS; KIND_MORE as more2, more3), coarse frames of the drag still arriving ("coarse": the
+    last one's arrival), the refinement's error line if it stopped, the server's CPU seconds to the end."""
+    t0, cpu0 = time.perf_counter(), cpu_seconds(pid)
+    seq = page.render(True)
+    out: dict = {"error": None}
+    while "full" not in out and time.perf_counter() - t0 < guard:
+        try:
+            msg = page.ws.recv(timeout=max(0.01, guard - (time.perf_counter() - t0)))
+        except TimeoutError:
+            break
+        now = time.perf_counter() - t0
+        if isinstance(msg, str):
+            data = json.loads(msg)
+            if data["type"] == "error":
+                out["error"] = data["message"]
+                break
+            continue
+        s, k, _, samples, w, h = SAMPLES.unpack(msg[: SAMPLES.size])
+        if k == KIND_COARSE:
+            out["coarse"] = now
+        elif s == seq:
+            out.setdefault(f"more{samples}" if k == KIND_MORE else RELEASE_KINDS.get(k, str(k)), now)
+    out["cpu"] = cpu_seconds(pid) - cpu0
+    return out
+
+
+def cpu_seconds(pid: int | None) -> float:
+    """User + system CPU seconds of process `pid` so far (0 without one)."""
+    if pid is None:
+        return 0.0
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def drag(page: Page, seconds: float = DRAG_SECONDS) -> dict[str, float]:
+    """Mouse moves every MOVE_GAP for `seconds` (sent whatever comes back), then the release: coarse frames a
+    second, the longest gap without a frame, the median coarse frame's width, release to refined frame."""
+    arrivals, sizes = moves(page, seconds)
+    end = arrivals[-1]
+    after = release(page)
+    if after["error"] is not None:
+        raise RuntimeError(after["error"])
     gaps = [b - a for a, b in zip(arrivals, arrivals[1:])]
     return {
-        "fps": (len(arrivals) - 2) / (end - start),
+        "fps": (len(arrivals) - 2) / (end - arrivals[0]),
         "gap": max(gaps),
-        "width": statistics.median(widths) if widths else 0.0,
-        "sharp": sharp if sharp is not None else full,
-        "release": full,
+        "width": statistics.median(w for w, _ in sizes) if sizes else 0.0,
+        "sharp": after.get("one", after["full"]),
+        "release": after["full"],
     }
 
 
@@ -285,6 +338,179 @@ def drag_lines(new: dict, old: dict | None, rounds: int, compare: Path | None = 
             f"Before: the same drags against the server of `{compare}`, interleaved case by case and round by round.",
         ]
     return lines + [""]
+
+
+GLASSWARE = ROOT / "examples" / "scenes" / "glassware.yaml"
+GLASS_SIZES = ((640, 480), (1280, 800))
+GLASS_DRAG = 1.5  # seconds of mouse moves before each release
+GLASS_GUARD = 120.0  # seconds: a hang guard for one refinement
+GLASS_BEGIN, GLASS_END = "<!-- bench/view_latency.py --glass: begin -->", "<!-- bench/view_latency.py --glass: end -->"
+
+
+def glass_round(page: Page, pid: int) -> dict:
+    """One drag of the glassware page, then the release: what `release` says, and how long the drag's last
+    frame stayed on the page when it was smaller than a quarter of the picture ("small")."""
+    arrivals, sizes = moves(page, GLASS_DRAG)
+    last_w, last_h = sizes[-1] if sizes else (0, 0)
+    last = arrivals[-2] - arrivals[-1]  # the last coarse frame's arrival, from the release (<= 0)
+    out = release(page, GLASS_GUARD, pid)
+    last = out.get("coarse", last)  # a frame of the drag may still come after the release
+    big = [out[k] for k in ("quarter", "one", "full") if k in out]
+    small = 4 * last_w * last_h < page.width * page.height
+    out["small"] = (min(big) - last if big else None) if small else 0.0  # None: no picture came (the budget)
+    out["shown"] = last_w
+    return out
+
+
+def glass(rounds: int, compare: Path | None) -> dict:
+    """The glassware refinement at each size, interleaved round by round (and tree by tree): per tree and size,
+    each measure's list over the rounds (a missing picture is None)."""
+    trees = {"new": None} | ({"old": compare} if compare else {})
+    out: dict = {(t, size): {} for t in trees for size in GLASS_SIZES}
+    with tempfile.TemporaryDirectory(prefix="implgen-bench-glass-") as cache:
+        servers, pages = [], {}
+        try:
+            for tree, path in trees.items():
+                env = dict(os.environ, IMPLGEN_CACHE=str(Path(cache) / tree))
+                if path is not None:
+                    env["PYTHONPATH"] = str(path / "generator")
+                for size in GLASS_SIZES:
+                    server, url = start_server(env, GLASSWARE)
+                    servers.append(server)
+                    page = Page(url, *size)
+                    release(page, GLASS_GUARD * 4)  # built and refined once before the drags
+                    pages[tree, size] = (page, server.pid)
+            for r in range(rounds):
+                for size in GLASS_SIZES:
+                    for tree in trees:
+                        got = glass_round(*pages[tree, size])
+                        for k in ("quarter", "one", "full", "small", "shown", "cpu", "error"):
+                            out[tree, size].setdefault(k, []).append(got.get(k))
+                        print(f"glass round {r + 1}/{rounds} {size} {tree}: {got}", file=sys.stderr, flush=True)
+        finally:
+            for server in servers:
+                server.terminate()
+                server.wait(30)
+    return out
+
+
+QUIET_ONE = 0.73  # s: glassware's 1-sample picture at 640×480 after the release, quiet 2-core AMD EPYC (docs/viewer.md)
+GLASS_PER_PIXEL = 2.4e-6  # s: a pixel at one sample, as the live frames measure it on that machine (the ladder's plan)
+
+
+def glass_work(rounds: int) -> dict:
+    """In this process, this tree's runtime: the core seconds (process CPU time: every thread) from the start of
+    a refinement to each of its pictures, encoding included, the way before (a 1-sample render at the pixel
+    centres, then a 4-sample render from nothing) and the ladder, interleaved round by round. Load inflates CPU
+    time less than wall time, and both ways alike."""
+    import time as _time
+
+    from implgen.scene.build import build_scene
+    from implgen.scene.renderjob import PIXELS_EVEN, RenderJob
+    from implgen.scene.tracer import CScene
+    from implgen.view import frames, ladder
+    from implgen.view.command import document_factory
+
+    doc = document_factory(GLASSWARE)()
+    out: dict = {}
+    for _ in range(rounds):
+        for w, h in GLASS_SIZES:
+            sc = doc.scene(w, h, 4)
+            cs = CScene(sc, build_scene(sc))
+            for way in ("before", "ladder"):
+                t0, got = _time.process_time(), out.setdefault((w, h, way), {})
+                if way == "before":
+                    for stage, spp in (("one", 1), ("full", 4)):
+                        with RenderJob(cs, w, h, spp, sc.max_depth, 2) as job:
+                            frames.live_png(frames.eight_bits(job.run()))
+                        got.setdefault(stage, []).append(_time.process_time() - t0)
+                else:
+                    steps = ladder.plan(w, h, 4, max(GLASS_PER_PIXEL, 1.0 / (w * h)), True)  # a pass a sample
+                    with RenderJob(cs, w, h, 4, sc.max_depth, 2) as job:
+                        for step in steps:
+                            img = job.run_pass(step.k0, step.k1, step.pixels)
+                            frames.live_png(frames.eight_bits(img[::2, ::2] if step.pixels == PIXELS_EVEN else img))
+                            got.setdefault(step.role + (str(step.k1) if step.role == "more" else ""), []).append(
+                                _time.process_time() - t0
+                            )
+            cs.close()
+    return out
+
+
+def work_lines(work: dict) -> list[str]:
+    lines = [
+        "Work (load-robust): core seconds from the start of the refinement to each picture, encoding included, "
+        "rendered in the benchmark's own process with this tree's runtime on 2 threads, the way before (a "
+        "1-sample render, then a 4-sample render from nothing) and the ladder interleaved; *quiet estimate*: "
+        f"{QUIET_ONE} s (the 1-sample picture at 640×480 on a quiet 2-core machine) times the ratio to the "
+        "1-sample render before.",
+        "",
+        "| size | way | → half size | → 1 spp | → 2 spp | → 3 spp | → 4 spp | "
+        "quiet estimate: half size, 1 spp, 4 spp (s) |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for w, h in GLASS_SIZES:
+        base = statistics.median(work[w, h, "before"]["one"])
+        scale = QUIET_ONE * (w * h) / (640 * 480) / base  # the quiet machine's seconds a core second here
+        for way in ("before", "ladder"):
+            m = work[w, h, way]
+            cells = [_median(m[k]) if k in m else "–" for k in ("quarter", "one", "more2", "more3", "full")]
+            est = ", ".join(
+                f"{statistics.median(m[k]) * scale:.2f}" if k in m else "–" for k in ("quarter", "one", "full")
+            )
+            lines.append(f"| {w}×{h} | {way} | " + " | ".join(cells) + f" | {est} |")
+    return lines + [""]
+
+
+def _median(values: list, digits: int = 3) -> str:
+    got = [v for v in values if v is not None]
+    text = f"{statistics.median(got):.{digits}f}" if got else "never"
+    return text + (f" ({len(values) - len(got)} of {len(values)} never)" if got and len(got) < len(values) else "")
+
+
+def glass_lines(out: dict, rounds: int, compare: Path | None, load: tuple[float, float]) -> list[str]:
+    lines = [
+        GLASS_BEGIN,
+        "## The glassware scene after a drag: the refinement ladder",
+        "",
+        f"Written by `bench/view_latency.py --glass --rounds {rounds}"
+        + (f" --compare {compare}`" if compare else "`")
+        + f" on {machine()}; load average (1 min) {load[0]:.2f} before, {load[1]:.2f} after. The server "
+        "(`implgen view examples/scenes/glassware.yaml`, its own process, 2 render threads) and this client share "
+        f"the machine. Each round: mouse moves every {MOVE_GAP * 1e3:.0f} ms for {GLASS_DRAG:g} s, then the release "
+        "(a refined request for the last move's view); sizes and trees interleaved round by round. Medians of "
+        f"{rounds} rounds. *Small frame*: how long the drag's last frame, when smaller than a quarter of the "
+        "picture, stays on the page (from its arrival to the first picture of a quarter or more). *CPU*: the "
+        "server's CPU time from the release to the 4-sample picture, or to the stop (on a quiet 2-core machine "
+        "the wall time is about half of it). *never*: the render budget (20 s) stopped it first. Targets on a "
+        "quiet 2-core machine: 1 sample ≤ 0.3 s, 4 samples ≤ 1.2 s, small frame ≤ 0.3 s.",
+        "",
+        "| size | server | last drag frame (px wide) | release → half size (s) | small frame shown (s) | "
+        "release → 1 spp (s) | release → 4 spp (s) | CPU to 4 spp (core s) |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for (tree, (w, h)), m in out.items():
+        name = "this tree" if tree == "new" else f"`{compare}`"
+        cells = [_median(m["shown"], 0)] + [_median(m[k]) for k in ("quarter", "small", "one", "full", "cpu")]
+        lines.append(f"| {w}×{h} | {name} | " + " | ".join(cells) + " |")
+    lines.append("")
+    for (tree, (w, h)), m in out.items():  # one message of each kind, its figures as the last round had them
+        said = {re.sub(r"[0-9.]+ ms", "N ms", e): e for e in m["error"] if e}
+        if said:
+            name = "this tree" if tree == "new" else f"`{compare}`"
+            stopped = sum(map(bool, m["error"]))
+            lines.append(f"- {w}×{h}, {name}: stopped by the budget in {stopped} of {rounds} rounds, saying")
+            lines += [f"  `{e}`" for e in said.values()]
+    return lines + ["", GLASS_END]
+
+
+def write_glass(path: Path, lines: list[str]) -> None:
+    """The glass section into the results file, in place of the last one (or at its end)."""
+    text = "\n".join(lines) + "\n"
+    old = path.read_text(encoding="utf-8") if path.exists() else ""
+    if GLASS_BEGIN in old and GLASS_END in old:
+        old = old[: old.index(GLASS_BEGIN)] + old[old.index(GLASS_END) + len(GLASS_END) + 1 :]
+    write_results(path, old.rstrip("\n") + "\n\n" + text)
 
 
 NEIGHBOUR_EQUATION = "(x+y+z+a+b+1)^15"
@@ -353,6 +579,7 @@ def main() -> int:
     ap.add_argument("--drag-only", action="store_true", dest="drag_only", help="the drags alone, printed")
     ap.add_argument("--drag-rounds", type=int, default=5, dest="drag_rounds")
     ap.add_argument("--compare", type=Path, help="a source tree whose server the drags are compared with")
+    ap.add_argument("--glass", action="store_true", help="the glassware refinement alone, into its own section")
     ap.add_argument("-o", "--output", type=Path, default=ROOT / "bench" / "results" / "view.md")
     args = ap.parse_args()
     if args.neighbours_only:
@@ -366,6 +593,15 @@ def main() -> int:
             finally:
                 server.kill()
                 server.wait(30)
+        return 0
+    if args.glass:
+        before = os.getloadavg()[0]
+        out = glass(args.rounds, args.compare)
+        work = glass_work(args.rounds)
+        lines = glass_lines(out, args.rounds, args.compare, (before, os.getloadavg()[0]))
+        lines[-1:-1] = work_lines(work)
+        print("\n".join(lines))
+        write_glass(args.output, lines)
         return 0
     if args.drag_only:
         load = os.getloadavg()[0]
@@ -469,9 +705,12 @@ def main() -> int:
     text = "\n".join(lines)
     print(text)
     old = args.output.read_text(encoding="utf-8") if args.output.exists() else ""
-    begin, end = "<!-- bench/view_gpu.py: begin -->", "<!-- bench/view_gpu.py: end -->"
-    if begin in old and end in old:  # bench/view_gpu.py's section of the file stays
-        text = text.rstrip("\n") + "\n\n" + old[old.index(begin) : old.index(end) + len(end)] + "\n"
+    for begin, end in (
+        ("<!-- bench/view_gpu.py: begin -->", "<!-- bench/view_gpu.py: end -->"),
+        (GLASS_BEGIN, GLASS_END),
+    ):
+        if begin in old and end in old:  # the sections of bench/view_gpu.py and of --glass stay
+            text = text.rstrip("\n") + "\n\n" + old[old.index(begin) : old.index(end) + len(end)] + "\n"
     write_results(args.output, text)
     return 0
 

@@ -131,6 +131,13 @@ void rt_render_free(rt_render *r);
  * samples depend only on the pixel's place in the whole image. Returns 0, or -1 for a range outside
  * [0, height) or empty. */
 int rt_render_set_rows(rt_render *r, int y0, int y1);
+/* Which pixels a pass renders (rt_render_set_pass): all, those whose x and y are both even, or the others. */
+enum { RT_PIXELS_ALL = 0, RT_PIXELS_EVEN = 1, RT_PIXELS_ODD = 2 };
+/* The next run is a pass: it adds samples [k0, k1) of each pixel of `pixels` (the samples a whole render takes,
+ * in its order) to sums (3 doubles a pixel of the rows rendered, row y0 first; read only when k0 > 0) and writes
+ * their mean over samples [0, k1) to rgb (the other pixels' rgb is left as it was). Passes [0, a), [a, b), ...,
+ * [., spp) over every pixel leave rgb bit for bit the whole render's. Returns 0, or -1 for bad arguments. */
+int rt_render_set_pass(rt_render *r, int k0, int k1, int pixels, double *sums);
 /* Renders into rgb ((y1 - y0) * width * 3 floats, row y0 first; all rows unless set). Blocks; safe to call
  * from a thread the caller does not block on. Returns 0, 1 when cancelled, -1 when threads could not be
  * started. */

@@ -11,6 +11,12 @@
  * next; the mutable fields sit on cache lines of their own, away from the camera frame every pixel reads;
  * and each thread writes the first touch of its own rows (no serial clearing of the image before the
  * threads start: only rows a cancelled render never reached are cleared, after it).
+ *
+ * A render may also be made in passes (rt_render_set_pass), as a viewer refines its picture: each pass adds
+ * samples [k0, k1) of every pixel, the very samples a whole render takes, to running sums in double kept by
+ * the caller, in the same order, so that after the last pass (k1 = spp) the image is the whole render's bit for
+ * bit. A pass may take only the pixels whose x and y are both even (a quarter of them: a half-size picture
+ * first) or only the others.
  */
 #if defined(__linux__) && !defined(_GNU_SOURCE)
 #define _GNU_SOURCE /* sched_getaffinity, sched_setaffinity: one thread per core when all cores render */
@@ -29,7 +35,10 @@
 struct rt_render {
     const rt_scene *s;
     int width, height, spp, max_depth, threads;
-    int y0, y1; /* the rows rt_render_run renders: [y0, y1) of the image (all of it unless set) */
+    int y0, y1;   /* the rows rt_render_run renders: [y0, y1) of the image (all of it unless set) */
+    int k0, k1;   /* the samples of each pixel rt_render_run adds: [k0, k1) of spp (all of them unless set) */
+    int pixels;   /* which pixels it renders: RT_PIXELS_ALL, RT_PIXELS_EVEN or RT_PIXELS_ODD */
+    double *sums; /* a pass's running sums, 3 a pixel of rows [y0, y1); NULL for a whole render */
     unsigned long seed;
     float *rgb;
     /* camera frame */
@@ -87,6 +96,9 @@ rt_render *rt_render_new(const rt_scene *s, int width, int height, int spp, int 
     r->height = height;
     r->y0 = 0;
     r->y1 = height;
+    r->k0 = 0;
+    r->k1 = spp;
+    r->pixels = RT_PIXELS_ALL;
     r->spp = spp;
     r->max_depth = max_depth < 0 ? 0 : (max_depth > RT_MAX_DEPTH ? RT_MAX_DEPTH : max_depth);
     r->threads = threads < 1 ? 1 : threads;
@@ -125,12 +137,94 @@ int rt_render_set_rows(rt_render *r, int y0, int y1)
     return 0;
 }
 
+int rt_render_set_pass(rt_render *r, int k0, int k1, int pixels, double *sums)
+{
+    if (!r || k0 < 0 || k1 > r->spp || k0 >= k1 || pixels < RT_PIXELS_ALL || pixels > RT_PIXELS_ODD || !sums)
+        return -1;
+    pthread_mutex_lock(&r->lock);
+    r->k0 = k0;
+    r->k1 = k1;
+    r->pixels = pixels;
+    r->sums = sums;
+    pthread_mutex_unlock(&r->lock);
+    return 0;
+}
+
 void rt_render_free(rt_render *r)
 {
     if (!r)
         return;
     pthread_mutex_destroy(&r->lock);
     free(r);
+}
+
+/* The pixel's random stream, after the stratification's permutation (perm) is drawn from it, as render_row
+ * draws them: sample k's two numbers are the stream's next two once samples 0 .. k-1 have taken theirs. */
+static uint64_t pixel_stream(const rt_render *r, int x, int y, int *perm)
+{
+    uint64_t rng = (uint64_t)r->seed * 0x100000001B3ULL ^ ((uint64_t)y * (uint64_t)r->width + (uint64_t)x);
+    int k;
+    splitmix64(&rng);
+    /* N-rooks stratification: sample k sits in column stratum k and row stratum perm[k]. */
+    for (k = 0; k < r->spp; ++k)
+        perm[k] = k;
+    for (k = r->spp - 1; k > 0; --k) {
+        int j = (int)(splitmix64(&rng) % (uint64_t)(k + 1)), t = perm[k];
+        perm[k] = perm[j];
+        perm[j] = t;
+    }
+    return rng;
+}
+
+/* A pass's row (rt_render_set_pass): its pixels' samples [k0, k1) added to their sums. The samples are
+ * render_row's, drawn from the same stream in the same order (a test holds the two to the same image). */
+static void render_row_pass(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
+{
+    int x, k, a, x0 = 0, step = 1;
+    const double py_centre = (1.0 - 2.0 * (y + 0.5) / r->height) * r->tan_half;
+    if (r->pixels != RT_PIXELS_ALL && y % 2 == 0) { /* even pixels: even x of an even row; the others: odd x */
+        x0 = r->pixels == RT_PIXELS_ODD;
+        step = 2;
+    } else if (r->pixels == RT_PIXELS_EVEN) {
+        return; /* an odd row has no even pixel */
+    }
+    for (x = x0; x < r->width; x += step) {
+        const size_t at = ((size_t)(y - r->y0) * (size_t)r->width + (size_t)x) * 3;
+        uint64_t rng = r->spp > 1 ? pixel_stream(r, x, y, perm) : 0;
+        double acc[3] = {0.0, 0.0, 0.0};
+        for (k = 0; k < r->k0; ++k) { /* a later pass: the samples before k0 are in the sums */
+            splitmix64(&rng);
+            splitmix64(&rng);
+        }
+        if (r->k0 > 0)
+            memcpy(acc, r->sums + at, sizeof acc);
+        for (k = r->k0; k < r->k1; ++k) {
+            double sx, sy, px, py, d[3], c[3];
+            if (r->spp == 1) {
+                px = (2.0 * (x + 0.5) / r->width - 1.0) * r->tan_half * r->aspect;
+                py = py_centre;
+            } else {
+                sx = (k + uniform01(&rng)) / r->spp;
+                sy = (perm[k] + uniform01(&rng)) / r->spp;
+                px = (2.0 * (x + sx) / r->width - 1.0) * r->tan_half * r->aspect;
+                py = (1.0 - 2.0 * (y + sy) / r->height) * r->tan_half;
+            }
+            for (a = 0; a < 3; ++a)
+                d[a] = px * r->u[a] + py * r->v[a] - r->w[a];
+            rt_trace_ray(r->s, r->eye, d, r->max_depth, c, stats);
+            if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {
+                stats[RT_NONFINITE] += 1.0;
+                continue;
+            }
+            for (a = 0; a < 3; ++a)
+                acc[a] += c[a];
+        }
+        for (a = 0; a < 3; ++a) {
+            double v = acc[a] / r->k1;
+            r->rgb[at + (size_t)a] = (float)v;
+        }
+        memcpy(r->sums + at, acc, sizeof acc);
+    }
 }
 
 static void render_row(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
@@ -245,7 +339,10 @@ static void *worker(void *arg)
         }
         y = r->next_row++;
         pthread_mutex_unlock(&r->lock);
-        render_row(r, y, stats, perm);
+        if (r->sums)
+            render_row_pass(r, y, stats, perm);
+        else
+            render_row(r, y, stats, perm);
     }
     free(perm);
     return NULL;

@@ -14,7 +14,7 @@ import pytest
 from implgen.scene.build import build_scene
 from implgen.scene.load import load_scene
 from implgen.scene.render import render
-from implgen.scene.renderjob import RenderJob
+from implgen.scene.renderjob import PIXELS_ALL, PIXELS_EVEN, PIXELS_ODD, RenderJob
 from implgen.scene.tracer import CScene
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -80,6 +80,43 @@ def test_one_run_per_job_and_only_inside_the_block(trio) -> None:
     with pytest.raises(RuntimeError, match="runs once"):
         RenderJob(cs, W, H, 1, 4, 1).run()
     job.cancel()  # after the block: does nothing
+
+
+def test_passes_make_the_whole_render_bit_for_bit(trio) -> None:
+    """The viewer's ladder: sample 0 of the pixels with even x and y (a half-size picture), of the others (the
+    whole picture at 1 sample), then samples 1 to 3 added: render()'s 4-sample image, bit for bit."""
+    sc, cs = trio
+    whole = render(sc, width=W, height=H, spp=4, max_depth=4, threads=2, seed=5)
+    with RenderJob(cs, W, H, 4, 4, 2, seed=5) as job:
+        quarter = job.run_pass(0, 1, PIXELS_EVEN)[::2, ::2].copy()
+        assert job.stats().rays["primary"] == ((W + 1) // 2) * ((H + 1) // 2)
+        one = job.run_pass(0, 1, PIXELS_ODD).copy()
+        two = job.run_pass(1, 2).copy()
+        last = job.run_pass(2, 4)
+        assert job.stats().rays["primary"] == W * H * 4  # no sample rendered twice
+    assert np.array_equal(last, whole)
+    assert np.array_equal(quarter, one[::2, ::2])
+    with RenderJob(cs, W, H, 4, 4, 1, seed=5) as job:  # sample 0 of every pixel in one pass: the same picture
+        assert np.array_equal(job.run_pass(0, 1), one)
+        assert np.array_equal(job.run_pass(1, 2), two)  # the mean of samples 0 and 1
+    assert 0 < np.abs(two - one).max() and 0 < np.abs(last - two).max()
+
+
+def test_passes_go_in_order(trio) -> None:
+    _, cs = trio
+    with RenderJob(cs, W, H, 4, 4, 1) as job:
+        for k0, k1, pixels in ((1, 2, PIXELS_ALL), (0, 5, PIXELS_ALL), (0, 0, PIXELS_ALL), (0, 1, 7)):
+            with pytest.raises(RuntimeError, match="out of order"):
+                job.run_pass(k0, k1, pixels)
+        job.run_pass(0, 1, PIXELS_EVEN)
+        with pytest.raises(RuntimeError, match="out of order"):
+            job.run_pass(1, 2)  # the odd pixels have no sample 0 yet
+        with pytest.raises(RuntimeError, match="runs once"):
+            job.run()
+    with RenderJob(cs, W, H, 4, 4, 1) as job:
+        job.run()
+        with pytest.raises(RuntimeError, match="out of order"):
+            job.run_pass(0, 1)
 
 
 def _wait_for_rows(job: RenderJob, rows: int = 1) -> None:

@@ -29,7 +29,7 @@ from implgen.view.command import document_factory
 from implgen.view.document import Document
 from implgen.view.protocol import MAX_MESSAGE
 from implgen.view.server import create_app, origin_allowed
-from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_ONE, KIND_SAVE, Session
+from implgen.view.session import HEADER, KIND_COARSE, KIND_FULL, KIND_MORE, KIND_ONE, KIND_QUARTER, KIND_SAVE, Session
 from view_fixtures import BALLS_SCENE
 
 SCENES = ROOT / "examples" / "scenes"
@@ -124,7 +124,7 @@ def test_coarse_then_full_frame_match_the_normal_render(client) -> None:
         ch, cw = coarse.shape[:2]  # a page's first coarse frame: at most half the width and height
         assert (seq, kind) == (3, KIND_COARSE) and 16 <= cw <= 80 and ch == round(cw * 0.75)
         seq, kind, full = frame(picture(ws))
-        if kind == KIND_ONE:  # the full size at 1 sample first, when the 4 samples are expected to be slow
+        while kind in (KIND_QUARTER, KIND_ONE, KIND_MORE):  # the refinement's first pictures, when it may be slow
             seq, kind, full = frame(picture(ws))
         assert (seq, kind, full.shape) == (3, KIND_FULL, (120, 160, 3))
     # the same view through parse_scene + render(): the full frame is lossless PNG of the same samples

@@ -187,6 +187,60 @@ def test_the_page_in_a_real_browser(server, driver) -> None:
     assert parse_spec({"name": "t", "equation": EQUATION, "params": {"c": 11.8}}).degree == 4
 
 
+# Every kind the canvas is marked with, in order: a MutationObserver keeps each old value of data-seq and data-kind
+RECORD_KINDS = """
+const c = document.getElementById('view');
+window.seenKinds = [];
+new MutationObserver((records) => {
+  for (const r of records) window.seenKinds.push([r.attributeName, r.oldValue]);
+}).observe(c, {attributes: true, attributeOldValue: true, attributeFilter: ['data-seq', 'data-kind']});
+"""
+
+
+def drawn_kinds(driver) -> list[tuple[int, str]]:
+    """(seq, kind) of each frame the page drew since RECORD_KINDS ran (drawFrame sets data-seq, then data-kind)."""
+    seen = driver.execute_script("return window.seenKinds")
+    now = driver.execute_script("const c = document.getElementById('view'); return [c.dataset.seq, c.dataset.kind];")
+    seqs = [old for name, old in seen if name == "data-seq"][1:] + [now[0]]
+    kinds = [old for name, old in seen if name == "data-kind"][1:] + [now[1]]
+    return list(zip(map(int, seqs), kinds))
+
+
+def test_after_a_drag_the_page_draws_the_refinement_ladder_in_order(server, driver, monkeypatch) -> None:
+    """The drag's frames kept under a quarter of the picture and the ladder forced into passes of one sample:
+    after the release the page draws the half-size picture, the full size at 1 sample, at 2 and 3, then at 4,
+    each better than the one before it, and its status line says which; the last is render()'s picture."""
+    from selenium.webdriver.common.action_chains import ActionChains
+
+    from implgen.view import ladder, pace
+
+    monkeypatch.setattr(ladder, "REFINE_TARGET", 0.0)
+    monkeypatch.setattr(ladder, "PASS_TARGET", 0.0)
+    monkeypatch.setattr(pace, "MAX_DIVISOR", 3)  # coarse frames of at most a ninth of the picture
+    driver.get(server)
+    first = wait_full_after(driver, -1)
+    driver.execute_script(RECORD_KINDS)
+    canvas = driver.find_element("id", "view")
+    ActionChains(driver).move_to_element(canvas).click_and_hold().move_by_offset(30, 5).move_by_offset(
+        30, 5
+    ).release().perform()
+    last = wait_full_after(driver, first)
+    drawn = drawn_kinds(driver)
+    after_drag = drawn[max(i for i, (_, kind) in enumerate(drawn) if kind == "coarse") + 1 :]
+    assert [kind for _, kind in after_drag][:5] == ["quarter", "one", "more", "more", "full"], drawn
+    # (the pointer's rest before the release may have started the ladder: the release's request, for the same
+    # view, renumbers the rest of it)
+    seqs = [seq for seq, _ in after_drag]
+    assert seqs == sorted(seqs) and after_drag[-1] == (last, "full"), drawn
+    w, h = driver.execute_script("const c = document.getElementById('view'); return [c.width, c.height];")
+    assert driver.find_element("id", "status").text.startswith(f"full {w} x {h} ")
+    doc = document_factory(None)()
+    doc.orbit = protocol.parse_orbit(driver.execute_script("return window.implgenState().orbit"))
+    doc.options.clip_size = float(driver.find_element("id", "clip-size").get_attribute("value"))
+    ref = to_uint8(render(doc.scene(w, h, 4), threads=2)).astype(int)
+    assert np.abs(canvas_pixels(driver) - ref).mean() < 1.0
+
+
 def test_beyond_loopback_the_page_works_through_its_token(driver) -> None:
     """A server listening on every address (as `--host 0.0.0.0`) asks for its token: the page opened with the
     link's token draws its picture (the page hands the token to its socket); without it, the page is refused.

@@ -323,16 +323,23 @@ def test_renders_and_saves_are_cut_by_a_time_budget(servers) -> None:
     p.render(refine=True, width=640, height=480)
     err = p.reply()
     assert err["type"] == "error", err
-    cost = r"this surface costs (more than )?[0-9.e+]+ ms a pixel"
+    # the message names what is rendered (the shape's name, kept from the starter: a scene's is its file name),
+    # the size of the picture that was stopped (the smallest live frame, or the full one), and what to do
+    cost = r"torus costs (more than )?[0-9.e+]+ ms a pixel"
     row = r"a row of 640 pixels would take about [0-9.e+]+ s, more than the 1 s budget of a render: .*"
-    assert re.fullmatch(f"render: {cost}: (render stopped after 1 s|{row})", err["message"]), err
+    stopped = (
+        r"its (48 × 36|640 × 480) picture stopped after 1 s: try a smaller window, or a larger budget "
+        r"\(IMPLGEN_VIEW_RENDER_BUDGET\)"
+    )
+    assert re.fullmatch(f"render: {cost}: ({stopped}|{row})", err["message"]), err
     p.send(type="save_png", width=16, height=4096, spp=1)  # short rows, a minute in all
     err = p.reply()
-    assert re.fullmatch(f"save_png: {cost}: save stopped after 1.5 s", err["message"]), err
+    stopped = "the 16 × 4096 save stopped after 1.5 s: try fewer samples or fewer pixels"
+    assert re.fullmatch(f"save_png: {cost}: {stopped}", err["message"]), err
     p.send(type="save_png", width=2048, height=64, spp=64)  # one row: minutes
     err = p.reply()
     assert re.fullmatch(
-        rf"save_png: {cost} \(64 samples\): a row of 2048 pixels would take about [0-9.e+]+ s, more than the "
+        rf"save_png: {cost} at 64 samples: a row of 2048 pixels would take about [0-9.e+]+ s, more than the "
         r"1.5 s budget of a save: fewer pixels a row or fewer samples",
         err["message"],
     ), err

@@ -11,6 +11,17 @@ asyncio.to_thread) while the caller polls `progress` or calls `cancel`; both are
 before the run starts (a cancel then stops it at once) or after the context is freed (they do nothing).
 The output image is allocated on entry, so `run` times the C loop alone (what `implgen bench render`
 reports). One run per job.
+
+A job may instead be rendered in passes, as the viewer refines a resting view (view/ladder.py):
+
+    with RenderJob(cs, width, height, 4, max_depth, threads) as job:
+        job.run_pass(0, 1, PIXELS_EVEN)   # sample 0 of the pixels whose x and y are even: img[::2, ::2]
+        job.run_pass(0, 1, PIXELS_ODD)    # sample 0 of the others: the whole picture at 1 sample
+        img = job.run_pass(1, 4)          # samples 1 to 3 added: bit for bit run()'s image at 4 samples
+
+Each pass adds the samples a whole render takes to running sums in double (kept by the job), in the same
+order, so the last pass's image is the whole render's bit for bit; the image between passes is the mean of the
+samples so far.
 """
 
 from __future__ import annotations
@@ -24,6 +35,7 @@ import numpy as np
 
 from implgen.scene.tracer import CScene
 
+PIXELS_ALL, PIXELS_EVEN, PIXELS_ODD = 0, 1, 2  # the pixels a pass renders (RT_PIXELS_*): all, x and y even, the others
 RAY_KINDS = ("primary", "shadow", "secondary")  # the first three stats slots (RT_RAYS_*)
 CANCELLED = 1  # rt_render_run's result when cancelled; 0 is done, anything else a failure
 
@@ -54,6 +66,8 @@ class RenderJob:
         self.rows = (0, height) if rows is None else rows
         self.seconds = 0.0  # wall time of rt_render_run, once run
         self.image: np.ndarray | None = None
+        self._sums: np.ndarray | None = None  # the passes' running sums (run_pass)
+        self._samples = {PIXELS_EVEN: 0, PIXELS_ODD: 0}  # samples a pixel the passes have added, by lattice
         self._ctx = None
         self._ran = False
         self._guard = threading.Lock()  # the context pointer: cancel/progress/stats vs free
@@ -89,18 +103,53 @@ class RenderJob:
         with self._running:
             with self._guard:
                 ctx = self._ctx
-                if self._ran or ctx is None:
+                if self._ran or ctx is None:  # run once, and never after a pass
                     raise RuntimeError("a RenderJob runs once, inside its with block")
                 self._ran = True
-            ptr = self.image.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
-            t0 = time.perf_counter()
-            code = self.cs.lib.rt_render_run(ctx, ptr)
-            self.seconds = time.perf_counter() - t0
+            code = self._run_c(ctx)
+        return self._outcome(code)
+
+    def _run_c(self, ctx) -> int:
+        """rt_render_run into the image, timed (under _running)."""
+        ptr = self.image.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
+        t0 = time.perf_counter()
+        code = self.cs.lib.rt_render_run(ctx, ptr)
+        self.seconds = time.perf_counter() - t0
+        return code
+
+    def _outcome(self, code: int) -> np.ndarray | None:
         if code == CANCELLED:
             return None
         if code != 0:
             raise RuntimeError(f"render failed (code {code})")
         return self.image
+
+    def run_pass(self, k0: int, k1: int, pixels: int = PIXELS_ALL) -> np.ndarray | None:
+        """Render samples [k0, k1) of `pixels` (blocking), added to the samples before k0 that earlier passes
+        rendered: the image (the mean so far for those pixels), or None when cancelled. Passes go in order, each
+        starting where the last one of its pixels ended; `run` is then not allowed. RuntimeError otherwise."""
+        lattices = (PIXELS_EVEN, PIXELS_ODD) if pixels == PIXELS_ALL else (pixels,)
+        with self._running:
+            with self._guard:
+                ctx = self._ctx
+                whole = self._ran and self._sums is None  # run() has rendered this job
+                if (
+                    ctx is None
+                    or whole
+                    or any(self._samples.get(p) != k0 for p in lattices)
+                    or not k0 < k1 <= self._args[2]
+                ):
+                    raise RuntimeError(f"pass [{k0}, {k1}) out of order, or outside the with block")
+                self._ran = True
+                if self._sums is None:
+                    self._sums = np.zeros(self.image.shape, np.float64)
+                if self.cs.lib.rt_render_set_pass(ctx, k0, k1, pixels, _doubles(self._sums)) != 0:
+                    raise RuntimeError("rt_render_set_pass failed")
+            code = self._run_c(ctx)
+            if code == 0:
+                for p in lattices:
+                    self._samples[p] = k1
+        return self._outcome(code)
 
     def cancel(self) -> None:
         """Ask the run to stop after its current rows (thread-safe; before the run: it will stop at once)."""
@@ -120,3 +169,7 @@ class RenderJob:
             if self._ctx:
                 self.cs.lib.rt_render_stats(self._ctx, out)
         return RenderStats(dict(zip(RAY_KINDS, out[:3])), int(out[3]))
+
+
+def _doubles(a: np.ndarray):
+    return a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))

@@ -55,6 +55,7 @@ def bind(lib: ctypes.CDLL) -> ctypes.CDLL:
         ),
         "rt_render_free": (None, [vp]),
         "rt_render_set_rows": (ctypes.c_int, [vp, ctypes.c_int, ctypes.c_int]),
+        "rt_render_set_pass": (ctypes.c_int, [vp, ctypes.c_int, ctypes.c_int, ctypes.c_int, _pd]),
         "rt_render_run": (ctypes.c_int, [vp, ctypes.POINTER(ctypes.c_float)]),
         "rt_render_progress": (ctypes.c_int, [vp]),
         "rt_render_cancel": (None, [vp]),

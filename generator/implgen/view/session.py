@@ -7,9 +7,9 @@ throwing it away at each mouse move would leave a drag with no frames at all whe
 the gap between moves. Nothing slow runs on the event loop: parses and builds go to the `parse` pool, live
 frames to the `render` pool, saves to the `save` pool (work.py), each C render under a Ticket with its time
 budget. Each request is first drawn coarse (1 sample per pixel, sent as JPEG, its size chosen by pace.py so
-that it takes about 30 ms) and, when it asks to be refined and nothing newer has come, at full size with 4
-samples (sent as PNG; first at 1 sample when the 4 would take more than REFINE_TARGET). A refined request for
-the view the last coarse frame showed goes straight to the full frame.
+that it takes about 30 ms) and, when it asks to be refined and nothing newer has come, refined pass by pass to
+`implgen render`'s picture at 4 samples (ladder.py). A refined request for the view the last coarse frame showed
+goes straight to the ladder, for the view being refined lets it go on, for the view last refined gets it again.
 
 A slider moves a param value: the scene description is rebuilt around the already loaded library (microseconds;
 params are run-time values of the generated code). A new equation is parsed once (protocol.py keeps the recent
@@ -21,18 +21,20 @@ have stopped: the server counts the page until then.
 from __future__ import annotations
 
 import asyncio
+import functools
 import logging
 import struct
 import time
 from collections.abc import Awaitable, Callable
 from dataclasses import replace
+from pathlib import Path
 
 from implgen import validate
 from implgen.errors import UserError
 from implgen.scene.build import BuildResult, build_scene, runtime_ready
 from implgen.scene.model import Scene
 from implgen.scene.render import usable_cores
-from implgen.view import dump, fit, frames, gpu, pick, protocol, sharepage
+from implgen.view import dump, fit, frames, gpu, ladder, pick, protocol, sharepage
 from implgen.view.document import Document
 from implgen.view.meshsave import MeshSaver
 from implgen.view.pace import CUT, Pace
@@ -42,9 +44,11 @@ FULL_SPP = 4
 MAX_RENDERS_PER_SECOND = 60  # per page: requests beyond this wait (and are overtaken by newer ones)
 KIND_COARSE, KIND_FULL, KIND_SAVE, KIND_ONE = 0, 1, 2, 3  # KIND_ONE: full size at 1 sample, before KIND_FULL
 KIND_MESH = 4  # Save mesh's STL (meshsave.py)
+KIND_QUARTER, KIND_MORE = 5, 6  # the refinement's half-size picture; full size at 2 to FULL_SPP - 1 samples
+LADDER_KINDS = {"quarter": KIND_QUARTER, "one": KIND_ONE, "more": KIND_MORE, "full": KIND_FULL}  # ladder.py's steps
 BUILD_QUIET, BUILD_POLL = 0.2, 0.4  # seconds: a build says nothing before the first, then repeats its progress
-REFINE_TARGET = 0.4  # seconds: a refined frame expected to take longer is first sent at 1 sample (KIND_ONE)
 HEADER = struct.Struct(">IBBxxHH")  # seq, kind, flags, width, height; the image bytes follow
+SAMPLES = struct.Struct(">IBBHHH")  # HEADER with its spare bytes read: the samples a pixel of a KIND_MORE frame
 FLAG_EMPTY = 1  # no pixel of the frame shows anything but the background: no real points in view
 
 log = logging.getLogger("implgen.view")
@@ -73,7 +77,9 @@ class Session:
         self._wake = asyncio.Event()
         self._live: Ticket | None = None  # the live render in progress
         self._live_full = False  # it is a refined frame (a newer request cancels it; a coarse one is finished)
-        self._shown: tuple | None = None  # the view the last coarse frame showed
+        self._shown, self._shown_pixels = None, 0  # the view the last coarse frame showed, and its pixels
+        self._ladder: list | None = None  # [view, seq] of the refinement running: its frames carry seq
+        self._final: tuple | None = None  # (view, width, height, bytes, empty) of the last refined frame sent
         self.pace = Pace()  # the coarse frames' size
         self._seconds = 0.0  # the last render's wall time, encoding included
         self._told = False  # the page was told a build is going on
@@ -155,6 +161,7 @@ class Session:
         else:
             index = validate.whole("object", "index", data.get("index"), 0, count - 1)
         self.doc.select(index)
+        self._final = None
         self._cost = None
         self.pace.new_shape()
         self._shape_id += 1
@@ -173,7 +180,7 @@ class Session:
             probe = fit.probe_scene(spec, trial.values)
             fitted = await self.work.call(self.work.render, fit.fit_clip, probe, await self._library(probe))
         self.doc.spec, self.doc.values = trial.spec, trial.values
-        self._shown = None  # an accepted shape is drawn coarse first, even the same one again
+        self._shown = self._final = None  # an accepted shape is drawn coarse first, even the same one again
         self._cost = None  # measured anew by the new shape's first render
         self.pace.new_shape()
         self._shape_id += 1
@@ -215,7 +222,11 @@ class Session:
 
     def request(self, req: protocol.RenderRequest) -> None:
         """The newest request wins: it replaces the waiting one and cancels the running refined render (a
-        coarse one is finished: it is the drag's next frame)."""
+        coarse one is finished: it is the drag's next frame). A refined request for the view being refined
+        changes nothing: the refinement goes on, its frames numbered for the newer request."""
+        if req.refine and self._ladder is not None and self._pending is None and self._ladder[0] == self._view(req):
+            self._ladder[1] = req.seq
+            return
         self._pending = req
         if self._live is not None and self._live_full:
             self._live.cancel()
@@ -244,16 +255,19 @@ class Session:
                 await self._failed(err, "viewer render failed")
 
     async def _frames(self, req: protocol.RenderRequest) -> None:
-        view = (req.width, req.height, req.values, req.orbit, req.options, id(self.doc.spec))
+        view = self._view(req)
         if req.gpu and not req.refine:
             return  # the page draws the live picture itself: the view is noted (and a refinement cancelled)
+        if req.refine and self._final is not None and self._final[0] == view:
+            await self._send_frame(req.seq, KIND_FULL, *self._final[1:])  # nothing changed: the same picture
+            return
         while not (req.refine and (view == self._shown or req.gpu)):
             cw, ch = self.pace.size(req.width, req.height)
             smallest = self.pace.smallest(req.width, req.height, cw)
             data, ticket = await self._render(cw, ch, 1, frames.live_jpeg, full=False, cut=not smallest)
             if data is not None:
                 self.pace.measured(cw * ch, self._seconds)
-                self._shown = view
+                self._shown, self._shown_pixels = view, cw * ch
                 await self._send_frame(req.seq, KIND_COARSE, cw, ch, *data)
                 break
             if ticket is None or not ticket.expired:
@@ -267,15 +281,35 @@ class Session:
                 return  # the next request is drawn at the new size
             # else this view again, smaller: it is all the page will see until the next move
         if req.refine and self._pending is None:
-            per_pixel = self.pace.seconds_per_pixel
-            if per_pixel is None or per_pixel * req.width * req.height * FULL_SPP > REFINE_TARGET:
-                data, _ = await self._render(req.width, req.height, 1, frames.live_png, full=True)
-                if data is None or self._pending is not None:
-                    return
-                await self._send_frame(req.seq, KIND_ONE, req.width, req.height, *data)
-            data, _ = await self._render(req.width, req.height, FULL_SPP, frames.live_png, full=True)
-            if data is not None:
-                await self._send_frame(req.seq, KIND_FULL, req.width, req.height, *data)
+            await self._refine(req, view)
+
+    async def _refine(self, req: protocol.RenderRequest, view: tuple) -> None:
+        """The refinement ladder (ladder.py) of the request's view, each picture sent as its pass ends."""
+        small = not req.gpu and self._shown_pixels * 4 < req.width * req.height
+        steps = ladder.plan(req.width, req.height, FULL_SPP, self.pace.seconds_per_pixel, small)
+        sc = self.doc.scene(req.width, req.height, FULL_SPP)
+        lib = await self._library(sc)
+        if self._pending is not None:  # overtaken while the scene was being built
+            return
+        ticket = self._ticket(req.width, req.height, FULL_SPP, "render", "render", self.work.limits.render_budget)
+        ticket.begin_pass(1, 1.0)  # (a row of the first pass)
+        ticket.check_rows(self._cost)
+        self._ladder, self._live, self._live_full = [view, req.seq], ticket, True
+        try:
+            send = functools.partial(self._send_picture, view=view)
+            done = await ladder.refine(self.work, ticket, sc, lib, steps, self.threads, send)
+        finally:
+            self._ladder, self._live, self._cost = None, None, ticket.cost or self._cost
+        if not done and ticket.expired:
+            raise ticket.over_budget()
+
+    async def _send_picture(self, p: ladder.Picture, view: tuple) -> None:
+        kind, flags = LADDER_KINDS[p.step.role], FLAG_EMPTY if p.empty else 0
+        head = SAMPLES.pack(self._ladder[1], kind, flags, p.step.k1 if kind == KIND_MORE else 0, p.width, p.height)
+        if kind == KIND_FULL:  # from now on a request for this view gets this picture again (request, _frames)
+            self._final, self._ladder = (view, p.width, p.height, p.data, p.empty), None
+        await self.send(head + p.data)
+        self.frames += 1
 
     async def _send_frame(self, seq: int, kind: int, width: int, height: int, data: bytes, empty: bool) -> None:
         await self.send(HEADER.pack(seq, kind, FLAG_EMPTY if empty else 0, width, height) + data)
@@ -292,7 +326,7 @@ class Session:
         if full and self._pending is not None:  # overtaken while the scene was being built
             return None, None
         budget = min(CUT, self.work.limits.render_budget) if cut else self.work.limits.render_budget
-        ticket = Ticket(budget, "render", "render", width, spp, self.threads)
+        ticket = self._ticket(width, height, spp, "render", "render", budget)
         ticket.check_rows(self._cost)
         self._live, self._live_full = ticket, full
         t0 = time.perf_counter()
@@ -306,13 +340,18 @@ class Session:
             raise ticket.over_budget()
         return data, ticket
 
+    def _ticket(self, width: int, height: int, spp: int, what: str, source: str, budget: float) -> Ticket:
+        """A C render's ticket, its messages naming what is rendered: the scene file, else the shape."""
+        name = Path(self.doc.base.source).name if self.doc.base is not None else self.doc.spec.name
+        return Ticket(budget, what, source, width, spp, self.threads, name=name, height=height)
+
     async def _save_png(self, width: int, height: int, spp: int) -> None:
         """The current view at any size: the same C render context and samples as render(), and the PNG encoder
         write_png uses (the same bytes as `implgen render` writes for this scene)."""
         try:
             sc = self.doc.scene(width, height, spp)
             lib = await self._library(sc)
-            ticket = Ticket(self.work.limits.save_budget, "save", "save_png", width, spp, self.threads)
+            ticket = self._ticket(width, height, spp, "save", "save_png", self.work.limits.save_budget)
             ticket.check_rows(self._cost)
             self._save = ticket
             data = await self.work.trace(
@@ -355,3 +394,7 @@ class Session:
             t.cancel()
         await asyncio.gather(*tasks, return_exceptions=True)  # work.trace waits for the C threads to stop
         await self.meshes.close()
+
+    def _view(self, req: protocol.RenderRequest) -> tuple:
+        """What a request's picture depends on: equal views have equal pictures."""
+        return (req.width, req.height, req.values, req.orbit, req.options, id(self.doc.spec))

@@ -139,11 +139,17 @@ class Pool(Executor):
 class Ticket:
     """The handle of one C render of `width` pixels a row at `spp` samples on `threads` threads, from before it
     starts to after it ends: cancel it (a newer request, the page closed) or let its budget run out, from the event
-    loop, whatever the worker thread is doing. `what` and `source` name it in messages ("save", "save_png")."""
+    loop, whatever the worker thread is doing. `what` and `source` name it in messages ("save", "save_png"), `name`
+    what is rendered (the scene file, or the shape). A render in passes (view/ladder.py) runs each under
+    `begin_pass`, each with the whole budget; `total` is then its samples a pixel, `shown` those sent so far."""
 
-    def __init__(self, budget: float, what: str, source: str, width: int, spp: int, threads: int):
+    def __init__(self, budget: float, what: str, source: str, width: int, spp: int, threads: int, name="", height=0):
         self.budget, self.what, self.source = budget, what, source
         self.width, self.spp, self.threads = width, spp, threads
+        self.name, self.height, self.total = name or "the scene", height, spp
+        self.share = 1.0  # the share of the pixels the run (a pass) renders
+        self.passes = False  # the render is made in passes (begin_pass)
+        self.shown = 0  # samples a pixel of the last whole picture a pass sent (view/ladder.py)
         self._lock = threading.Lock()
         self._job = None  # the RenderJob while it exists
         self._cancelled = False
@@ -162,6 +168,10 @@ class Ticket:
             if self._job is not None:
                 self._job.cancel()
 
+    def begin_pass(self, samples: int, share: float) -> None:
+        """Worker thread, before `attach`: the next run is a pass of `samples` samples over `share` of the pixels."""
+        self.spp, self.share, self.passes = samples, share, True
+
     def attach(self, job, loop: asyncio.AbstractEventLoop) -> None:
         """Worker thread: the RenderJob is about to run; cancelled already, it stops at once; the budget starts."""
         with self._lock:
@@ -177,36 +187,59 @@ class Ticket:
             job, self._job = self._job, None
         rows = job.progress() if job is not None else 0
         if rows:
-            self.cost = job.seconds * self.threads / (rows * self.width * self.spp)
+            self.cost = job.seconds * self.threads / (rows * self.width * self.share * self.spp)
 
     def _arm(self) -> None:
+        """Event loop: the budget's timer for the run going on (a pass's replaces the last pass's)."""
         with self._lock:
+            self.disarm()
             if self._job is not None:
                 left = self.budget - (time.monotonic() - self._started)
                 self._timer = asyncio.get_running_loop().call_later(max(0.0, left), self._expire)
 
     def _expire(self) -> None:
         with self._lock:
-            if self._job is not None and not self._cancelled:
-                self.expired = (time.monotonic() - self._started, self._job.progress())
+            spent = time.monotonic() - self._started
+            late = spent < self.budget  # an earlier pass's timer, come after this pass began: not this one's
+            if self._job is not None and not self._cancelled and not late:
+                self.expired = (spent, self._job.progress())
                 self._job.cancel()
+        if late:
+            self._arm()
 
     def disarm(self) -> None:
         """Event loop, once the render has ended."""
         if self._timer is not None:
             self._timer.cancel()
+            self._timer = None
 
-    def _cost_text(self, per_pixel: str) -> str:
-        return f"this surface costs {per_pixel} a pixel{f' ({self.spp} samples)' if self.spp > 1 else ''}"
+    def _cost_text(self, per_pixel: str, samples: int) -> str:
+        return f"{self.name} costs {per_pixel} a pixel{f' at {samples} samples' if samples > 1 else ''}"
 
     def over_budget(self) -> UserError:
-        """The message for a render its budget stopped: the surface's cost, in core time a pixel."""
+        """The message for a render its budget stopped: what it renders and what that costs (core time a pixel,
+        at one sample for a render in passes), and what to do."""
         seconds, rows = self.expired or (self.budget, 0)
+        samples = 1 if self.passes else self.spp
+        pixels = self.width * self.share * self.spp / samples  # pixels at `samples` a pixel a row
         if rows:
-            cost = f"{seconds * self.threads / (rows * self.width) * 1e3:.2g} ms"
+            cost = f"{seconds * self.threads / (rows * pixels) * 1e3:.2g} ms"
         else:  # no row finished: each thread spent the time on less than one row
-            cost = f"more than {seconds / self.width * 1e3:.2g} ms"
-        return UserError(self.source, f"{self._cost_text(cost)}: {self.what} stopped after {self.budget:g} s")
+            cost = f"more than {seconds / pixels * 1e3:.2g} ms"
+        size, budget = f"{self.width} × {self.height}", f"{self.budget:g} s"
+        if self.what == "save":
+            stopped = f"the {size} save stopped after {budget}: try fewer samples or fewer pixels"
+        elif self.shown:
+            stopped = (
+                f"its {size} picture stopped at {self.shown} of {self.total} samples a pixel (a pass ran past the "
+                f"{budget} budget): a smaller window gets all {self.total} in time"
+            )
+        else:
+            stopped = (
+                f"its {size} picture stopped after {budget}: try a smaller window, or a larger budget "
+                "(IMPLGEN_VIEW_RENDER_BUDGET)"
+            )
+        return UserError(self.source, f"{self._cost_text(cost, samples)}: {stopped}")
 
     def check_rows(self, cost: float | None) -> None:
         """Refuse, before it starts, a render one row of which would outlast the budget at `cost` core seconds a
@@ -215,11 +248,11 @@ class Ticket:
             return
         row = cost * self.width * self.spp  # one thread renders a whole row
         if row > self.budget:
+            costs = self._cost_text(f"{cost * self.spp * 1e3:.2g} ms", self.spp)
             raise UserError(
                 self.source,
-                f"{self._cost_text(f'{cost * self.spp * 1e3:.2g} ms')}: a row of {self.width} pixels would take "
-                f"about {row:.3g} s, more than the {self.budget:g} s budget of a {self.what}: fewer pixels a row "
-                "or fewer samples",
+                f"{costs}: a row of {self.width} pixels would take about {row:.3g} s, more than the "
+                f"{self.budget:g} s budget of a {self.what}: fewer pixels a row or fewer samples",
             )
 
 

@@ -6,10 +6,15 @@
   const $ = (id) => document.getElementById(id);
   const canvas = $("view");
   const ctx2d = canvas.getContext("2d");
-  const HEADER = 12; // seq (u32), kind (u8), flags (u8), 2 spare bytes, width (u16), height (u16)
-  const KIND_COARSE = 0, KIND_FULL = 1, KIND_SAVE = 2, KIND_ONE = 3, KIND_MESH = 4;
-  const RANK = { [KIND_COARSE]: 0, [KIND_ONE]: 1, [KIND_FULL]: 2 }; // a newer frame of the same request wins
-  const KIND_NAME = { [KIND_COARSE]: "coarse", [KIND_ONE]: "full, 1 sample", [KIND_FULL]: "full" };
+  const HEADER = 12; // seq (u32), kind (u8), flags (u8), samples (u16: a KIND_MORE frame's), width (u16), height (u16)
+  const KIND_COARSE = 0, KIND_FULL = 1, KIND_SAVE = 2, KIND_ONE = 3, KIND_MESH = 4, KIND_QUARTER = 5, KIND_MORE = 6;
+  // a better frame of the same request wins: the refinement's half-size picture, 1 sample, more (their count in
+  // the header's spare bytes), all samples
+  const RANK = { [KIND_COARSE]: 0, [KIND_QUARTER]: 1, [KIND_ONE]: 2, [KIND_MORE]: 2, [KIND_FULL]: 1000 };
+  const KIND_NAME = { [KIND_COARSE]: "coarse", [KIND_QUARTER]: "half size, 1 sample", [KIND_ONE]: "full, 1 sample",
+    [KIND_FULL]: "full" };
+  const KIND_MARK = { [KIND_COARSE]: "coarse", [KIND_QUARTER]: "quarter", [KIND_ONE]: "one", [KIND_MORE]: "more",
+    [KIND_FULL]: "full" }; // the canvas's data-kind, for tests
   const FLAG_EMPTY = 1; // the frame shows nothing but the background
   // the GPU preview (gpu.js): draws the live picture in this browser where it can, else null or inactive
   const gpu = window.ImplgenGpu ? ImplgenGpu.create({ stage: $("stage"), view: canvas, note: $("gpu-note"),
@@ -145,12 +150,14 @@
     return true;
   }
 
-  // Coarse frames while something moves; refined once it has rested.
-  function moved() {
+  // Coarse frames while something moves; refined once it has rested (a drag: once the pointer stops, held or not).
+  const REST = 180, DRAG_REST = 100; // ms
+  function movedFor(rest) {
     requestRender(false);
     clearTimeout(restTimer);
-    restTimer = setTimeout(() => requestRender(true), 180);
+    restTimer = setTimeout(() => requestRender(true), rest);
   }
+  function moved() { movedFor(REST); } // (an event listener too: it takes no argument)
 
   function parseParamsText(text) {
     const out = byName();
@@ -274,7 +281,7 @@
   async function drawFrame(buf) {
     const view = new DataView(buf);
     const fseq = view.getUint32(0), kind = view.getUint8(4), flags = view.getUint8(5);
-    const w = view.getUint16(8), h = view.getUint16(10);
+    const samples = view.getUint16(6), w = view.getUint16(8), h = view.getUint16(10);
     const bytes = new Uint8Array(buf, HEADER);
     lastError = "";
     if (kind === KIND_MESH) { implgenMesh.received(bytes); return; } // Save mesh (mesh.js)
@@ -283,8 +290,8 @@
       showMessage(`saved ${w} x ${h} PNG`, false);
       return;
     }
-    const rank = RANK[kind];
-    if (rank === undefined) return;
+    if (RANK[kind] === undefined) return;
+    const rank = RANK[kind] + (kind === KIND_MORE ? samples : 0);
     const stale = () => fseq < drawnSeq || (fseq === drawnSeq && rank <= drawnKind);
     if (stale()) return;
     const type = kind === KIND_COARSE ? "image/jpeg" : "image/png";
@@ -294,15 +301,16 @@
     ctx2d.drawImage(bitmap, 0, 0, canvas.width, canvas.height);
     lastBitmap = bitmap;
     drawnSeq = fseq; drawnKind = rank; frames += 1;
-    canvas.dataset.seq = fseq; canvas.dataset.kind = kind === KIND_FULL ? "full" : kind === KIND_ONE ? "one" : "coarse";
+    canvas.dataset.seq = fseq; canvas.dataset.kind = KIND_MARK[kind];
     canvas.dataset.frames = frames;
     const sent = sentAt.get(fseq);
     const ms = sent === undefined ? "" : ` ${Math.round(performance.now() - sent.t)} ms`;
     if (sent !== undefined && !$("clip-size").classList.contains("bad")) goodClipSize = sent.clip;
     // a picture drawn: the last error is over (not a field's own complaint while it still holds no number)
     if (messageIsError && fseq > errorSeq && !$("clip-size").classList.contains("bad")) showMessage("", false);
-    $("status").textContent = `${KIND_NAME[kind]} ${w} x ${h}${ms}`;
-    if (gpu && kind !== KIND_COARSE) gpu.serverFrame(ctx2d, kind === KIND_FULL);
+    const name = kind === KIND_MORE ? `full, ${samples} samples` : KIND_NAME[kind];
+    $("status").textContent = `${name} ${w} x ${h}${ms}`;
+    if (gpu && kind !== KIND_COARSE && kind !== KIND_QUARTER) gpu.serverFrame(ctx2d, kind === KIND_FULL);
     showEmpty((flags & FLAG_EMPTY) !== 0);
     for (const k of sentAt.keys()) if (k < fseq) sentAt.delete(k);
   }
@@ -433,14 +441,14 @@
       o.yaw = (o.yaw - dx * 0.4) % 360;
       o.pitch = Math.max(-89, Math.min(89, o.pitch + dy * 0.4));
     }
-    requestRender(false);
+    movedFor(DRAG_REST);
   });
   const endDrag = (e) => {
     if (!drag) return;
     const click = !drag.moved;
     drag = null;
     canvas.classList.remove("dragging");
-    if (!click) { requestRender(true); return; }
+    if (!click) { clearTimeout(restTimer); requestRender(true); return; }
     if (sceneMode && e.type === "pointerup") { // a click on a scene: edit the object there
       const r = canvas.getBoundingClientRect();
       const x = (e.clientX - r.left) * canvas.width / r.width, y = (e.clientY - r.top) * canvas.height / r.height;
