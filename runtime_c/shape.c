@@ -71,6 +71,11 @@ static int clip_box(const ig_shape_prep *prep, const double o[3], const double d
     return *t0 <= *t1;
 }
 
+int ig_shape_clip(const ig_shape_prep *prep, const double o[3], const double d[3], double *t0, double *t1)
+{
+    return prep->bounded ? clip_box(prep, o, d, t0, t1) : *t0 <= *t1;
+}
+
 /* The shift point: minimises sum over finite axes of (o_i + t d_i - c_i)^2, clamped to [t0, t1]. */
 double ig_shape_shift_point(const ig_shape_prep *prep, const double o[3], const double d[3], double t0, double t1)
 {

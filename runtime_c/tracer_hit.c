@@ -321,6 +321,7 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
         return 0;
     if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]) || !isfinite(o[0]) || !isfinite(o[1]) || !isfinite(o[2]))
         return 0;
+    RT_TRACE_QUERY(s, o, d, tmin, tmax, mode, skip);
     q.s = s;
     rt_ray_init(&q.ray, o, d, s->far);
     q.tmin = tmin;

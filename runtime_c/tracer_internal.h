@@ -61,6 +61,9 @@ struct rt_scene {
     rt_bvh_node *bvh;
     int nbvh;
     char error[256];
+#ifdef RT_TRACE
+    struct rt_trace_log *trace; /* the instrumented build's record of a render's rays (tracer_floor.c), or NULL */
+#endif
 };
 
 /* One end of an inside-interval: where it is and which surface makes it. */
@@ -121,6 +124,29 @@ enum { RT_CLOSEST = 0, RT_ANY_OPAQUE = 1 };
 /* The object a ray spawned at hit h need not test (rt_scene_closest's `skip`): h's object when it is flat
  * (a plane meets a line once, and that is h itself), else -1. */
 int rt_spawn_skip(const rt_scene *s, const rt_hit *h);
+
+/* The floor report's recording hooks (tracer_floor.c). In the instrumented build (-DRT_TRACE, made by
+ * bench/floor.py) they write the kind of the rays being traced, every scene query and every leaf solve whose ray
+ * enters the leaf's box into the scene's log, if one is attached; otherwise they are empty, and the render loop
+ * is the same code as without them. The kind is kept in the log: record with one render thread. */
+#ifdef RT_TRACE
+void rt_trace_set_kind(const rt_scene *s, int kind);
+void rt_trace_query(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
+                    int skip);
+/* A leaf's solve along o + s u over [lo, hi] (in s) with the given mode (IG_ALL_ROOTS, IG_FIRST_ROOT, IG_ANY_ROOT,
+ * or RT_TRACE_PLANE: the plane's own path, along the ray o + t d as it is), and the nr roots r it gave. */
+void rt_trace_solve(const rt_scene *s, int leaf, const double o[3], const double u[3], double lo, double hi, int mode,
+                    int nr, const double *r);
+#define RT_TRACE_KIND(s, kind) rt_trace_set_kind((s), (kind))
+#define RT_TRACE_QUERY(s, o, d, tmin, tmax, mode, skip) rt_trace_query((s), (o), (d), (tmin), (tmax), (mode), (skip))
+#define RT_TRACE_SOLVE(s, leaf, o, u, lo, hi, mode, nr, r)                                                             \
+    rt_trace_solve((s), (leaf), (o), (u), (lo), (hi), (mode), (nr), (r))
+#else
+#define RT_TRACE_KIND(s, kind) ((void)0)
+#define RT_TRACE_QUERY(s, o, d, tmin, tmax, mode, skip) ((void)0)
+#define RT_TRACE_SOLVE(s, leaf, o, u, lo, hi, mode, nr, r) ((void)0)
+#endif
+#define RT_TRACE_PLANE 3
 
 /* tracer_scene.c */
 void rt_xform_point(const double m[12], const double p[3], double out[3]);
