@@ -50,6 +50,67 @@ void ig_sort(double *r, int k);
 /* Sort ascending and drop exact duplicates; returns the new count. */
 int ig_sort_unique(double *r, int k);
 
+/* ig_roots_core for a nominal degree n <= 2 (a plane's or a quadric's ray polynomial), the method aside (every
+ * method solves these in closed form): the same pipeline -- bad input, exact rescaling, the degree dropped while the
+ * leading coefficient is zero, zero roots taken out, the closed form, then sorting and keeping the roots in
+ * [lo, hi] -- written inline, so that the shape layer's many low-degree solves (every CSG leaf of a glass) skip the
+ * general entry. roots.c's ig_roots_stats answers n <= 2 with it too: one implementation. */
+static inline int ig_roots_low(const double *c, int n, double lo, double hi, int first, double *roots)
+{
+    double p[3], r[3], cmax = 0.0;
+    int k, top, m, deg, cnt = 0, most = first ? 1 : n;
+    if (!(lo <= hi)) /* also NaN bounds */
+        return 0;
+    if (n == 1) { /* a plane, the common case in a scene: no set-up, no scaling needed (the quotient is
+                   * scale-free); c[0] == 0 gives +0, c[1] == 0 no root */
+        double x = -c[0] / c[1];
+        if (!(fabs(c[0]) <= DBL_MAX) || !(fabs(c[1]) <= DBL_MAX) || !isfinite(x) || !(x >= lo && x <= hi))
+            return 0; /* also c[1] == 0: no root, or the zero polynomial */
+        roots[0] = x == 0.0 ? 0.0 : x;
+        return 1;
+    }
+    for (k = 0; k <= n; ++k) {
+        double a = fabs(c[k]);
+        if (!(a <= DBL_MAX)) /* NaN or Inf */
+            return 0;
+        cmax = a > cmax ? a : cmax;
+    }
+    if (cmax == 0.0)
+        return 0;                            /* the zero polynomial: every t is a root; reported as none */
+    if (cmax > 0x1p200 || cmax < 0x1p-200) { /* exact rescaling by a power of two */
+        int e = ilogb(cmax);
+        double s1 = ldexp(1.0, -e / 2), s2 = ldexp(1.0, -e - (-e / 2));
+        for (k = 0; k <= n; ++k)
+            p[k] = (c[k] * s1) * s2;
+    } else {
+        for (k = 0; k <= n; ++k)
+            p[k] = c[k];
+    }
+    top = n;
+    while (top > 0 && p[top] == 0.0)
+        --top;
+    m = 0; /* multiplicity of the root t = 0 */
+    while (m < top && p[m] == 0.0)
+        ++m;
+    deg = top - m;
+    k = 0;
+    if (deg == 1) {
+        double x = -p[m] / p[m + 1];
+        if (isfinite(x))
+            r[k++] = x;
+    } else if (deg == 2) {
+        k = ig_quadratic(p[0], p[1], p[2], r);
+    }
+    if (m > 0)
+        r[k++] = 0.0;
+    if (k > 1 && (deg != 2 || m > 0)) /* ig_quadratic lists its roots ascending and distinct already */
+        k = ig_sort_unique(r, k);
+    for (m = 0; m < k && cnt < most; ++m)
+        if (r[m] >= lo && r[m] <= hi && isfinite(r[m]))
+            roots[cnt++] = r[m] == 0.0 ? 0.0 : r[m]; /* no -0 */
+    return cnt;
+}
+
 /* Closed forms on a polynomial of exact degree 3 or 4 (c[n] != 0, c[0] != 0, coefficients scaled to max 1):
  * all real roots in [lo, hi], ascending. polish != 0: Newton-polished, factorisation refined; 0: classic. */
 int ig_closed_cubic(const double *c, double lo, double hi, int polish, double *r);
