@@ -130,7 +130,7 @@ int ig_bracket_roots(const double *c, int n, double a, double b, int first, doub
  * ig_bracket_interval (and counts it in *fallbacks unless that is NULL). _first: the leftmost root only. */
 int ig_bernstein_interval(const double *c, int n, double a, double b, int *fallbacks, double *r);
 int ig_bernstein_first(const double *c, int n, double a, double b, int *fallbacks, double *r);
-/* IG_ANY_ROOT: the leftmost piece's root, unrefined when the piece was certified (see above). */
+/* IG_ANY_ROOT: a point where a root sits, unrefined when certified (see below). */
 int ig_bernstein_any(const double *c, int n, double a, double b, int *fallbacks, double *r);
 
 /* Sturm isolation on a finite interval [a, b] for exact degree n >= 3 (c[n] != 0, c[0] != 0). */
@@ -140,9 +140,11 @@ int ig_sturm_interval(const double *c, int n, double a, double b, double *r);
 int ig_real_roots_any(const double *c, int n, double lo, double hi, int method, double *roots);
 
 /* The modes of the `first` argument below. IG_ANY_ROOT is a yes/no query (the tracer's opaque shadow rays):
- * at most one value, a point of [lo, hi] where some root may sit -- the first root refined, or a point strictly
- * inside a piece that the Bernstein method has certified to hold exactly one simple root (sign change at both
- * ends, one sign variation), left unrefined. Methods without such pieces answer as IG_FIRST_ROOT. */
+ * at most one value, a point of [lo, hi] where some root may sit -- the first root refined, or, from the Bernstein
+ * method, a point strictly inside an interval that holds a root, left unrefined: a piece certified to hold exactly
+ * one simple root (sign change at both ends, one sign variation), or two points of [lo, hi] where p's certified
+ * signs differ (an odd number of roots between them; the first such pair the subdivision meets, its middle).
+ * Methods without such pieces answer as IG_FIRST_ROOT. */
 enum { IG_ALL_ROOTS = 0, IG_FIRST_ROOT = 1, IG_ANY_ROOT = 2 };
 
 /* The same with first != 0: only the smallest root (at most one), as ig_first_root. */
