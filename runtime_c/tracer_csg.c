@@ -52,7 +52,7 @@ static void leaf_ray_of(const rt_node *n, const rt_ray *ray, leaf_ray *lr)
     lr->o = ray->o;
     lr->d = ray->d;
     lr->inv = ray->inv;
-    lr->u = ray->u;
+    lr->u = NULL; /* set once the leaf's box is entered (leaf_spans) */
     lr->L = ray->len;
     if (!n->identity) { /* an identity leaf takes the world ray as it is, with its inverse and unit direction */
         rt_xform_point(n->minv, ray->o, lr->own_o);
@@ -139,6 +139,8 @@ static int leaf_spans(const rt_scene *s, int k, const rt_ray *ray, double a, dou
     if (!n->identity) {
         lr.L = ig_unit_vector(lr.d, lr.own_u); /* o, d: already in the leaf's object space */
         lr.u = lr.own_u;
+    } else {
+        lr.u = rt_ray_unit(ray, lr.own_u);
     }
     nr = (lr.L > 0.0 && isfinite(lr.L)) ? leaf_roots_unit(s, k, n, lr.o, lr.u, lr.L, a, b, r) : 0;
     ends[0].leaf = f0 ? k : -1; /* a box face, or open where the ray's range starts inside */
@@ -239,7 +241,7 @@ int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d
         return 0;
     if (tmax > s->far)
         tmax = s->far;
-    rt_ray_init(&ray, o, d, s->far);
+    rt_ray_init(&ray, o, d, s->far, 1);
     n = rt_spans(s, node, &ray, tmin, tmax, sp, RT_MAX_SPANS);
     if (n > max)
         n = max;
@@ -397,7 +399,7 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
     int k = s->objects[object], nr;
     const rt_node *n = &s->nodes[k];
     double lo = tmin, hi = tmax, oo[3], u[3], L = ray->len, r[IG_MAX_DEGREE + 2];
-    const double *po = ray->o, *pu = ray->u;
+    const double *po = ray->o, *pu;
     ig_shape_expansion ex, *ex_wanted;
     /* A bounded object needs no clip to its world box here: the BVH has clipped the ray to a box around it,
      * a CSG root clips to its own box first thing in rt_spans, and a leaf's solve clips to the object-space box,
@@ -424,6 +426,8 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
         L = ig_affine_unit_ray(n->minv, ray->o, ray->d, oo, u);
         po = oo;
         pu = u;
+    } else {
+        pu = rt_ray_unit(ray, u);
     }
     if (!(L > 0.0) || !isfinite(L))
         return 0;

@@ -57,6 +57,9 @@ struct rt_scene {
     int nunbounded;
     unsigned char *flat; /* per object: a top-level leaf of degree 1 (part of a plane), which no ray leaving
                             it can meet again: rays spawned from it need not test it (rt_scene_closest) */
+    int unit_rays;       /* some leaf solves along the world ray's unit direction (an identity leaf in a CSG tree,
+                            or an identity top-level leaf that the plane path does not take): every ray works it
+                            out at once (rt_ray_init); otherwise only a plane path's rare fallback needs it */
     int *order;          /* bounded objects in BVH leaf order */
     rt_bvh_node *bvh;
     int nbvh;
@@ -93,7 +96,8 @@ typedef struct rt_ray {
     double o[3], d[3];
     double inv[3]; /* 1 / d[a]; not used where d[a] == 0 */
     double len;    /* |d| */
-    double u[3];   /* d / |d|: the unit direction an identity leaf solves along */
+    double u[3];   /* d / |d|: the unit direction an identity leaf solves along (when unit; see rt_ray_unit) */
+    int unit;      /* u is worked out */
     double far_t;  /* far / |d|: where an unbounded object's solve stops (INFINITY when d = 0) */
 } rt_ray;
 
@@ -219,9 +223,17 @@ static inline double rt_maxabs3(const double v[3])
     return a > b ? (a > c ? a : c) : (b > c ? b : c);
 }
 
-/* The ray o + t d with its length, inverse direction, unit direction and where an unbounded object's solve stops
- * (far / |d|). */
-static inline void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far)
+/* The unit direction d / len of a ray of length len ((0, 0, 0) when len is 0) into u. */
+static inline void rt_unit_of(const double d[3], double len, double u[3])
+{
+    int a;
+    for (a = 0; a < 3; ++a)
+        u[a] = len > 0.0 ? d[a] / len : 0.0;
+}
+
+/* The ray o + t d with its length, inverse direction, where an unbounded object's solve stops (far / |d|) and, when
+ * unit (the scene's unit_rays), its unit direction. */
+static inline void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far, int unit)
 {
     int a;
     memcpy(r->o, o, sizeof r->o);
@@ -229,14 +241,19 @@ static inline void rt_ray_init(rt_ray *r, const double o[3], const double d[3], 
     r->len = sqrt(rt_dot(d, d));
     for (a = 0; a < 3; ++a)
         r->inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
-    if (r->len > 0.0) {
-        for (a = 0; a < 3; ++a)
-            r->u[a] = d[a] / r->len;
-        r->far_t = far / r->len;
-    } else {
-        r->u[0] = r->u[1] = r->u[2] = 0.0;
-        r->far_t = INFINITY;
-    }
+    r->unit = unit;
+    if (unit)
+        rt_unit_of(d, r->len, r->u);
+    r->far_t = r->len > 0.0 ? far / r->len : INFINITY;
+}
+
+/* The ray's unit direction: its own when worked out, else into tmp (the same quotients). */
+static inline const double *rt_ray_unit(const rt_ray *r, double tmp[3])
+{
+    if (r->unit)
+        return r->u;
+    rt_unit_of(r->d, r->len, tmp);
+    return tmp;
 }
 
 static inline int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1,
