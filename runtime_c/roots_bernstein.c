@@ -88,6 +88,17 @@ static void bz_fallback(bz_ctx *c, double tl, double tr)
         ++*c->fallbacks;
 }
 
+/* A yes/no query's answer from a piece [tl, tr] whose ends' certified signs differ, so that a root lies strictly
+ * inside: its middle, when that is strictly inside (1); 0 when tl and tr are too close for one. */
+static int any_inside(bz_ctx *c, double tl, double tr)
+{
+    double x = 0.5 * tl + 0.5 * tr;
+    if (!(x > tl && x < tr))
+        return 0;
+    c->out[c->cnt++] = x;
+    return 1;
+}
+
 /* Fully unrolled loops in the fixed-degree bodies (GCC's and Clang's pragma; other compilers ignore it) */
 #if defined(__GNUC__)
 #define BZ_PRAGMA(x) _Pragma(#x)
