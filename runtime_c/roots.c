@@ -180,16 +180,10 @@ int ig_roots_stats(const double *c, int n, double lo, double hi, int method, int
 {
     if (!c || !roots || n < 0 || n > IG_MAX_DEGREE)
         return 0;
+    if (n <= 2) /* a plane, a quadric: the closed forms, every method alike (roots_impl.h) */
+        return ig_roots_low(c, n, lo, hi, first, roots);
     if (!(lo <= hi)) /* also NaN bounds */
         return 0;
-    if (n == 1) { /* a plane, the common case in a scene (the tracer's ground): no set-up, no scaling needed
-                   * (the quotient is scale-free); c[0] == 0 gives +0, c[1] == 0 no root */
-        double x = -c[0] / c[1];
-        if (!(fabs(c[0]) <= DBL_MAX) || !(fabs(c[1]) <= DBL_MAX) || !isfinite(x) || !(x >= lo && x <= hi))
-            return 0; /* also c[1] == 0: no root, or the zero polynomial */
-        roots[0] = x == 0.0 ? 0.0 : x;
-        return 1;
-    }
     double cmax = 0.0;
     for (int k = 0; k <= n; ++k) {
         double m = fabs(c[k]);

@@ -88,6 +88,17 @@ static void bz_fallback(bz_ctx *c, double tl, double tr)
         ++*c->fallbacks;
 }
 
+/* A yes/no query's answer from a piece [tl, tr] whose ends' certified signs differ, so that a root lies strictly
+ * inside: its middle, when that is strictly inside (1); 0 when tl and tr are too close for one. */
+static int any_inside(bz_ctx *c, double tl, double tr)
+{
+    double x = 0.5 * tl + 0.5 * tr;
+    if (!(x > tl && x < tr))
+        return 0;
+    c->out[c->cnt++] = x;
+    return 1;
+}
+
 /* Fully unrolled loops in the fixed-degree bodies (GCC's and Clang's pragma; other compilers ignore it) */
 #if defined(__GNUC__)
 #define BZ_PRAGMA(x) _Pragma(#x)
@@ -152,6 +163,31 @@ static const struct {
                             BZ_ENTRY(18), BZ_ENTRY(20), BZ_ENTRY(22), BZ_ENTRY(24)};
 #undef BZ_ENTRY
 
+/* IG_ANY_ROOT asks only whether a root exists: where two certified signs of p differ, one does, in between. The
+ * signs at a, at the middle m and at b (the conversion's end values, certified by end_sign), and p's exact value
+ * p[0] at 0 when 0 lies inside (the ray polynomial is expanded about a point of the ray next to the object, often
+ * inside the solid it crosses): the middle of the first pair that differs, a point strictly inside that pair's
+ * interval; NaN when they all agree. */
+static double any_sign_change(double p0, double a, double m, double b, int sl, int sm, int sr)
+{
+    int s0 = p0 > 0.0 ? 1 : (p0 < 0.0 ? -1 : 0);
+    double x = NAN, l = a, r = b;
+    if (sl != sm) {
+        r = m;
+    } else if (sm != sr) {
+        l = m;
+    } else if (s0 != 0 && s0 != sl && a < 0.0 && 0.0 < b && m != 0.0) {
+        if (m > 0.0) /* the change is in (a, 0) */
+            r = 0.0;
+        else
+            l = 0.0;
+    } else {
+        return NAN;
+    }
+    x = 0.5 * l + 0.5 * r;
+    return x > l && x < r ? x : NAN;
+}
+
 /* [a, b] as a whole to bracketing (its first-root mode when first != 0: bitwise the first of its list). */
 static int bracket_whole(const double *p, int n, double a, double b, int first, double *out)
 {
@@ -191,6 +227,13 @@ static int bernstein(const double *p, int n, double a, double b, int first, doub
     int sm = end_sign(&c, R[0], m, tol, &vm);
     if (sl == 0 || sr == 0 || sm == 0) /* a root at an end or the middle (within rounding) */
         return bracket_whole(p, n, a, b, first, out);
+    if (first == IG_ANY_ROOT) {
+        double x = any_sign_change(p[0], a, m, b, sl, sm, sr);
+        if (!isnan(x)) {
+            out[0] = x;
+            return 1;
+        }
+    }
     piece(&c, L, a, m, sl, sm, vl, vm, tol, 1);
     piece(&c, R, m, b, sm, sr, vm, vr, tol, 1);
     if (first) { /* the leftmost piece holding a root ended the search */

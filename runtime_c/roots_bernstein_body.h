@@ -134,6 +134,8 @@ static void BZ_FN(piece)(bz_ctx *c, const double *b, double tl, double tr, int s
     const int n = c->n;
     if (c->first && c->cnt + c->nfb > 0)
         return;
+    if (c->first == IG_ANY_ROOT && sl != sr && any_inside(c, tl, tr)) /* certified signs that differ */
+        return;
     int unsure;
     int v = BZ_FN(variations)(b, n, tol, sl, sr, &unsure);
     if (v == 0)

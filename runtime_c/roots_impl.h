@@ -50,6 +50,67 @@ void ig_sort(double *r, int k);
 /* Sort ascending and drop exact duplicates; returns the new count. */
 int ig_sort_unique(double *r, int k);
 
+/* ig_roots_core for a nominal degree n <= 2 (a plane's or a quadric's ray polynomial), the method aside (every
+ * method solves these in closed form): the same pipeline -- bad input, exact rescaling, the degree dropped while the
+ * leading coefficient is zero, zero roots taken out, the closed form, then sorting and keeping the roots in
+ * [lo, hi] -- written inline, so that the shape layer's many low-degree solves (every CSG leaf of a glass) skip the
+ * general entry. roots.c's ig_roots_stats answers n <= 2 with it too: one implementation. */
+static inline int ig_roots_low(const double *c, int n, double lo, double hi, int first, double *roots)
+{
+    double p[3], r[3], cmax = 0.0;
+    int k, top, m, deg, cnt = 0, most = first ? 1 : n;
+    if (!(lo <= hi)) /* also NaN bounds */
+        return 0;
+    if (n == 1) { /* a plane, the common case in a scene: no set-up, no scaling needed (the quotient is
+                   * scale-free); c[0] == 0 gives +0, c[1] == 0 no root */
+        double x = -c[0] / c[1];
+        if (!(fabs(c[0]) <= DBL_MAX) || !(fabs(c[1]) <= DBL_MAX) || !isfinite(x) || !(x >= lo && x <= hi))
+            return 0; /* also c[1] == 0: no root, or the zero polynomial */
+        roots[0] = x == 0.0 ? 0.0 : x;
+        return 1;
+    }
+    for (k = 0; k <= n; ++k) {
+        double a = fabs(c[k]);
+        if (!(a <= DBL_MAX)) /* NaN or Inf */
+            return 0;
+        cmax = a > cmax ? a : cmax;
+    }
+    if (cmax == 0.0)
+        return 0;                            /* the zero polynomial: every t is a root; reported as none */
+    if (cmax > 0x1p200 || cmax < 0x1p-200) { /* exact rescaling by a power of two */
+        int e = ilogb(cmax);
+        double s1 = ldexp(1.0, -e / 2), s2 = ldexp(1.0, -e - (-e / 2));
+        for (k = 0; k <= n; ++k)
+            p[k] = (c[k] * s1) * s2;
+    } else {
+        for (k = 0; k <= n; ++k)
+            p[k] = c[k];
+    }
+    top = n;
+    while (top > 0 && p[top] == 0.0)
+        --top;
+    m = 0; /* multiplicity of the root t = 0 */
+    while (m < top && p[m] == 0.0)
+        ++m;
+    deg = top - m;
+    k = 0;
+    if (deg == 1) {
+        double x = -p[m] / p[m + 1];
+        if (isfinite(x))
+            r[k++] = x;
+    } else if (deg == 2) {
+        k = ig_quadratic(p[0], p[1], p[2], r);
+    }
+    if (m > 0)
+        r[k++] = 0.0;
+    if (k > 1 && (deg != 2 || m > 0)) /* ig_quadratic lists its roots ascending and distinct already */
+        k = ig_sort_unique(r, k);
+    for (m = 0; m < k && cnt < most; ++m)
+        if (r[m] >= lo && r[m] <= hi && isfinite(r[m]))
+            roots[cnt++] = r[m] == 0.0 ? 0.0 : r[m]; /* no -0 */
+    return cnt;
+}
+
 /* Closed forms on a polynomial of exact degree 3 or 4 (c[n] != 0, c[0] != 0, coefficients scaled to max 1):
  * all real roots in [lo, hi], ascending. polish != 0: Newton-polished, factorisation refined; 0: classic. */
 int ig_closed_cubic(const double *c, double lo, double hi, int polish, double *r);
@@ -69,7 +130,7 @@ int ig_bracket_roots(const double *c, int n, double a, double b, int first, doub
  * ig_bracket_interval (and counts it in *fallbacks unless that is NULL). _first: the leftmost root only. */
 int ig_bernstein_interval(const double *c, int n, double a, double b, int *fallbacks, double *r);
 int ig_bernstein_first(const double *c, int n, double a, double b, int *fallbacks, double *r);
-/* IG_ANY_ROOT: the leftmost piece's root, unrefined when the piece was certified (see above). */
+/* IG_ANY_ROOT: a point where a root sits, unrefined when certified (see below). */
 int ig_bernstein_any(const double *c, int n, double a, double b, int *fallbacks, double *r);
 
 /* Sturm isolation on a finite interval [a, b] for exact degree n >= 3 (c[n] != 0, c[0] != 0). */
@@ -79,9 +140,11 @@ int ig_sturm_interval(const double *c, int n, double a, double b, double *r);
 int ig_real_roots_any(const double *c, int n, double lo, double hi, int method, double *roots);
 
 /* The modes of the `first` argument below. IG_ANY_ROOT is a yes/no query (the tracer's opaque shadow rays):
- * at most one value, a point of [lo, hi] where some root may sit -- the first root refined, or a point strictly
- * inside a piece that the Bernstein method has certified to hold exactly one simple root (sign change at both
- * ends, one sign variation), left unrefined. Methods without such pieces answer as IG_FIRST_ROOT. */
+ * at most one value, a point of [lo, hi] where some root may sit -- the first root refined, or, from the Bernstein
+ * method, a point strictly inside an interval that holds a root, left unrefined: a piece certified to hold exactly
+ * one simple root (sign change at both ends, one sign variation), or two points of [lo, hi] where p's certified
+ * signs differ (an odd number of roots between them; the first such pair the subdivision meets, its middle).
+ * Methods without such pieces answer as IG_FIRST_ROOT. */
 enum { IG_ALL_ROOTS = 0, IG_FIRST_ROOT = 1, IG_ANY_ROOT = 2 };
 
 /* The same with first != 0: only the smallest root (at most one), as ig_first_root. */

@@ -71,8 +71,14 @@ static int clip_box(const ig_shape_prep *prep, const double o[3], const double d
     return *t0 <= *t1;
 }
 
-/* The shift point: minimises sum over finite axes of (o_i + t d_i - c_i)^2, clamped to [t0, t1]. */
-double ig_shape_shift_point(const ig_shape_prep *prep, const double o[3], const double d[3], double t0, double t1)
+int ig_shape_clip(const ig_shape_prep *prep, const double o[3], const double d[3], double *t0, double *t1)
+{
+    return prep->bounded ? clip_box(prep, o, d, t0, t1) : *t0 <= *t1;
+}
+
+/* The shift point: minimises sum over finite axes of (o_i + t d_i - c_i)^2, clamped to [t0, t1]. Inline here, so
+ * that every solve has it without a call; ig_shape_shift_point is the same for other callers. */
+static inline double shift_point(const ig_shape_prep *prep, const double o[3], const double d[3], double t0, double t1)
 {
     double num = 0.0, den = 0.0;
     for (int k = 0; k < prep->nfinite; ++k) {
@@ -94,13 +100,20 @@ double ig_shape_shift_point(const ig_shape_prep *prep, const double o[3], const 
     return ts;
 }
 
+double ig_shape_shift_point(const ig_shape_prep *prep, const double o[3], const double d[3], double t0, double t1)
+{
+    return shift_point(prep, o, d, t0, t1);
+}
+
 int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_prep *prep, const double o[3],
                    const double d[3], double tmin, double tmax, ig_root_method method, int first, double *roots,
                    ig_shape_expansion *ex)
 {
+    int finite = 1; /* one branch for the six: isfinite(x) is |x| <= DBL_MAX (false for NaN) */
     for (int i = 0; i < 3; ++i)
-        if (!isfinite(o[i]) || !isfinite(d[i]))
-            return 0;
+        finite &= (fabs(o[i]) <= DBL_MAX) & (fabs(d[i]) <= DBL_MAX);
+    if (!finite)
+        return 0;
     if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
         return 0;
     if (!(tmin <= tmax))
@@ -111,14 +124,15 @@ int ig_shape_solve(const ig_shape *shape, const double *params, const ig_shape_p
     double t0 = tmin, t1 = tmax;
     if (prep->bounded && !clip_box(prep, o, d, &t0, &t1))
         return 0;
-    double ts = ig_shape_shift_point(prep, o, d, t0, t1);
-    if (!isfinite(ts))
+    double ts = shift_point(prep, o, d, t0, t1);
+    if (!isfinite(ts)) /* clamped to an infinite end */
         ts = 0.0;
     double os[3] = {o[0] + ts * d[0], o[1] + ts * d[1], o[2] + ts * d[2]};
     double c[IG_MAX_DEGREE + 1];
     shape->coeffs(os, d, params, c);
     double s[IG_MAX_DEGREE];
-    int k = ig_roots_core(c, n, t0 - ts, t1 - ts, (int)method, first, s);
+    int k = n <= 2 ? ig_roots_low(c, n, t0 - ts, t1 - ts, first, s)
+                   : ig_roots_core(c, n, t0 - ts, t1 - ts, (int)method, first, s);
     int m = 0;
     for (int i = 0; i < k; ++i) {
         double t = ts + s[i];

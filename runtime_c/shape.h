@@ -52,6 +52,11 @@ typedef struct ig_shape_prep {
 
 void ig_shape_prepare(const ig_shape *shape, const double *params, ig_shape_prep *prep);
 
+/* The clip ig_shape_solve starts with: [*t0, *t1] narrowed to where o + t d is inside prep's box (grown, see
+ * shape.c); 1 when that is not empty. For a caller that needs to know which rays reach the solve's work (the
+ * floor report, bench/floor.py). */
+int ig_shape_clip(const ig_shape_prep *prep, const double o[3], const double d[3], double *t0, double *t1);
+
 /* The point ts of the ray o + t d, clamped to [t0, t1], that ig_shape_solve expands f(o + t d) around (shape.c
  * explains the rule); 0 when it is not finite. */
 double ig_shape_shift_point(const ig_shape_prep *prep, const double o[3], const double d[3], double t0, double t1);

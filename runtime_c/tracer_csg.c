@@ -13,11 +13,16 @@
 #include <math.h>
 #include <string.h>
 
-/* Roots (in t) of a leaf along the object-space ray oo + s u, u the unit direction and s = t L. */
-static inline int leaf_roots_unit(const rt_node *n, const double oo[3], const double u[3], double L, double lo,
-                                  double hi, double *r)
+/* Roots (in t) of a leaf along the object-space ray oo + s u, u the unit direction and s = t L. s and leaf: the
+ * scene and the leaf's node index, for the floor report's record (s may be NULL: none). */
+static inline int leaf_roots_unit(const rt_scene *s, int leaf, const rt_node *n, const double oo[3], const double u[3],
+                                  double L, double lo, double hi, double *r)
 {
     int k = ig_shape_solve(n->shape, n->params, &n->prep, oo, u, lo * L, hi * L, IG_ROOTS_AUTO, 0, r, NULL), i;
+    (void)s;
+    (void)leaf;
+    if (s)
+        RT_TRACE_SOLVE(s, leaf, oo, u, lo * L, hi * L, IG_ALL_ROOTS, k, r);
     for (i = 0; i < k; ++i)
         r[i] /= L;
     return k;
@@ -31,7 +36,7 @@ int rt_leaf_roots(const rt_node *n, const double oo[3], const double od[3], doub
     double u[3], L = ig_unit_vector(od, u); /* oo, od: already in object space */
     if (!(L > 0.0) || !isfinite(L))
         return 0;
-    return leaf_roots_unit(n, oo, u, L, lo, hi, r);
+    return leaf_roots_unit(NULL, -1, n, oo, u, L, lo, hi, r);
 }
 
 /* A leaf's ray as its solve takes it: origin, direction, inverse direction (NULL when it is not the world
@@ -47,7 +52,7 @@ static void leaf_ray_of(const rt_node *n, const rt_ray *ray, leaf_ray *lr)
     lr->o = ray->o;
     lr->d = ray->d;
     lr->inv = ray->inv;
-    lr->u = ray->u;
+    lr->u = NULL; /* set once the leaf's box is entered (leaf_spans) */
     lr->L = ray->len;
     if (!n->identity) { /* an identity leaf takes the world ray as it is, with its inverse and unit direction */
         rt_xform_point(n->minv, ray->o, lr->own_o);
@@ -134,8 +139,10 @@ static int leaf_spans(const rt_scene *s, int k, const rt_ray *ray, double a, dou
     if (!n->identity) {
         lr.L = ig_unit_vector(lr.d, lr.own_u); /* o, d: already in the leaf's object space */
         lr.u = lr.own_u;
+    } else {
+        lr.u = rt_ray_unit(ray, lr.own_u);
     }
-    nr = (lr.L > 0.0 && isfinite(lr.L)) ? leaf_roots_unit(n, lr.o, lr.u, lr.L, a, b, r) : 0;
+    nr = (lr.L > 0.0 && isfinite(lr.L)) ? leaf_roots_unit(s, k, n, lr.o, lr.u, lr.L, a, b, r) : 0;
     ends[0].leaf = f0 ? k : -1; /* a box face, or open where the ray's range starts inside */
     ends[1].leaf = f1 ? k : -1;
     nx = leaf_breakpoints(r, nr, a, b, &f0, &f1, x);
@@ -234,7 +241,7 @@ int rt_node_spans(const rt_scene *s, int node, const double o[3], const double d
         return 0;
     if (tmax > s->far)
         tmax = s->far;
-    rt_ray_init(&ray, o, d, s->far);
+    rt_ray_init(&ray, o, d, s->far, 1);
     n = rt_spans(s, node, &ray, tmin, tmax, sp, RT_MAX_SPANS);
     if (n > max)
         n = max;
@@ -264,12 +271,14 @@ static void surface_hit(rt_pending *hit, int leaf, double t)
  * quotient does not depend on the direction's length, so the world parameter t comes out directly, with one
  * division), no shift point (for a line it gains nothing: f(o) is rounded relative to |grad f| |o|, as
  * o + t d itself is), no solver call chain. 1: a hit in (tmin, tmax) and [lo, hi]; 0: no hit; -1: a
- * coefficient not finite or c1 not a normal number -- the general path decides. */
-static int plane_hit(const rt_node *n, int k, const rt_ray *ray, double tmin, double tmax, double lo, double hi,
-                     rt_pending *hit)
+ * coefficient not finite or c1 not a normal number -- the general path decides. s: for the floor report's
+ * record. */
+static int plane_hit(const rt_scene *s, const rt_node *n, int k, const rt_ray *ray, double tmin, double tmax, double lo,
+                     double hi, rt_pending *hit)
 {
     double oo[3], od[3], c[2], t;
     const double *po = ray->o, *pd = ray->d;
+    (void)s;
     if (!n->identity) {
         rt_xform_point(n->minv, ray->o, oo);
         rt_xform_vector(n->minv, ray->d, od);
@@ -280,8 +289,11 @@ static int plane_hit(const rt_node *n, int k, const rt_ray *ray, double tmin, do
     if (!(fabs(c[0]) <= DBL_MAX) || !(fabs(c[1]) >= DBL_MIN && fabs(c[1]) <= DBL_MAX))
         return -1;
     t = -c[0] / c[1];
-    if (!(t > tmin && t < tmax && t >= lo && t <= hi))
+    if (!(t > tmin && t < tmax && t >= lo && t <= hi)) {
+        RT_TRACE_SOLVE(s, k, po, pd, lo, hi, RT_TRACE_PLANE, 0, &t);
         return 0;
+    }
+    RT_TRACE_SOLVE(s, k, po, pd, lo, hi, RT_TRACE_PLANE, 1, &t);
     surface_hit(hit, k, t);
     hit->noise_known = 1; /* the expansion c0 + c1 t around the ray's origin, as rt_expansion_noise sums it */
     hit->noise_sum = fabs(c[1]) * fabs(t) + fabs(c[0]);
@@ -387,7 +399,7 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
     int k = s->objects[object], nr;
     const rt_node *n = &s->nodes[k];
     double lo = tmin, hi = tmax, oo[3], u[3], L = ray->len, r[IG_MAX_DEGREE + 2];
-    const double *po = ray->o, *pu = ray->u;
+    const double *po = ray->o, *pu;
     ig_shape_expansion ex, *ex_wanted;
     /* A bounded object needs no clip to its world box here: the BVH has clipped the ray to a box around it,
      * a CSG root clips to its own box first thing in rt_spans, and a leaf's solve clips to the object-space box,
@@ -406,7 +418,7 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
     /* A top-level leaf is a surface: its hit is the nearest root after tmin, solved along the unit object-space
      * direction (see rt_leaf_roots); an identity leaf takes the ray's own. */
     if (n->prep.degree == 1 && !n->prep.bounded && n->clip == RT_CLIP_NONE) {
-        int got = plane_hit(n, k, ray, tmin, tmax, lo, hi, hit);
+        int got = plane_hit(s, n, k, ray, tmin, tmax, lo, hi, hit);
         if (got >= 0)
             return got;
     }
@@ -414,6 +426,8 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
         L = ig_affine_unit_ray(n->minv, ray->o, ray->d, oo, u);
         po = oo;
         pu = u;
+    } else {
+        pu = rt_ray_unit(ray, u);
     }
     if (!(L > 0.0) || !isfinite(L))
         return 0;
@@ -425,5 +439,6 @@ int rt_object_hit(const rt_scene *s, int object, const rt_ray *ray, double tmin,
         any = 0;
     ex_wanted = any ? NULL : &ex;
     nr = leaf_solve(n, po, pu, L, tmin, tmax, lo, hi, any, r, ex_wanted);
+    RT_TRACE_SOLVE(s, k, po, pu, lo * L, hi * L, any ? IG_ANY_ROOT : IG_FIRST_ROOT, nr, r);
     return first_root_hit(n, k, r, nr, L, tmin, tmax, ex_wanted, hit);
 }

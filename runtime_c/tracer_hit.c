@@ -160,10 +160,13 @@ static inline int object_normal(const rt_node *n, int face, const double po[3], 
     return 0;
 }
 
-/* Turns the normals nw and g to their side and returns whether the ray enters the solid at the hit. */
-static inline int orient_normals(const rt_pending *pd, int singular, const double d[3], double nw[3], double g[3])
+/* Turns the normals nw and g to their side and returns whether the ray enters the solid at the hit; *flipped: 1 when
+ * they were turned around. */
+static inline int orient_normals(const rt_pending *pd, int singular, const double d[3], double nw[3], double g[3],
+                                 int *flipped)
 {
     int a, entering = pd->entering;
+    *flipped = 0;
     if (singular) {
         /* grad f = 0 (a cusp, an apex): no normal exists; face the ray so shading stays finite. */
         double len = sqrt(rt_dot(d, d));
@@ -180,6 +183,7 @@ static inline int orient_normals(const rt_pending *pd, int singular, const doubl
             nw[a] = -nw[a];
             g[a] = -g[a];
         }
+        *flipped = 1;
     }
     return entering;
 }
@@ -190,17 +194,23 @@ void rt_finish_hit(const rt_scene *s, const rt_pending *pd, const double o[3], c
     const rt_node *n = &s->nodes[pd->leaf];
     rt_hit_lazy own, *lz = lazy ? lazy : &own;
     double g[3], nw[3], len;
-    int a, singular, entering;
+    int a, singular, entering, flipped;
 
     hit_points(n, pd, o, d, hit, lz);
     singular = object_normal(n, pd->face, hit->po, lz, g);
     if (!singular && !ig_affine_normal(n->minv, g, nw)) /* normals map by the inverse transpose */
         singular = 1;
-    entering = orient_normals(pd, singular, d, nw, g);
+    entering = orient_normals(pd, singular, d, nw, g, &flipped);
     memcpy(hit->n, nw, sizeof nw);
-    len = sqrt(rt_dot(g, g));
-    for (a = 0; a < 3; ++a)
-        hit->no[a] = len > 0.0 ? g[a] / len : nw[a];
+    if (pd->face == 0 && !singular) {
+        /* g / |g| is object_normal's lz->u, turned like g (-a / b == -(a / b)): no second square root */
+        for (a = 0; a < 3; ++a)
+            hit->no[a] = flipped ? -lz->u[a] : lz->u[a];
+    } else {
+        len = sqrt(rt_dot(g, g));
+        for (a = 0; a < 3; ++a)
+            hit->no[a] = len > 0.0 ? g[a] / len : nw[a];
+    }
     hit->err = 0.0;
     hit->t = pd->t;
     hit->object = pd->object;
@@ -321,8 +331,9 @@ int rt_scene_closest(const rt_scene *s, const double o[3], const double d[3], do
         return 0;
     if (!isfinite(d[0]) || !isfinite(d[1]) || !isfinite(d[2]) || !isfinite(o[0]) || !isfinite(o[1]) || !isfinite(o[2]))
         return 0;
+    RT_TRACE_QUERY(s, o, d, tmin, tmax, mode, skip);
     q.s = s;
-    rt_ray_init(&q.ray, o, d, s->far);
+    rt_ray_init(&q.ray, o, d, s->far, s->unit_rays);
     q.tmin = tmin;
     q.best = tmax;
     q.mode = mode;

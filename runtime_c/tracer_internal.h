@@ -57,10 +57,16 @@ struct rt_scene {
     int nunbounded;
     unsigned char *flat; /* per object: a top-level leaf of degree 1 (part of a plane), which no ray leaving
                             it can meet again: rays spawned from it need not test it (rt_scene_closest) */
+    int unit_rays;       /* some leaf solves along the world ray's unit direction (an identity leaf in a CSG tree,
+                            or an identity top-level leaf that the plane path does not take): every ray works it
+                            out at once (rt_ray_init); otherwise only a plane path's rare fallback needs it */
     int *order;          /* bounded objects in BVH leaf order */
     rt_bvh_node *bvh;
     int nbvh;
     char error[256];
+#ifdef RT_TRACE
+    struct rt_trace_log *trace; /* the instrumented build's record of a render's rays (tracer_floor.c), or NULL */
+#endif
 };
 
 /* One end of an inside-interval: where it is and which surface makes it. */
@@ -90,7 +96,8 @@ typedef struct rt_ray {
     double o[3], d[3];
     double inv[3]; /* 1 / d[a]; not used where d[a] == 0 */
     double len;    /* |d| */
-    double u[3];   /* d / |d|: the unit direction an identity leaf solves along */
+    double u[3];   /* d / |d|: the unit direction an identity leaf solves along (when unit; see rt_ray_unit) */
+    int unit;      /* u is worked out */
     double far_t;  /* far / |d|: where an unbounded object's solve stops (INFINITY when d = 0) */
 } rt_ray;
 
@@ -121,6 +128,29 @@ enum { RT_CLOSEST = 0, RT_ANY_OPAQUE = 1 };
 /* The object a ray spawned at hit h need not test (rt_scene_closest's `skip`): h's object when it is flat
  * (a plane meets a line once, and that is h itself), else -1. */
 int rt_spawn_skip(const rt_scene *s, const rt_hit *h);
+
+/* The floor report's recording hooks (tracer_floor.c). In the instrumented build (-DRT_TRACE, made by
+ * bench/floor.py) they write the kind of the rays being traced, every scene query and every leaf solve whose ray
+ * enters the leaf's box into the scene's log, if one is attached; otherwise they are empty, and the render loop
+ * is the same code as without them. The kind is kept in the log: record with one render thread. */
+#ifdef RT_TRACE
+void rt_trace_set_kind(const rt_scene *s, int kind);
+void rt_trace_query(const rt_scene *s, const double o[3], const double d[3], double tmin, double tmax, int mode,
+                    int skip);
+/* A leaf's solve along o + s u over [lo, hi] (in s) with the given mode (IG_ALL_ROOTS, IG_FIRST_ROOT, IG_ANY_ROOT,
+ * or RT_TRACE_PLANE: the plane's own path, along the ray o + t d as it is), and the nr roots r it gave. */
+void rt_trace_solve(const rt_scene *s, int leaf, const double o[3], const double u[3], double lo, double hi, int mode,
+                    int nr, const double *r);
+#define RT_TRACE_KIND(s, kind) rt_trace_set_kind((s), (kind))
+#define RT_TRACE_QUERY(s, o, d, tmin, tmax, mode, skip) rt_trace_query((s), (o), (d), (tmin), (tmax), (mode), (skip))
+#define RT_TRACE_SOLVE(s, leaf, o, u, lo, hi, mode, nr, r)                                                             \
+    rt_trace_solve((s), (leaf), (o), (u), (lo), (hi), (mode), (nr), (r))
+#else
+#define RT_TRACE_KIND(s, kind) ((void)0)
+#define RT_TRACE_QUERY(s, o, d, tmin, tmax, mode, skip) ((void)0)
+#define RT_TRACE_SOLVE(s, leaf, o, u, lo, hi, mode, nr, r) ((void)0)
+#endif
+#define RT_TRACE_PLANE 3
 
 /* tracer_scene.c */
 void rt_xform_point(const double m[12], const double p[3], double out[3]);
@@ -193,9 +223,17 @@ static inline double rt_maxabs3(const double v[3])
     return a > b ? (a > c ? a : c) : (b > c ? b : c);
 }
 
-/* The ray o + t d with its length, inverse direction, unit direction and where an unbounded object's solve stops
- * (far / |d|). */
-static inline void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far)
+/* The unit direction d / len of a ray of length len ((0, 0, 0) when len is 0) into u. */
+static inline void rt_unit_of(const double d[3], double len, double u[3])
+{
+    int a;
+    for (a = 0; a < 3; ++a)
+        u[a] = len > 0.0 ? d[a] / len : 0.0;
+}
+
+/* The ray o + t d with its length, inverse direction, where an unbounded object's solve stops (far / |d|) and, when
+ * unit (the scene's unit_rays), its unit direction. */
+static inline void rt_ray_init(rt_ray *r, const double o[3], const double d[3], double far, int unit)
 {
     int a;
     memcpy(r->o, o, sizeof r->o);
@@ -203,14 +241,19 @@ static inline void rt_ray_init(rt_ray *r, const double o[3], const double d[3], 
     r->len = sqrt(rt_dot(d, d));
     for (a = 0; a < 3; ++a)
         r->inv[a] = d[a] != 0.0 ? 1.0 / d[a] : 0.0;
-    if (r->len > 0.0) {
-        for (a = 0; a < 3; ++a)
-            r->u[a] = d[a] / r->len;
-        r->far_t = far / r->len;
-    } else {
-        r->u[0] = r->u[1] = r->u[2] = 0.0;
-        r->far_t = INFINITY;
-    }
+    r->unit = unit;
+    if (unit)
+        rt_unit_of(d, r->len, r->u);
+    r->far_t = r->len > 0.0 ? far / r->len : INFINITY;
+}
+
+/* The ray's unit direction: its own when worked out, else into tmp (the same quotients). */
+static inline const double *rt_ray_unit(const rt_ray *r, double tmp[3])
+{
+    if (r->unit)
+        return r->u;
+    rt_unit_of(r->d, r->len, tmp);
+    return tmp;
 }
 
 static inline int rt_clip_box(const double box[6], const double o[3], const double d[3], double *t0, double *t1,

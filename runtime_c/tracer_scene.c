@@ -432,6 +432,27 @@ static int build_bvh(rt_scene *s, int first, int count)
     return k;
 }
 
+/* Whether any leaf solves along the world ray's unit direction (rt_scene's unit_rays): an identity leaf under a CSG
+ * node, or an identity top-level leaf that is not a plane the plane path takes (rt_object_hit). */
+static int unit_rays_needed(const rt_scene *s)
+{
+    int i;
+    for (i = 0; i < s->nnodes; ++i) {
+        const rt_node *n = &s->nodes[i];
+        if (n->kind != RT_LEAF) {
+            if ((s->nodes[n->left].kind == RT_LEAF && s->nodes[n->left].identity) ||
+                (s->nodes[n->right].kind == RT_LEAF && s->nodes[n->right].identity))
+                return 1;
+        }
+    }
+    for (i = 0; i < s->nobjects; ++i) {
+        const rt_node *n = &s->nodes[s->objects[i]];
+        if (n->kind == RT_LEAF && n->identity && !(n->prep.degree == 1 && !n->prep.bounded && n->clip == RT_CLIP_NONE))
+            return 1;
+    }
+    return 0;
+}
+
 int rt_scene_commit(rt_scene *s)
 {
     int i, a, nb = 0;
@@ -454,6 +475,7 @@ int rt_scene_commit(rt_scene *s)
         return fail(s, "out of memory");
     s->nunbounded = 0;
     s->nbvh = 0;
+    s->unit_rays = unit_rays_needed(s);
     for (i = 0; i < s->nobjects; ++i) {
         const rt_node *n = &s->nodes[s->objects[i]];
         s->flat[i] = n->kind == RT_LEAF && n->shape->degree == 1;

@@ -169,6 +169,7 @@ static void shadow_transmittance(const rt_tracer *tr, const rt_hit *from, const 
             dd[a] = light[a] - q[a];
         if (tr->stats)
             tr->stats[RT_RAYS_SHADOW] += 1.0;
+        RT_TRACE_KIND(s, RT_RAYS_SHADOW);
         /* any opaque hit before the light is full shadow, whether or not it is the closest */
         if (!rt_scene_closest(s, q, dd, 0.0, 1.0, RT_ANY_OPAQUE, skip, &ph))
             return;
@@ -364,6 +365,7 @@ static void trace(const rt_tracer *tr, const double o[3], const double d[3], int
     rt_pending ph;
     double col[3];
 
+    RT_TRACE_KIND(s, depth == 0 ? RT_RAYS_PRIMARY : RT_RAYS_SECONDARY);
     if (!rt_scene_closest(s, o, d, 0.0, INFINITY, RT_CLOSEST, skip, &ph)) {
         memcpy(rgb, s->background, 3 * sizeof(double));
         return;

@@ -25,7 +25,14 @@ SOLVER_SOURCES = (
 BENCH_SOURCES = ("roots_bench.c",)  # clock_gettime around every solve: `implgen bench solvers`
 SHAPE_SOURCES = ("shape.c", "shape_batch.c")
 MESH_SOURCES = ("mesh_kernels.c",)  # the mesh's dual vertices and triangles: plain arrays, no shape
-TRACER_SOURCES = ("tracer_scene.c", "tracer_hit.c", "tracer_csg.c", "tracer_shade.c", "tracer_render.c")
+TRACER_SOURCES = (
+    "tracer_scene.c",
+    "tracer_hit.c",
+    "tracer_csg.c",
+    "tracer_shade.c",
+    "tracer_render.c",
+    "tracer_floor.c",
+)
 # The Embree 3 adapter (docs/embree.md): in no library implgen builds, so nothing here needs Embree; compiled by
 # whoever links Embree (examples/embree/, tests/test_embree.py, bench/embree.py)
 EMBREE_SOURCES = ("embree_shape.c",)

@@ -118,8 +118,9 @@ def runtime_progress() -> tuple[int, int]:
     return clib.objects_present(_runtime_jobs(), LIBRARY_FLAGS)
 
 
-def build_library(entries: Sequence[ShapeEntry]) -> tuple[Path, int]:
-    """The tracer library holding these shapes: (its path, how many shapes were generated on this call)."""
+def build_library(entries: Sequence[ShapeEntry], extra_flags: Sequence[str] = ()) -> tuple[Path, int]:
+    """The tracer library holding these shapes: (its path, how many shapes were generated on this call).
+    extra_flags: more compiler flags for every object (bench/floor.py's instrumented build: -DRT_TRACE)."""
     dirs, generated = [], 0
     for e in entries:
         d, fresh = generated_dir(e.spec)
@@ -132,4 +133,5 @@ def build_library(entries: Sequence[ShapeEntry]) -> tuple[Path, int]:
     jobs = _runtime_jobs()
     jobs += [(d / f"{e.c_name}.c", [rt, d]) for d, e in zip(dirs, entries)]
     jobs.append((glue, [rt, *dirs]))
-    return clib.build_jobs(jobs, extra_flags=LIBRARY_FLAGS, libs=["-lm", "-pthread"], tag="scene"), generated
+    flags = [*LIBRARY_FLAGS, *extra_flags]
+    return clib.build_jobs(jobs, extra_flags=flags, libs=["-lm", "-pthread"], tag="scene"), generated

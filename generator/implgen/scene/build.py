@@ -63,9 +63,10 @@ class BuildResult:
         return BuildResult(library=self.library, entries=entries, leaf_index=leaf_index, generated=0)
 
 
-def build_scene(scene: Scene, fold: bool = False) -> BuildResult:
+def build_scene(scene: Scene, fold: bool = False, extra_flags: tuple[str, ...] = ()) -> BuildResult:
+    """The scene's library; extra_flags: more compiler flags (bench/floor.py's instrumented build)."""
     entries, leaf_index = plan_shapes(scene, fold)
-    library, generated = build_library(entries)
+    library, generated = build_library(entries, extra_flags)
     return BuildResult(library=library, entries=entries, leaf_index=leaf_index, generated=generated)
 
 
