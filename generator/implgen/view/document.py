@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from pathlib import PurePath
 
 import numpy as np
 
@@ -142,12 +143,17 @@ class Document:
             "degree": spec.degree,
         }
 
+    def scene_name(self) -> str:
+        """What a scene file's saved files are called: its file's name without the folder and the suffix."""
+        return PurePath(self.base.source).stem if self.base is not None else ""
+
     def state(self) -> dict:
         """What the page starts from: the shape, its values, the camera, the options (and a scene's objects)."""
         o, orbit = self.options, self.orbit
         return {
             **self.shape_state(),
             "mode": "spec" if self.base is None else "scene",
+            "scene_name": self.scene_name(),
             "objects": self.objects(),
             "object": self.object_index(),
             "orbit": {

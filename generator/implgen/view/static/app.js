@@ -51,10 +51,27 @@
   const fromHex = (hex) => [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16) / 255);
 
   // ---------------------------------------------------------------- what the page says
-  function showMessage(text, isError) {
-    $("message").textContent = text;
-    messageIsError = isError && text !== "";
-    if (isError) { lastError = text; errorSeq = seq; }
+  // The message line lies over the top of the picture. `kind`: "error" (true) stays until a newer picture;
+  // "note" (false: a file saved, a link copied) goes with the user's next action, or after NOTE_MS; "keep" (work
+  // in progress, the connection lost) stays until something replaces it.
+  const NOTE_MS = 8000;
+  let messageKind = "";
+  let noteTimer = 0;
+  function showMessage(text, kind) {
+    kind = kind === true ? "error" : kind === false || kind === undefined ? "note" : kind;
+    const line = $("message");
+    line.textContent = text;
+    line.classList.toggle("bad", kind === "error");
+    messageKind = text ? kind : "";
+    messageIsError = kind === "error" && text !== "";
+    if (kind === "error") { lastError = text; errorSeq = seq; }
+    clearTimeout(noteTimer);
+    if (messageKind === "note") noteTimer = setTimeout(() => showMessage("", "note"), NOTE_MS);
+  }
+
+  // the user did something new: a note on what was done before (a link copied, a file saved) is stale
+  function acted() {
+    if (messageKind === "note") showMessage("", "note");
   }
 
   function showOverlay() {
@@ -177,6 +194,7 @@
   let acceptedEquation = null; // the equation text the server last accepted (as the box showed it)
   function applyShape() {
     clearTimeout(typing);
+    acted();
     const text = $("equation").value;
     const name = userName ? $("shape-name").value.trim()
       : (text === acceptedEquation || sceneMode ? $("shape-name").value : "surface");
@@ -242,7 +260,7 @@
       const show = () => { value.textContent = Number(state.values[name]).toPrecision(4); };
       show();
       // coarse while it moves, refined when it rests: even when it is let go where it started (no "change")
-      slider.addEventListener("input", () => { state.values[name] = parseFloat(slider.value); show(); moved(); });
+      slider.addEventListener("input", () => { acted(); state.values[name] = parseFloat(slider.value); show(); moved(); });
       slider.addEventListener("change", () => requestRender(true));
       const setRange = () => {
         const a = parseFloat(min.value), b = parseFloat(max.value);
@@ -279,8 +297,9 @@
     lastError = "";
     if (kind === KIND_MESH) { implgenMesh.received(bytes); return; } // Save mesh (mesh.js)
     if (kind === KIND_SAVE) {
-      download(new Blob([bytes], { type: "image/png" }), "implgen-view.png");
-      showMessage(`saved ${w} x ${h} PNG`, false);
+      const name = `${fileName()}.png`;
+      download(new Blob([bytes], { type: "image/png" }), name);
+      showMessage(`saved ${name}: ${w} \u00d7 ${h} pixels`, "note");
       return;
     }
     const rank = RANK[kind];
@@ -305,6 +324,13 @@
     if (gpu && kind !== KIND_COARSE) gpu.serverFrame(ctx2d, kind === KIND_FULL);
     showEmpty((flags & FLAG_EMPTY) !== 0);
     for (const k of sentAt.keys()) if (k < fseq) sentAt.delete(k);
+  }
+
+  // saved files are named after the shape, or in a scene after the scene file (they hold the whole scene)
+  let sceneName = "";
+  function fileName() {
+    const name = sceneMode ? sceneName : $("shape-name").value;
+    return String(name).replace(/[^A-Za-z0-9_-]/g, "") || "surface";
   }
 
   function download(blob, name) {
@@ -333,6 +359,7 @@
       fitCanvas();
       setOptions(msg.options);
       sceneMode = msg.mode === "scene";
+      sceneName = typeof msg.scene_name === "string" ? msg.scene_name : "scene";
       $("gallery-row").hidden = sceneMode || gallery.length === 0;
       $("object-row").hidden = !sceneMode;
       if (sceneMode) showObjects(msg.objects, msg.object);
@@ -377,10 +404,13 @@
     } else if (msg.type === "mesh") {
       implgenMesh.message(msg);
     } else if (msg.type === "yaml") {
-      download(new Blob([msg.text], { type: "application/yaml" }), `${$("shape-name").value.replace(/[^A-Za-z0-9_]/g, "") || "scene"}.yaml`);
+      const name = `${fileName()}.yaml`;
+      download(new Blob([msg.text], { type: "application/yaml" }), name);
+      showMessage(`saved ${name}: the view as a scene file (implgen render draws it, implgen view reopens it)`, "note");
     } else if (msg.type === "page") {
       download(new Blob([msg.text], { type: "text/html" }), msg.name);
-      if (typeof msg.note === "string") showMessage(msg.note, false); // its shader cut by the GLSL budget
+      const cut = typeof msg.note === "string" ? `; ${msg.note}` : ""; // its shader cut by the GLSL budget
+      showMessage(`saved ${msg.name}: this view as a page that draws it with WebGL2, no server needed${cut}`, "note");
     } else if (msg.type === "c") {
       $("code").textContent = msg.text;
       $("code-dialog").showModal();
@@ -401,7 +431,7 @@
       // the error the server closed after stays in view (a scene file that no longer reads, too many pages)
       const text = e.code === 1013 && lastError ? lastError
         : `${lastError ? lastError + " - " : ""}disconnected from the server${why}`;
-      showMessage(text, false);
+      showMessage(text, "keep");
       overlay.connect = e.code === 1013 ? "too many pages open" : "disconnected";
       showOverlay();
     });
@@ -410,6 +440,7 @@
   // ---------------------------------------------------------------- the picture: orbit, pan, zoom
   let drag = null;
   canvas.addEventListener("pointerdown", (e) => {
+    acted();
     drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey, x0: e.clientX, y0: e.clientY, moved: false };
     canvas.setPointerCapture(e.pointerId);
     canvas.classList.add("dragging");
@@ -452,6 +483,7 @@
   canvas.addEventListener("pointercancel", endDrag);
   canvas.addEventListener("wheel", (e) => {
     e.preventDefault();
+    acted();
     state.orbit.distance = Math.max(1e-3, Math.min(1e6, state.orbit.distance * Math.exp(e.deltaY * 0.001)));
     moved();
   }, { passive: false });
@@ -465,22 +497,24 @@
   $("apply").addEventListener("click", applyShape);
   $("clip-size").addEventListener("input", () => { userClip = true; });
   for (const id of ["clip", "clip-size", "cut", "color", "inside", "background", "lights"]) {
-    $(id).addEventListener("input", moved);
+    $(id).addEventListener("input", () => { acted(); moved(); });
     $(id).addEventListener("change", () => requestRender(true));
   }
   $("reset-view").addEventListener("click", () => {
+    acted();
     state.orbit = JSON.parse(JSON.stringify(state.home));
     requestRender(true);
   });
   $("save-png").addEventListener("click", () => {
-    showMessage("rendering...", false);
+    acted();
+    showMessage(`rendering ${$("save-width").value} \u00d7 ${$("save-height").value} pixels...`, "keep");
     lastError = "";
     send({ type: "save_png", width: parseInt($("save-width").value, 10), height: parseInt($("save-height").value, 10),
       spp: parseInt($("save-spp").value, 10) });
   });
   // a link pasted into this page's address (only the part after "#" differs: no reload) opens its view too
   window.addEventListener("hashchange", () => { if (ws && !openLink()) requestRender(true); });
-  $("object").addEventListener("change", () => send({ type: "object", index: Number($("object").value) }));
+  $("object").addEventListener("change", () => { acted(); send({ type: "object", index: Number($("object").value) }); });
 
   // ---------------------------------------------------------------- the gallery (gallery.json: docs/surfaces.md)
   let gallery = [];
@@ -495,6 +529,7 @@
     const g = gallery[Number($("gallery").value)];
     $("gallery").value = "";
     if (!g) return;
+    acted();
     const params = g.params || {};
     $("equation").value = g.equation;
     $("params-text").value = Object.entries(params).map(([k, v]) => `${k} = ${v}`).join(", ");
@@ -509,11 +544,15 @@
     navigator.clipboard.writeText(location.href).then(() => showMessage("link copied: it reopens this view", false),
       () => showMessage(`the link: ${location.href}`, false));
   });
-  $("save-yaml").addEventListener("click", () => send({ type: "save_yaml", width: canvas.width, height: canvas.height }));
+  $("save-yaml").addEventListener("click", () => acted() || send({ type: "save_yaml", width: canvas.width, height: canvas.height }));
   $("shape-name").addEventListener("input", () => { userName = true; });
   $("shape-name").addEventListener("keydown", (e) => { if (e.key === "Enter") applyShape(); });
   $("show-c").addEventListener("click", () => send({ type: "show_c" }));
-  $("export-page").addEventListener("click", () => send({ type: "export_page" }));
+  $("export-page").addEventListener("click", () => {
+    showMessage("making the page (its GLSL)...", "keep");
+    send({ type: "export_page" });
+  });
+  $("message").addEventListener("click", () => showMessage("", "note")); // dismissed
   $("close-code").addEventListener("click", () => $("code-dialog").close());
 
   // ---------------------------------------------------------------- the picture's size: the window's
