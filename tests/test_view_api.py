@@ -264,7 +264,9 @@ def test_save_yaml_is_a_scene_that_renders_to_the_page_s_full_frame(client, tmp_
     rendered = np.asarray(Image.open(tmp_path / "out.png").convert("RGB"))
     assert np.array_equal(rendered, full)  # the same picture, pixel for pixel
     assert full.std() > 10
-    doc = document_factory(path)()  # `implgen view saved.yaml`: the same view
+    doc = document_factory(path)()  # `implgen view saved.yaml`: the same view, on the page it was saved from
+    assert doc.base is None and (doc.options.clip, doc.options.cut, doc.options.lights) == (clip, cut, "studio")
+    assert doc.options.color == (0.2, 0.7, 0.4) and doc.options.clip_size == (3.5 if clip != "none" else 3.0)
     again = to_uint8(render(doc.scene(96, 72, 4), threads=2))
     assert np.abs(again.astype(int) - full).mean() < 0.5
 

@@ -88,3 +88,90 @@ def test_messages_are_where_the_eye_is_and_every_saved_file_is_said(server, size
     wheel(d)
     wait(d, lambda d: text(d, "message") == "", "the note on the copied link stayed after the view moved")
     wait_full_after(d, seq)
+
+
+def saved_text(driver, button: str = "save-yaml") -> str:
+    """Click `button` and return the text of the file the page hands to the browser."""
+    driver.execute_script(
+        "window.saved = []; const make = URL.createObjectURL;"
+        "URL.createObjectURL = (b) => { window.saved.push(b); return make(b); };"
+    )
+    driver.find_element("id", button).click()
+    return driver.execute_async_script(
+        "const done = arguments[arguments.length - 1];"
+        "const look = () => window.saved.length ? window.saved[0].text().then(done) : setTimeout(look, 50);"
+        "look();"
+    )
+
+
+def set_field(driver, element_id: str, value) -> None:
+    """A control set as a person sets it: the value, then its input and change events."""
+    driver.execute_script(
+        "const e = document.getElementById(arguments[0]); e.value = arguments[1];"
+        "e.dispatchEvent(new Event('input')); e.dispatchEvent(new Event('change'));",
+        element_id,
+        value,
+    )
+
+
+def set_slider(driver, name: str, value: float) -> None:
+    driver.execute_script(
+        "const s = document.querySelector(`input[type=range][data-name=${arguments[0]}]`); s.value = arguments[1];"
+        "s.dispatchEvent(new Event('input')); s.dispatchEvent(new Event('change'));",
+        name,
+        value,
+    )
+
+
+def page_look(driver) -> dict:
+    """What the page shows of the view: mode, Look controls (and whether they can be used), sliders."""
+    return driver.execute_script(
+        "const v = (id) => document.getElementById(id).value, off = (id) => document.getElementById(id).disabled;"
+        "const sliders = [...document.querySelectorAll('#sliders .slider')].map((row) => {"
+        "  const [lo, s, hi] = row.querySelectorAll('input');"
+        "  return [s.dataset.name, lo.value, hi.value, Number(s.value)]; });"
+        "return {clip: v('clip'), size: v('clip-size'), cut: document.getElementById('cut').checked,"
+        " color: v('color'), inside: v('inside'), background: v('background'), lights: v('lights'),"
+        " disabled: ['clip', 'clip-size', 'cut', 'color', 'inside'].filter(off),"
+        " gallery: !document.getElementById('gallery-row').hidden,"
+        " objects: !document.getElementById('object-row').hidden, sliders,"
+        " equation: v('equation'), name: v('shape-name')}"
+    )
+
+
+def test_a_saved_yaml_reopens_as_the_same_page(server, tmp_path) -> None:
+    """Save YAML, then `implgen view FILE`: the picture was right, but the page opened in scene mode with the Look
+    controls disabled, clip "none", size 3, a gold colour while the picture was box-clipped and red, the gallery
+    hidden, a slider's span made anew around the saved value. Now the file reopens as the page it was saved from."""
+    from test_view_browser import canvas_pixels
+
+    d = chromium(1280, 800)
+    try:
+        seq = open_page(d, server)
+        set_field(d, "clip", "box")
+        set_field(d, "clip-size", "1.6")
+        d.execute_script("document.getElementById('clip-size').dispatchEvent(new Event('input'))")
+        set_field(d, "color", "#e02020")
+        set_field(d, "background", "#203040")
+        set_field(d, "lights", "headlight")
+        set_slider(d, "a", 1.2345)
+        seq = wait_full_after(d, seq)
+        wheel(d, 2)
+        import time
+
+        time.sleep(0.6)  # the wheel's rest
+        seq = wait_full_after(d, max(seq, frame_state(d)[0] - 1))
+        before, shown = page_look(d), canvas_pixels(d)
+        path = tmp_path / "torus.yaml"
+        path.write_text(saved_text(d))
+        with view_process(str(path)) as url:
+            open_page(d, url)
+            wait(d, lambda d: frame_state(d)[1] == "full", "the saved view was not drawn")
+            after = page_look(d)
+            assert after == before, (after, before)
+            assert after["disabled"] == [] and after["gallery"] and not after["objects"]
+            import numpy as np
+
+            assert np.abs(canvas_pixels(d) - shown).mean() < 1.0
+    finally:
+        d.quit()

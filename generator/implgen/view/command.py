@@ -44,7 +44,7 @@ def document_factory(path: Path | None):
         scene_path = path
 
         def scene_document() -> Document:
-            return Document.for_scene(parse_scene(read_yaml(scene_path, what="scene"), scene_path))
+            return Document.for_file(parse_scene(read_yaml(scene_path, what="scene"), scene_path))
 
         scene_document.reads_files = True
         return scene_document

@@ -132,6 +132,12 @@ class Document:
         doc.options = Options(clip="none", lights="scene", background=scene.background)
         return doc
 
+    @staticmethod
+    def for_file(scene: Scene) -> Document:
+        """A scene file's document: the page's own saved view (Save YAML of a shape) reopens as that page, a spec
+        with its clip, colours, light preset and camera; any other scene is edited as a scene."""
+        return saved_view(scene) or Document.for_scene(scene)
+
     def shape_state(self) -> dict:
         """The shape the page shows: its name, equation, params, their values and the degree."""
         spec = self.spec
@@ -141,6 +147,7 @@ class Document:
             "params": spec.params,
             "values": self.values,
             "degree": spec.degree,
+            "ranges": {k: list(r) for k, r in spec.ranges.items()},  # the sliders' spans
         }
 
     def scene_name(self) -> str:
@@ -262,6 +269,65 @@ class Document:
         sc.lights = self.lights()
         sc.background = self.options.background
         return sc
+
+
+def _saved_shape(node: Node) -> tuple[Leaf, Material, str | None, float, bool] | None:
+    """The shape of a view Save YAML wrote and its clip: (leaf, material, clip kind or None, size, cut), or None
+    when the object is not one (a transform, a material of another kind, a clip off the origin)."""
+    clip, size, cut = None, 3.0, False
+    if isinstance(node, Csg):  # the cut solid: the shape intersected with the clip solid, its cut face inside
+        right = node.right
+        kind = next((k for k, c in CLIP_SPECS.items() if isinstance(right, Leaf) and right.spec.name == c.name), None)
+        if node.op != "intersection" or not isinstance(node.left, Leaf) or kind is None:
+            return None
+        if right.spec.equation != CLIP_SPECS[kind].equation or set(right.params) != {"r"}:
+            return None
+        leaf, material, clip, size, cut = node.left, node.material, kind, float(right.params["r"]), True
+        if leaf.material is not None or right.material != replace(material, color=material.inside):
+            return None
+    else:
+        leaf, material = node, node.material
+        if leaf.clip is not None:
+            if any(leaf.clip.center):
+                return None
+            clip, size = leaf.clip.kind, leaf.clip.size
+    if not isinstance(leaf, Leaf) or leaf.clip is not None and cut or not np.array_equal(leaf.matrix, np.eye(3, 4)):
+        return None
+    if material is None or material.inside is None or material != Material(material.color, inside=material.inside,
+                                                                              **MATERIAL):
+        return None
+    return leaf, material, clip, size, cut
+
+
+def _close(a, b, scale: float) -> bool:
+    return bool(np.allclose(np.asarray(a, float), np.asarray(b, float), rtol=0.0, atol=1e-9 * scale))
+
+
+def saved_view(scene: Scene) -> Document | None:
+    """The page a scene file was saved from (dump.yaml_text of a shape, not of a scene): one shape, untransformed,
+    in the viewer's two-sided material, clipped about the origin or not at all, seen by an orbit camera under one of
+    the light presets. None for any other scene."""
+    if len(scene.objects) != 1 or scene.animation.frames > 1:
+        return None
+    found = _saved_shape(scene.objects[0])
+    if found is None:
+        return None
+    leaf, material, clip, size, cut = found
+    doc = Document(spec=leaf.spec, values=dict(leaf.params), orbit=Orbit.looking(scene.camera))
+    cam, scale = doc.orbit.camera(), max(1.0, doc.orbit.distance)
+    if not (_close(cam.position, scene.camera.position, scale) and _close(cam.up, scene.camera.up, 1.0)):
+        return None
+    doc.options = Options(clip=clip or "none", clip_size=size, cut=cut, color=material.color,
+                          inside=material.inside, background=scene.background)
+    for preset in LIGHT_PRESETS:
+        doc.options.lights = preset
+        lights = doc.lights()
+        if len(lights) == len(scene.lights) and all(
+            _close(a.position, b.position, scale) and _close(a.color, b.color, 1.0)
+            for a, b in zip(lights, scene.lights)
+        ):
+            return doc
+    return None
 
 
 def _with_leaf(node: Node, edits: dict[int, tuple[Spec, dict[str, float]]]) -> Node:

@@ -10,7 +10,9 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
                                                                       the page draws the live picture itself,
                                                                       so no coarse frames, only the refined
     {"type": "save_png", "width": 1920, "height": 1080, "spp": 16}    the current view through render()
-    {"type": "save_yaml", "width": 640, "height": 480}               the view as a scene file (its full frame)
+    {"type": "save_yaml", "width": 640, "height": 480,
+     "ranges": {"a": [0, 2]}}                                         the view as a scene file (its full frame),
+                                                                      with the page's slider ranges
     {"type": "save_mesh", "cells": 128, "values": {...},
      "options": {...}}                                                the shape as a closed STL (meshsave.py)
     {"type": "stop_mesh"}                                             stop the mesh in progress
@@ -188,6 +190,29 @@ def parse_values(raw: Any, spec: Spec) -> dict[str, float]:
         if name in spec.params:  # a stale slider of a param that is gone is ignored
             values[name] = validate.number("values", str(name), v, *RANGES["value"])
     return values
+
+
+def parse_ranges(raw: Any, spec: Spec, values: dict[str, float]) -> dict[str, tuple[float, float]]:
+    """The page's slider ranges (Save YAML keeps them): for the shape's params, low below high, widened to hold the
+    value; a range at whose ends a coefficient would not stay a finite double is left out."""
+    out = {}
+    for name, pair in _mapping("ranges", raw if raw is not None else {}).items():
+        if name not in spec.params:
+            continue
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise UserError("ranges", f"{name}: expected [low, high]")
+        lo, hi = (validate.number("ranges", str(name), v, *RANGES["value"]) for v in pair)
+        value = values.get(name, spec.params[name])
+        lo, hi = min(lo, value), max(hi, value)
+        if not lo < hi:
+            continue
+        try:
+            spec.check_values({name: lo}, "ranges", name)
+            spec.check_values({name: hi}, "ranges", name)
+        except UserError:
+            continue
+        out[name] = (lo, hi)
+    return out
 
 
 def parse_orbit(raw: Any) -> Orbit:

@@ -123,7 +123,10 @@ class Session:
                 self.meshes.stop()
             elif kind == "save_yaml":
                 width, height = protocol.parse_size(data, "save_yaml")
-                text = await self.work.call(self.work.parse, dump.yaml_text, replace(self.doc), width, height, FULL_SPP)
+                doc = replace(self.doc)
+                ranges = protocol.parse_ranges(data.get("ranges"), doc.spec, doc.values)
+                doc.spec = replace(doc.spec, ranges={**doc.spec.ranges, **ranges})  # for the file only
+                text = await self.work.call(self.work.parse, dump.yaml_text, doc, width, height, FULL_SPP)
                 await self.send({"type": "yaml", "mode": self._mode(), "text": text})
             elif kind in ("pick", "object"):
                 await self._pick(data)

@@ -30,6 +30,7 @@
     options: {},
     home: null, // the orbit to go back to
   };
+  const userRanges = new Set(); // the params whose slider span the user set by hand
   let ws = null;
   let lastError = ""; // the server's last error line, kept when the socket closes after it
   let messageIsError = false; // the message line holds an error: the next picture clears it
@@ -222,8 +223,12 @@
     $("equation-error").textContent = "";
     state.params = byName(msg.params);
     state.values = byName(msg.values);
+    const given = byName(msg.ranges);
     for (const [k, v] of Object.entries(state.params)) {
-      if (!Object.hasOwn(state.ranges, k)) {
+      const r = given[k];
+      if (!userRanges.has(k) && Array.isArray(r) && r.length === 2) {
+        state.ranges[k] = [Math.min(r[0], state.values[k]), Math.max(r[1], state.values[k])];
+      } else if (!Object.hasOwn(state.ranges, k)) {
         const span = Math.max(1, Math.abs(v));
         state.ranges[k] = [v - span, v + span];
       }
@@ -266,6 +271,7 @@
         const a = parseFloat(min.value), b = parseFloat(max.value);
         if (Number.isFinite(a) && Number.isFinite(b) && a < b) {
           state.ranges[name] = [a, b];
+          userRanges.add(name); // the user's own span stays while the param does
           slider.min = a; slider.max = b; slider.step = (b - a) / 1000;
           slider.value = state.values[name];
         }
@@ -534,6 +540,7 @@
     $("equation").value = g.equation;
     $("params-text").value = Object.entries(params).map(([k, v]) => `${k} = ${v}`).join(", ");
     state.ranges = byName(g.ranges);
+    userRanges.clear();
     $("gallery-note").textContent = `${g.title}: ${g.description} (${g.reference})`;
     userName = false;
     send({ type: "shape", equation: g.equation, name: g.name, params, ranges: g.ranges || {}, bounds: g.bounds || null,
@@ -544,7 +551,12 @@
     navigator.clipboard.writeText(location.href).then(() => showMessage("link copied: it reopens this view", false),
       () => showMessage(`the link: ${location.href}`, false));
   });
-  $("save-yaml").addEventListener("click", () => acted() || send({ type: "save_yaml", width: canvas.width, height: canvas.height }));
+  $("save-yaml").addEventListener("click", () => {
+    acted();
+    const ranges = byName();
+    for (const k of Object.keys(state.params)) ranges[k] = state.ranges[k];
+    send({ type: "save_yaml", width: canvas.width, height: canvas.height, ranges });
+  });
   $("shape-name").addEventListener("input", () => { userName = true; });
   $("shape-name").addEventListener("keydown", (e) => { if (e.key === "Enter") applyShape(); });
   $("show-c").addEventListener("click", () => send({ type: "show_c" }));
