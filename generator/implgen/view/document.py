@@ -293,8 +293,11 @@ def _saved_shape(node: Node) -> tuple[Leaf, Material, str | None, float, bool] |
             clip, size = leaf.clip.kind, leaf.clip.size
     if not isinstance(leaf, Leaf) or leaf.clip is not None and cut or not np.array_equal(leaf.matrix, np.eye(3, 4)):
         return None
-    if material is None or material.inside is None or material != Material(material.color, inside=material.inside,
-                                                                              **MATERIAL):
+    if (
+        material is None
+        or material.inside is None
+        or material != Material(material.color, inside=material.inside, **MATERIAL)
+    ):
         return None
     return leaf, material, clip, size, cut
 
@@ -317,8 +320,14 @@ def saved_view(scene: Scene) -> Document | None:
     cam, scale = doc.orbit.camera(), max(1.0, doc.orbit.distance)
     if not (_close(cam.position, scene.camera.position, scale) and _close(cam.up, scene.camera.up, 1.0)):
         return None
-    doc.options = Options(clip=clip or "none", clip_size=size, cut=cut, color=material.color,
-                          inside=material.inside, background=scene.background)
+    doc.options = Options(
+        clip=clip or "none",
+        clip_size=size,
+        cut=cut,
+        color=material.color,
+        inside=material.inside,
+        background=scene.background,
+    )
     for preset in LIGHT_PRESETS:
         doc.options.lights = preset
         lights = doc.lights()
