@@ -172,6 +172,7 @@ def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
             "params": {"r": 1.5},
             "values": {"r": 1.5},
             "degree": 2,
+            "ranges": {},  # the sliders' spans the spec declares
             "shape_id": 1,  # the first shape accepted since the hello (the GPU preview's GLSL names it)
             "fit": None,  # not asked for
             "objects": [],  # a scene file's, to pick from
@@ -311,7 +312,9 @@ def test_failures_are_one_error_reply_and_the_page_keeps_going(client, monkeypat
             assert reply(ws) == {"type": "error", "field": "message", "message": line}
         ws.send_text(json.dumps({"type": "shape", "equation": "x^2 +"}))
         err = reply(ws)
-        assert err["field"] == "equation" and "syntax error in 'x^2 +'" in err["message"], err
+        assert err["field"] == "equation" and "syntax error at column 5: '+' has nothing after it" in err["message"]
+        assert err["position"] == 4  # the page's caret goes under the '+'
+
         ws.send_bytes(b"{}")
         assert reply(ws) == {"type": "error", "field": "message", "message": "message: expected text (JSON)"}
         ws.send_text(render_msg(hello, seq=2, refine=False))

@@ -175,3 +175,36 @@ def test_a_saved_yaml_reopens_as_the_same_page(server, tmp_path) -> None:
             assert np.abs(canvas_pixels(d) - shown).mean() < 1.0
     finally:
         d.quit()
+
+
+def caret_shown(driver) -> list:
+    """The equation's error as shown: [message, the line at fault, the caret line, whether it all fits]."""
+    return driver.execute_script(
+        "const e = document.getElementById('equation-error'), pre = e.querySelector('pre');"
+        "if (!pre) return [e.textContent];"
+        "const [line, caret] = pre.textContent.split('\\n');"
+        "return [e.firstChild.textContent, line, caret, pre.scrollWidth <= pre.clientWidth];"
+    )
+
+
+def test_a_syntax_error_says_where_with_a_caret_and_the_likely_fix(server, sized) -> None:
+    """`x^2 + y^2 + (z^2 - 1` and `2x^2 + y^2` used to give only "syntax error in '...'": now the message says
+    the column and the fix, and a caret under the equation's line points at the place, whole in the panel."""
+    from test_view_page import apply
+
+    d = sized
+    open_page(d, server)
+    apply(d, "x^2 + y^2 + (z^2 - 1")
+    wait(d, lambda d: "column" in caret_shown(d)[0], "no place given for an unclosed '('")
+    message, line, caret, fits = caret_shown(d)
+    assert "syntax error at column 13: '(' is never closed" in message
+    assert line == "x^2 + y^2 + (z^2 - 1" and caret == " " * 12 + "^" and fits
+    apply(d, "2x^2 + y^2 + z^2 - 4*x*y*z + 2")
+    wait(d, lambda d: "2x" in caret_shown(d)[0], "no fix named for 2x")
+    message, line, caret, fits = caret_shown(d)
+    assert "write 2*x for 2x" in message and caret == " ^" and fits
+    long = "x^2 + y^2 + z^2 - 1 + " * 4 + "(x + y"
+    apply(d, long)
+    wait(d, lambda d: "never closed" in caret_shown(d)[0], "no place given in a long equation")
+    message, line, caret, fits = caret_shown(d)
+    assert fits and line[len(caret) - 1] == "(" and line.startswith("\u2026")  # a window about the place

@@ -27,7 +27,8 @@ error reply, whatever failed, is built here (`error`, `error_for`). An equation'
 high degree) is remembered, refusal included, for the last PARSE_CACHE mappings of text, params and bounds: the
 session runs it on its parse pool, never on the event loop.
 
-    {"type": "error", "field": "equation" | "message", "message": "..."}
+    {"type": "error", "field": "equation" | "message", "message": "...",
+     "position": 12}                                                  (an equation's: the character at fault)
 """
 
 from __future__ import annotations
@@ -105,8 +106,9 @@ def error_for(err: Exception) -> dict:
         err = out_of_files_error(None, err)
     if not isinstance(err, UserError):
         return error("message", f"internal error: {type(err).__name__}")
-    if err.source == "equation":
-        return error("equation", err.message)
+    if err.source == "equation":  # beside the equation box, a caret under the character at fault when known
+        reply = error("equation", err.message)
+        return reply if err.position is None else {**reply, "position": err.position}
     return error("message", str(err))
 
 
@@ -136,7 +138,7 @@ def _parse(mapping: dict[str, Any]) -> Spec:
     """parse_spec(mapping, "equation"), remembered by the mapping's JSON text (the last PARSE_CACHE of them)."""
     hit = _parse_text(json.dumps(mapping, sort_keys=True))
     if isinstance(hit, UserError):
-        raise UserError(hit.source, hit.message)
+        raise UserError(hit.source, hit.message, hit.position)
     return hit
 
 

@@ -199,6 +199,7 @@
     const text = $("equation").value;
     const name = userName ? $("shape-name").value.trim()
       : (text === acceptedEquation || sceneMode ? $("shape-name").value : "surface");
+    sentEquation = text;
     send({ type: "shape", equation: text, name, params: parseParamsText($("params-text").value),
       fit: !userClip });
   }
@@ -215,6 +216,29 @@
       o.target = [0, 0, 0];
       o.distance = r / Math.sin(o.fov * Math.PI / 360) * 1.1;
     }
+  }
+
+  // The parser's line under the equation box; where it knows the character at fault, that line of the equation
+  // (at most CARET_WIDE characters of it about the place) with a caret under it.
+  const CARET_WIDE = 34;
+  let sentEquation = ""; // the equation text last sent: an error's position is in it
+  function showEquationError(message, position) {
+    const box = $("equation-error");
+    box.replaceChildren(document.createTextNode(message));
+    const text = sentEquation;
+    if (!Number.isInteger(position) || position < 0 || position > text.length) return;
+    const start = text.lastIndexOf("\n", position - 1) + 1;
+    const stop = text.indexOf("\n", position);
+    let line = text.slice(start, stop < 0 ? text.length : stop).replace(/\t/g, " ");
+    let column = position - start;
+    if (line.length > CARET_WIDE) {
+      const from = Math.max(0, Math.min(column - CARET_WIDE / 2, line.length - CARET_WIDE));
+      line = (from > 0 ? "\u2026" : "") + line.slice(from, from + CARET_WIDE) + (from + CARET_WIDE < line.length ? "\u2026" : "");
+      column += from > 0 ? 1 - from : 0;
+    }
+    const caret = Object.assign(document.createElement("pre"), { className: "caret" });
+    caret.textContent = `${line}\n${" ".repeat(column)}^`;
+    box.append(caret);
   }
 
   // ---------------------------------------------------------------- messages in
@@ -403,7 +427,7 @@
     } else if (msg.type === "error") {
       if (msg.field === "equation") {
         $("equation").classList.add("bad");
-        $("equation-error").textContent = msg.message;
+        showEquationError(msg.message, msg.position);
       } else {
         showMessage(msg.message, true);
       }
@@ -543,6 +567,7 @@
     userRanges.clear();
     $("gallery-note").textContent = `${g.title}: ${g.description} (${g.reference})`;
     userName = false;
+    sentEquation = g.equation;
     send({ type: "shape", equation: g.equation, name: g.name, params, ranges: g.ranges || {}, bounds: g.bounds || null,
       fit: !userClip });
   });
