@@ -172,7 +172,7 @@ def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
             "params": {"r": 1.5},
             "values": {"r": 1.5},
             "degree": 2,
-            "ranges": {},  # the sliders' spans the spec declares
+            "ranges": {"r": [0.0, 3.0]},  # the slider's span: r only squared (a radius), 0 where the ball shrinks away
             "shape_id": 1,  # the first shape accepted since the hello (the GPU preview's GLSL names it)
             "fit": None,  # not asked for
             "objects": [],  # a scene file's, to pick from

@@ -208,3 +208,44 @@ def test_a_syntax_error_says_where_with_a_caret_and_the_likely_fix(server, sized
     wait(d, lambda d: "never closed" in caret_shown(d)[0], "no place given in a long equation")
     message, line, caret, fits = caret_shown(d)
     assert fits and line[len(caret) - 1] == "(" and line.startswith("\u2026")  # a window about the place
+
+
+def exported_ranges(html: str) -> dict[str, tuple[float, float]]:
+    """The sliders of an exported page: name -> (min, max), as its inputs have them."""
+    import re
+
+    found = re.findall(r'<input type="range" data-param="\d+" min="([^"]+)" max="([^"]+)"[^>]*aria-label="(\w+)"', html)
+    return {name: (float(lo), float(hi)) for lo, hi, name in found}
+
+
+def shown_ranges(driver) -> dict[str, tuple[float, float]]:
+    return {name: (float(lo), float(hi)) for name, lo, hi, _ in page_look(driver)["sliders"]}
+
+
+def test_slider_ranges_stay_where_the_surface_keeps_its_kind_and_the_exported_page_agrees(server) -> None:
+    """The torus's tube radius b ran -0.65..1.35 (a negative radius; past 1 a spindle), Barth's golden ratio 0..3.24,
+    and Export page made its own ranges. Now a range is where the surface stays the same kind, and the exported
+    page has the viewer's, the user's own edits included."""
+    from test_view_page import BARTH6, apply
+
+    d = chromium(1280, 800)
+    try:
+        open_page(d, server)
+        lo, hi = shown_ranges(d)["b"]
+        assert 0 <= lo < 0.35 < hi <= 1.0, (lo, hi)
+        apply(d, BARTH6, "phi = 1.618033988749895, w = 1")
+        wait(d, lambda d: text(d, "degree") == "degree 6", "Barth's sextic was not accepted")
+        wait(d, lambda d: set(shown_ranges(d)) == {"phi", "w"}, "no sliders for Barth's params")
+        lo, hi = shown_ranges(d)["phi"]
+        assert 1.0 <= lo < 1.618 < hi <= 2.3, (lo, hi)  # between phi = 1 and its mirror: no sign change
+        d.execute_script(
+            "const min = document.querySelector('input[aria-label=\"w min\"]'); min.value = '0.5';"
+            "min.dispatchEvent(new Event('change'));"
+        )
+        shown = shown_ranges(d)
+        assert shown["w"][0] == 0.5
+        exported = exported_ranges(saved_text(d, "export-page"))
+        assert exported.keys() == shown.keys()
+        assert all(exported[k] == pytest.approx(shown[k]) for k in shown), (exported, shown)
+    finally:
+        d.quit()

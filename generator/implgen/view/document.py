@@ -16,6 +16,7 @@ import numpy as np
 from implgen.scene.model import Camera, Clip, Csg, Leaf, Light, Material, Node, Scene
 from implgen.share.page import MATERIAL  # the shape's material, both sides: the shared page's too
 from implgen.spec.entry import parse_spec
+from implgen.spec.paramrange import param_ranges
 from implgen.spec.parse import Spec
 
 CLIPS = ("none", "sphere", "box")
@@ -109,6 +110,8 @@ class Document:
     leaf: Leaf | None = None
     # a scene file's leaves edited so far, other than `leaf`: id(leaf) -> (its spec, its param values)
     edits: dict[int, tuple[Spec, dict[str, float]]] = field(default_factory=dict)
+    # the slider ranges the page sent with a save or an export (the user's own spans): name -> (low, high)
+    ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     @staticmethod
     def for_spec(spec: Spec) -> Document:
@@ -147,7 +150,7 @@ class Document:
             "params": spec.params,
             "values": self.values,
             "degree": spec.degree,
-            "ranges": {k: list(r) for k, r in spec.ranges.items()},  # the sliders' spans
+            "ranges": {k: list(r) for k, r in param_ranges(spec).items()},  # the sliders' spans (paramrange.py)
         }
 
     def scene_name(self) -> str:

@@ -32,6 +32,7 @@ from implgen.errors import UserError
 from implgen.scene.build import BuildResult, build_scene, runtime_ready
 from implgen.scene.model import Scene
 from implgen.scene.render import usable_cores
+from implgen.spec.paramrange import param_ranges
 from implgen.view import dump, fit, frames, gpu, pick, protocol, sharepage
 from implgen.view.document import Document
 from implgen.view.meshsave import MeshSaver
@@ -131,7 +132,9 @@ class Session:
             elif kind in ("pick", "object"):
                 await self._pick(data)
             elif kind == "export_page":
-                name, html, note = await self.work.derive_glsl(sharepage.page_text, replace(self.doc))
+                doc = replace(self.doc)
+                doc.ranges = protocol.parse_ranges(data.get("ranges"), doc.spec, doc.values)
+                name, html, note = await self.work.derive_glsl(sharepage.page_text, doc)
                 await self.send({"type": "page", "name": name, "text": html, **({"note": note} if note else {})})
             elif kind == "glsl":  # the GPU preview asks for the current shape's GLSL: derived (SymPy) in a task of
                 if self._glsl is not None:  # its own, so the renders behind it are read meanwhile; a newer ask wins
@@ -158,6 +161,7 @@ class Session:
         else:
             index = validate.whole("object", "index", data.get("index"), 0, count - 1)
         self.doc.select(index)
+        await self.work.call(self.work.parse, param_ranges, self.doc.spec)  # the sliders' spans, off the loop
         self._cost = None
         self.pace.new_shape()
         self._shape_id += 1
@@ -170,6 +174,7 @@ class Session:
         spec = await self.work.call(self.work.parse, protocol.parse_shape, data, self.doc.spec)
         trial = replace(self.doc)  # the page keeps showing the current shape until the new one is built
         trial.set_spec(spec)
+        await self.work.call(self.work.parse, param_ranges, spec)  # the sliders' spans (kept with the spec)
         await self._library(trial.scene())
         fitted = None
         if data.get("fit") is True:  # the page's clip size is not the user's own: fit it to the new surface

@@ -401,11 +401,7 @@
     } else if (msg.type === "shape") {
       if (linkValues) { // the link's slider values, for the params the shape has
         for (const [k, v] of Object.entries(linkValues)) {
-          if (Object.hasOwn(msg.values, k)) {
-            msg.values[k] = v;
-            const span = Math.max(1, Math.abs(msg.params[k]));
-            state.ranges[k] = [Math.min(v, msg.params[k] - span), Math.max(v, msg.params[k] + span)];
-          }
+          if (Object.hasOwn(msg.values, k)) msg.values[k] = v; // its slider's span widened to hold it
         }
         linkValues = null;
       }
@@ -576,18 +572,21 @@
     navigator.clipboard.writeText(location.href).then(() => showMessage("link copied: it reopens this view", false),
       () => showMessage(`the link: ${location.href}`, false));
   });
-  $("save-yaml").addEventListener("click", () => {
-    acted();
+  const pageRanges = () => {
     const ranges = byName();
     for (const k of Object.keys(state.params)) ranges[k] = state.ranges[k];
-    send({ type: "save_yaml", width: canvas.width, height: canvas.height, ranges });
+    return ranges;
+  };
+  $("save-yaml").addEventListener("click", () => {
+    acted();
+    send({ type: "save_yaml", width: canvas.width, height: canvas.height, ranges: pageRanges() });
   });
   $("shape-name").addEventListener("input", () => { userName = true; });
   $("shape-name").addEventListener("keydown", (e) => { if (e.key === "Enter") applyShape(); });
   $("show-c").addEventListener("click", () => send({ type: "show_c" }));
   $("export-page").addEventListener("click", () => {
     showMessage("making the page (its GLSL)...", "keep");
-    send({ type: "export_page" });
+    send({ type: "export_page", ranges: pageRanges() }); // the sliders' spans as the page shows them
   });
   $("message").addEventListener("click", () => showMessage("", "note")); // dismissed
   $("close-code").addEventListener("click", () => $("code-dialog").close());
