@@ -249,3 +249,52 @@ def test_slider_ranges_stay_where_the_surface_keeps_its_kind_and_the_exported_pa
         assert all(exported[k] == pytest.approx(shown[k]) for k in shown), (exported, shown)
     finally:
         d.quit()
+
+
+def clip_framing(driver) -> tuple[float, float]:
+    """(the clip's bounding ball's angular radius, the picture's half-angle in its narrower direction), degrees,
+    from the page's camera, clip and canvas."""
+    import math
+
+    size = float(driver.find_element("id", "clip-size").get_attribute("value"))
+    kind = driver.find_element("id", "clip").get_attribute("value")
+    orbit, w, h = driver.execute_script(
+        "const c = document.getElementById('view'); return [window.implgenState().orbit, c.clientWidth, c.clientHeight]"
+    )
+    r = size * (math.sqrt(3) if kind == "box" else 1.0)
+    off = math.dist(orbit["target"], (0, 0, 0))
+    ball = math.degrees(math.asin(min(1.0, (r + off) / orbit["distance"])))
+    half = math.degrees(math.atan(math.tan(math.radians(orbit["fov"] / 2)) * min(1.0, w / h)))
+    return ball, half
+
+
+def framed(driver) -> bool:
+    ball, half = clip_framing(driver)
+    return 0.7 * half < ball <= half
+
+
+def test_the_camera_frames_the_clip_at_the_start_for_new_shapes_and_on_reset(server, sized) -> None:
+    """The start torus's camera framed the torus's box, not its clip ball, which overflowed the picture; after a
+    clip size set by hand (2.4) a new shape (Togliatti) overflowed it too, the camera left where it was; at
+    800×600 the picture is taller than wide and a ball framed by the vertical angle overflowed sideways. Now the
+    start, each new equation and Reset frame the clip in the picture's narrower direction."""
+    from selenium.webdriver.support.ui import Select
+
+    d = sized
+    seq = open_page(d, server)
+    assert framed(d), clip_framing(d)
+    size = d.find_element("id", "clip-size")
+    size.clear()
+    size.send_keys("2.4\n")
+    seq = wait_full_after(d, seq)
+    Select(d.find_element("id", "gallery")).select_by_visible_text("Togliatti quintic")
+    wait(d, lambda d: text(d, "degree") == "degree 5", "Togliatti's quintic was not accepted")
+    seq = wait_full_after(d, seq)
+    assert d.find_element("id", "clip-size").get_attribute("value") == "2.4"  # the user's own size stays
+    assert framed(d), clip_framing(d)
+    wheel(d, 6)  # zoom out, then back with Reset
+    seq = wait_full_after(d, seq)
+    assert not framed(d)
+    d.find_element("id", "reset-view").click()
+    wait_full_after(d, seq)
+    assert framed(d), clip_framing(d)

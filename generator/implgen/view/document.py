@@ -112,18 +112,19 @@ class Document:
     edits: dict[int, tuple[Spec, dict[str, float]]] = field(default_factory=dict)
     # the slider ranges the page sent with a save or an export (the user's own spans): name -> (low, high)
     ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
+    frame: bool = True  # the page frames the clip at the start (not a saved view's camera, nor a scene's)
 
     @staticmethod
     def for_spec(spec: Spec) -> Document:
         doc = Document(spec=spec, values=dict(spec.params))
         box = spec.box()
         if box is not None and all(math.isfinite(v) for v in box):
-            # frame the spec's box: the camera sees its bounding sphere
+            # a clip ball about the origin that holds the spec's box (its bounding sphere, and a margin)
             radius = 0.5 * math.dist(box[:3], box[3:])
             center = tuple(0.5 * (lo + hi) for lo, hi in zip(box[:3], box[3:]))
-            doc.orbit.target = center
-            doc.orbit.distance = max(1e-3, radius / math.sin(math.radians(doc.orbit.fov / 2)) * 1.1)
-            doc.options.clip_size = max(1e-3, round(radius * 1.2, 3))
+            doc.options.clip_size = max(1e-3, round(radius * 1.2 + math.dist(center, (0.0, 0.0, 0.0)), 3))
+        # the camera frames the clip ball (the page frames it again for its picture's narrower direction)
+        doc.orbit.distance = max(1e-3, doc.options.clip_size / math.sin(math.radians(doc.orbit.fov / 2)) * 1.1)
         return doc
 
     @staticmethod
@@ -163,6 +164,7 @@ class Document:
         return {
             **self.shape_state(),
             "mode": "spec" if self.base is None else "scene",
+            "frame": self.base is None and self.frame,
             "scene_name": self.scene_name(),
             "objects": self.objects(),
             "object": self.object_index(),
@@ -319,7 +321,7 @@ def saved_view(scene: Scene) -> Document | None:
     if found is None:
         return None
     leaf, material, clip, size, cut = found
-    doc = Document(spec=leaf.spec, values=dict(leaf.params), orbit=Orbit.looking(scene.camera))
+    doc = Document(spec=leaf.spec, values=dict(leaf.params), orbit=Orbit.looking(scene.camera), frame=False)
     cam, scale = doc.orbit.camera(), max(1.0, doc.orbit.distance)
     if not (_close(cam.position, scene.camera.position, scale) and _close(cam.up, scene.camera.up, 1.0)):
         return None

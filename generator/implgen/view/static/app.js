@@ -148,7 +148,7 @@
     const { view, bad } = implgenLink.decode(location.hash, linkRanges);
     // a note, not an error: the picture that follows does not clear it
     if (bad.length) showMessage(`share link: left out what did not read: ${bad.join(", ")}`, false);
-    if (view.orbit) state.orbit = view.orbit;
+    if (view.orbit) { state.orbit = view.orbit; linkCamera = true; }
     if (view.options) {
       setOptions(Object.assign(readOptions(), view.options));
       if (view.options.clip !== undefined) userClip = true; // the link's clip (and camera) stay as they are
@@ -207,15 +207,24 @@
   function fitClip(size) {
     if (userClip) return;
     const r = size ?? DEFAULT_CLIP; // none: the surface runs on (or has no real point): the default ball
-    const before = Number($("clip-size").value);
     $("clip-size").value = r;
     $("clip-size").classList.remove("bad");
     goodClipSize = r;
-    if (!(before > 0) || Math.abs(r - before) > 0.2 * before) { // a new size: frame the ball
-      const o = state.orbit;
-      o.target = [0, 0, 0];
-      o.distance = r / Math.sin(o.fov * Math.PI / 360) * 1.1;
-    }
+  }
+
+  // The camera frames the clip at the start, for each new equation and on Reset: the clip's bounding ball (about
+  // the origin; a box's is sqrt(3) times its half-edge) whole in the picture's narrower direction, with a margin,
+  // whether the size was fitted or set by hand. A link's or a saved file's camera is kept.
+  let linkCamera = false; // a link gave the camera: its shape keeps it
+  function frameClip() {
+    const o = state.orbit;
+    const typed = Number($("clip-size").value);
+    const size = typed > 0 ? typed : (goodClipSize ?? DEFAULT_CLIP);
+    const r = $("clip").value === "box" ? size * Math.sqrt(3) : size;
+    const aspect = canvas.clientWidth > 0 && canvas.clientHeight > 0 ? canvas.clientWidth / canvas.clientHeight : 1;
+    const half = Math.atan(Math.tan(o.fov * Math.PI / 360) * Math.min(1, aspect));
+    o.target = [0, 0, 0];
+    o.distance = Math.min(1e6, r / Math.sin(half) * 1.1);
   }
 
   // The parser's line under the equation box; where it knows the character at fault, that line of the equation
@@ -388,6 +397,7 @@
       linkRanges = msg.limits.ranges;
       fitCanvas();
       setOptions(msg.options);
+      if (msg.frame) { frameClip(); state.home = JSON.parse(JSON.stringify(state.orbit)); }
       sceneMode = msg.mode === "scene";
       sceneName = typeof msg.scene_name === "string" ? msg.scene_name : "scene";
       $("gallery-row").hidden = sceneMode || gallery.length === 0;
@@ -411,9 +421,12 @@
         $("equation").classList.remove("bad");
       }
       if (sceneMode && msg.objects) showObjects(msg.objects, msg.object ?? Number($("object").value));
+      const fresh = !sceneMode && $("equation").value !== acceptedEquation; // a new equation, not new defaults
       showShape(msg);
       if (gpu) gpu.shape(msg);
       if ("fit" in msg) fitClip(msg.fit);
+      if (fresh && !linkCamera) frameClip();
+      linkCamera = false;
       requestRender(true);
     } else if (msg.type === "glsl") {
       if (gpu) gpu.program(msg);
@@ -529,6 +542,7 @@
   $("reset-view").addEventListener("click", () => {
     acted();
     state.orbit = JSON.parse(JSON.stringify(state.home));
+    if (!sceneMode) frameClip(); // the clip as it is now
     requestRender(true);
   });
   $("save-png").addEventListener("click", () => {
