@@ -175,6 +175,7 @@ def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
             "ranges": {"r": [0.0, 3.0]},  # the slider's span: r only squared (a radius), 0 where the ball shrinks away
             "shape_id": 1,  # the first shape accepted since the hello (the GPU preview's GLSL names it)
             "fit": None,  # not asked for
+            "unbounded": False,  # a ball: the probe finds all of it (a cone would run on without end)
             "objects": [],  # a scene file's, to pick from
         }
         ws.send_text(
@@ -616,3 +617,15 @@ def test_the_gallery_list_is_served_as_plain_json(client) -> None:
     kummer = next(g for g in listing if g["name"] == "kummer")
     assert kummer["ranges"] == {"mu": [0.65, 1.7]} and kummer["params"] == {"mu": 1.3}
     assert set(kummer) == {"name", "title", "description", "reference", "equation", "params", "ranges", "bounds"}
+
+
+def test_the_docs_count_the_runtime_s_files_as_the_page_does() -> None:
+    """The first run's line counts the runtime's files as the build does ("3 of N files"); the docs said "of 9"
+    when the page said "of 14". A number the docs give is the build's count."""
+    import re
+
+    from implgen.scene.build import runtime_ready
+
+    text = (ROOT / "docs" / "viewer.md").read_text()
+    assert "of N files" in text
+    assert all(int(n) == runtime_ready()[1] for n in re.findall(r"\d+ of (\d+) files", text))

@@ -298,3 +298,124 @@ def test_the_camera_frames_the_clip_at_the_start_for_new_shapes_and_on_reset(ser
     d.find_element("id", "reset-view").click()
     wait_full_after(d, seq)
     assert framed(d), clip_framing(d)
+
+
+def same_line(driver, first: str, second: str) -> bool:
+    """Whether two elements (CSS selectors) sit on one line of their row."""
+    return driver.execute_script(
+        "const a = document.querySelector(arguments[0]).getBoundingClientRect(),"
+        " b = document.querySelector(arguments[1]).getBoundingClientRect();"
+        "return Math.abs((a.top + a.bottom) / 2 - (b.top + b.bottom) / 2) < 8;",
+        first,
+        second,
+    )
+
+
+def heading_in_view(driver) -> bool:
+    return driver.execute_script(
+        "const h = document.querySelector('#controls h1'), r = h.getBoundingClientRect();"
+        "const hit = document.elementFromPoint(r.left + 4, r.top + r.height / 2); return hit === h;"
+    )
+
+
+def test_small_things_labels_dialog_names_and_messages(server, sized) -> None:
+    """At 1280×800 the background swatch wrapped away from its label and Save PNG and Export page onto lines of
+    their own; "Show generated C" scrolled the panel's header away and its dialog scrolled with the code; Save PNG
+    was always implgen-view.png; a picture too large said "more than 37748736 pixels"; a cone with clip "none"
+    was one flat colour with no hint."""
+    d = sized
+    seq = open_page(d, server)
+    for control in ("color", "inside", "background", "clip", "clip-size", "lights", "save-spp"):
+        assert same_line(d, f"label[for={control}]", f"#{control}"), control
+    if d.get_window_size()["width"] >= 1280:
+        assert same_line(d, "#save-width", "#save-png")
+        assert same_line(d, "#save-yaml", "#export-page") and same_line(d, "#save-yaml", "#copy-link")
+
+    d.find_element("id", "show-c").click()
+    wait(d, lambda d: "torus_coeffs(" in text(d, "code"), "no generated C")
+    d.execute_script("document.getElementById('code').scrollTop = 1e9")
+    assert in_view(d, "close-code"), "the dialog's Close scrolled away with the code"
+    d.find_element("id", "close-code").click()
+    assert heading_in_view(d), "the panel's header scrolled away"
+
+    keep_downloads(d)
+    for field, value in (("save-width", "64"), ("save-height", "48"), ("save-spp", "1")):
+        set_field(d, field, value)
+    d.find_element("id", "save-png").click()
+    wait(d, lambda d: text(d, "message").startswith("saved torus.png"), "Save PNG did not say its file")
+    assert downloaded(d) == ["torus.png"]
+    set_field(d, "save-width", "8192")
+    set_field(d, "save-height", "8192")
+    d.find_element("id", "save-png").click()
+    wait(d, lambda d: "8192 × 8192 is 67,108,864 pixels" in text(d, "message"), "the size not said")
+    assert "6144 × 6144 would do" in text(d, "message")
+
+    from test_view_page import apply
+
+    apply(d, "x^2 + y^2 - z^2")
+    wait(d, lambda d: text(d, "degree") == "degree 2", "the cone was not accepted")
+    seq = wait_full_after(d, seq)
+    set_field(d, "clip", "none")
+    wait(d, lambda d: "runs on without end" in text(d, "overlay"), "no hint on a cone without a clip")
+    set_field(d, "clip", "sphere")
+    wait(d, lambda d: text(d, "overlay") == "", "the hint stayed with a clip")
+
+
+def test_the_first_picture_after_a_gallery_pick_is_not_a_blur(server) -> None:
+    """The first frame after a gallery pick was an 84×71 blur stretched over the picture: now a new shape's first
+    request waits a moment for its full-size picture before showing a coarse one."""
+    from selenium.webdriver.support.ui import Select
+
+    d = chromium(1280, 800)
+    try:
+        seq = open_page(d, server)
+        d.execute_script(
+            "window.drawn = []; const c = document.getElementById('view');"
+            "new MutationObserver(() => window.drawn.push([Number(c.dataset.seq), c.dataset.kind]))"
+            ".observe(c, {attributes: true, attributeFilter: ['data-frames']});"
+        )
+        Select(d.find_element("id", "gallery")).select_by_visible_text("Kummer quartic")
+        wait(d, lambda d: text(d, "degree") == "degree 4", "the Kummer quartic was not accepted")
+        wait_full_after(d, seq)
+        drawn = [kind for s, kind in d.execute_script("return window.drawn") if s > seq]
+        assert drawn and drawn[0] != "coarse", drawn
+    finally:
+        d.quit()
+
+
+def test_a_scene_s_list_fits_the_panel_and_its_files_are_named_after_the_scene(tmp_path, sized) -> None:
+    """The object drop-down ran past the panel; Save YAML was named after the picked object though it holds the
+    whole scene. Now the list fits, and the scene's files are named after the scene file."""
+    import yaml
+    from selenium.webdriver.support.ui import Select
+
+    scene = {
+        "camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "fov": 40},
+        "lights": [{"position": [0, 5, 5], "color": [1, 1, 1]}],
+        "objects": [
+            {
+                "difference": [
+                    {"equation": "x^2 + y^2 + z^2 - 1", "name": "a_rather_long_shape_name_for_the_list"},
+                    {"equation": "x^2 + (y - 0.8)^2 + z^2 - 0.36", "name": "another_long_shape_name_here"},
+                ]
+            }
+        ],
+    }
+    path = tmp_path / "long_names.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    d = sized
+    with view_process(str(path)) as url:
+        open_page(d, url)
+        fits = d.execute_script(
+            "const s = document.getElementById('object').getBoundingClientRect(),"
+            " c = document.getElementById('controls');"
+            "return s.right <= c.getBoundingClientRect().right + 1 && c.scrollWidth <= c.clientWidth;"
+        )
+        assert fits, "the object list runs past the panel"
+        Select(d.find_element("id", "object")).select_by_index(1)
+        pick = "another_long_shape_name_here"
+        wait(d, lambda d: d.find_element("id", "shape-name").get_attribute("value") == pick, "no pick")
+        keep_downloads(d)
+        d.find_element("id", "save-yaml").click()
+        wait(d, lambda d: text(d, "message").startswith("saved long_names.yaml"), "Save YAML named otherwise")
+        assert downloaded(d) == ["long_names.yaml"]

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import functools
 import json
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -282,7 +283,12 @@ def parse_save(data: dict) -> tuple[int, int, int]:
     w = validate.whole("save_png", "width", data.get("width", 1920), 1, MAX_SAVE[0])
     h = validate.whole("save_png", "height", data.get("height", 1080), 1, MAX_SAVE[1])
     if w * h > MAX_SAVE_PIXELS:
-        raise UserError("save_png", f"more than {MAX_SAVE_PIXELS} pixels")
+        k = math.sqrt(MAX_SAVE_PIXELS / (w * h))  # the same shape, within the bound
+        raise UserError(
+            "save_png",
+            f"{w} × {h} is {w * h:,} pixels, more than the {MAX_SAVE_PIXELS:,} (8192 × 4608) a saved picture may "
+            f"have: {int(w * k)} × {int(h * k)} would do",
+        )
     spp = validate.whole("save_png", "spp", data.get("spp", 16), 1, MAX_SAVE_SPP)
     return w, h, spp
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import math
 import struct
 import time
 from collections.abc import Awaitable, Callable
@@ -176,16 +177,21 @@ class Session:
         trial.set_spec(spec)
         await self.work.call(self.work.parse, param_ranges, spec)  # the sliders' spans (kept with the spec)
         await self._library(trial.scene())
-        fitted = None
-        if data.get("fit") is True:  # the page's clip size is not the user's own: fit it to the new surface
+        fitted, unbounded = None, False
+        box = spec.box(trial.values) if spec.params else spec.box()
+        if data.get("fit") is True or box is None or not all(map(math.isfinite, box)):
+            # where its real points are: the clip fitted to them (when the size is not the user's own), or that
+            # it runs on without end (the page says so when there is no clip)
             probe = fit.probe_scene(spec, trial.values)
-            fitted = await self.work.call(self.work.render, fit.fit_clip, probe, await self._library(probe))
+            far = await self.work.call(self.work.render, fit.reach, probe, await self._library(probe))
+            fitted = fit.clip_for(far) if data.get("fit") is True else None
+            unbounded = far is not None and math.isinf(far)
         self.doc.spec, self.doc.values = trial.spec, trial.values
         self._shown = None  # an accepted shape is drawn coarse first, even the same one again
         self._cost = None  # measured anew by the new shape's first render
         self.pace.new_shape()
         self._shape_id += 1
-        await self.send(self._shape_reply(fit=fitted, objects=self.doc.objects()))
+        await self.send(self._shape_reply(fit=fitted, unbounded=unbounded, objects=self.doc.objects()))
 
     # ------------------------------------------------------------------ rendering
 
@@ -209,7 +215,7 @@ class Session:
 
     async def _tell_build(self) -> None:
         """While a build lasts more than a moment: what it does, for the page's status ("compiling the runtime
-        (first run only): 3 of 9 files", once per build cache; then the shape)."""
+        (first run only): 3 of N files", once per build cache; then the shape)."""
         await asyncio.sleep(BUILD_QUIET)
         while True:
             done, total = await asyncio.to_thread(runtime_ready)

@@ -35,7 +35,7 @@
   let lastError = ""; // the server's last error line, kept when the socket closes after it
   let messageIsError = false; // the message line holds an error: the next picture clears it
   let errorSeq = 0; // ... a picture of a request sent after the error came, not an older one still on its way
-  const overlay = { connect: "connecting...", build: "", empty: false }; // what the picture's overlay says
+  const overlay = { connect: "connecting...", build: "", empty: false, unbounded: false }; // the overlay's words
   let lastBitmap = null; // the picture drawn last, drawn again when the canvas changes size
   let seq = 0;
   let drawnSeq = -1;
@@ -76,8 +76,12 @@
   }
 
   function showOverlay() {
-    // the most pressing first: a build in progress, the connection, an empty picture
-    $("overlay").textContent = overlay.build || overlay.connect || (overlay.empty ? "no real points in view" : "");
+    // the most pressing first: a build in progress, the connection, an empty picture, a surface without a clip
+    // that runs on without end (it may fill the view with one colour)
+    const endless = overlay.unbounded && !sceneMode && $("clip").value === "none"
+      ? "this surface runs on without end: with clip none it can fill the view; choose a sphere or box clip" : "";
+    $("overlay").textContent = overlay.build || overlay.connect || (overlay.empty ? "no real points in view" : "")
+      || endless;
   }
 
   function showEmpty(empty) {
@@ -117,6 +121,7 @@
       const q = queued;
       queued = null;
       seq += 1;
+      if (holdNext && q.refine) { holdSeq = seq; holdNext = false; }
       state.options = readOptions();
       if (q.refine) keepLink();
       sentAt.set(seq, { t: performance.now(), clip: state.options.clip_size });
@@ -328,9 +333,19 @@
     $("lights").value = o.lights;
   }
 
-  async function drawFrame(buf) {
+  // A new shape's first request (no drag) holds its coarse frame up to HOLD_MS for the full-size one behind it:
+  // the first picture after a gallery pick was an 84 x 71 blur. A drag's frames are never held.
+  const HOLD_MS = 1500;
+  let holdNext = false, holdSeq = -1, held = null;
+  async function drawFrame(buf, released = false) {
     const view = new DataView(buf);
     const fseq = view.getUint32(0), kind = view.getUint8(4), flags = view.getUint8(5);
+    if (kind === KIND_COARSE && fseq === holdSeq && !released) {
+      held = buf;
+      setTimeout(() => { if (held === buf) { held = null; drawFrame(buf, true); } }, HOLD_MS);
+      return;
+    }
+    if (kind !== KIND_COARSE && fseq >= holdSeq) held = null; // the sharp one came: the held one is stale
     const w = view.getUint16(8), h = view.getUint16(10);
     const bytes = new Uint8Array(buf, HEADER);
     lastError = "";
@@ -425,7 +440,10 @@
       showShape(msg);
       if (gpu) gpu.shape(msg);
       if ("fit" in msg) fitClip(msg.fit);
+      overlay.unbounded = msg.unbounded === true;
+      showOverlay();
       if (fresh && !linkCamera) frameClip();
+      if (fresh) holdNext = true; // its first picture: not a blur of a few pixels when a sharp one is near
       linkCamera = false;
       requestRender(true);
     } else if (msg.type === "glsl") {
@@ -536,7 +554,7 @@
   $("apply").addEventListener("click", applyShape);
   $("clip-size").addEventListener("input", () => { userClip = true; });
   for (const id of ["clip", "clip-size", "cut", "color", "inside", "background", "lights"]) {
-    $(id).addEventListener("input", () => { acted(); moved(); });
+    $(id).addEventListener("input", () => { acted(); moved(); showOverlay(); });
     $(id).addEventListener("change", () => requestRender(true));
   }
   $("reset-view").addEventListener("click", () => {
