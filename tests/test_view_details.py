@@ -419,3 +419,52 @@ def test_a_scene_s_list_fits_the_panel_and_its_files_are_named_after_the_scene(t
         d.find_element("id", "save-yaml").click()
         wait(d, lambda d: text(d, "message").startswith("saved long_names.yaml"), "Save YAML named otherwise")
         assert downloaded(d) == ["long_names.yaml"]
+
+
+def test_a_scene_s_link_reopens_the_same_view_of_the_same_scene(tmp_path) -> None:
+    """In scene mode a link copied after an orbit reopened another view: the link's equation went to the file's
+    first object (the floor became the picked ball). Now it names the picked object, and reopens the camera, that
+    object and its edits; the note says what a link holds."""
+    import time
+
+    import numpy as np
+    import yaml
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.support.ui import Select
+
+    from test_view_browser import canvas_pixels
+    from test_view_page import apply
+    from view_fixtures import BALLS_SCENE
+
+    path = tmp_path / "balls.yaml"
+    path.write_text(yaml.safe_dump(BALLS_SCENE))
+    d = chromium(1280, 800)
+    try:
+        with view_process(str(path)) as url:
+            seq = open_page(d, url)
+            Select(d.find_element("id", "object")).select_by_index(2)
+            wait(d, lambda d: d.find_element("id", "shape-name").get_attribute("value") == "right", "no pick")
+            apply(d, "(x - 2)^2 + y^2 + z^2 - r^2", "r = 0.6")
+            wait(d, lambda d: set(shown_ranges(d)) == {"r"}, "the right ball's edit was not accepted")
+            seq = wait_full_after(d, seq)
+            canvas = d.find_element("id", "view")
+            ActionChains(d).move_to_element(canvas).click_and_hold().move_by_offset(-60, 25).release().perform()
+            wheel(d, 2)
+            time.sleep(0.6)  # the wheel's rest
+            seq = wait_full_after(d, max(seq, frame_state(d)[0] - 1))
+            d.find_element("id", "copy-link").click()
+            wait(d, lambda d: "the picked object and its edits" in text(d, "message"), "no word on what a link holds")
+            link, here = d.current_url, canvas_pixels(d)
+            assert "obj=2" in link
+            first = d.current_window_handle
+            d.switch_to.new_window("tab")
+            open_page(d, link)
+            wait(d, lambda d: d.find_element("id", "shape-name").get_attribute("value") == "right", "not the object")
+            time.sleep(0.5)
+            wait_full_after(d, frame_state(d)[0] - 1)
+            assert Select(d.find_element("id", "object")).first_selected_option.text.startswith("right")
+            assert np.abs(canvas_pixels(d) - here).mean() < 1.0
+            d.close()
+            d.switch_to.window(first)
+    finally:
+        d.quit()

@@ -3,7 +3,8 @@
 A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
 
     {"type": "shape", "equation": "...", "params": {"a": 1.0}}        a new equation and its param defaults
-                                                                      (optional "bounds" as in a spec)
+                                                                      (optional "bounds" as in a spec; "object":
+                                                                      a scene's leaf it is for, picked first)
     {"type": "render", "seq": 7, "refine": true, "width": 640, "height": 480,
      "values": {"a": 1.2}, "orbit": {...}, "options": {...},
      "gpu": false}                                                    the view to show (the newest wins); gpu:

@@ -172,8 +172,15 @@ class Session:
         return "spec" if self.doc.base is None else "scene"
 
     async def _shape(self, data: dict) -> None:
-        spec = await self.work.call(self.work.parse, protocol.parse_shape, data, self.doc.spec)
         trial = replace(self.doc)  # the page keeps showing the current shape until the new one is built
+        picked = None
+        if data.get("object") is not None:  # a scene's link: the equation is that object's
+            count = len(self.doc.objects())
+            if count == 0:
+                raise UserError("shape", "object: only a scene file has objects to pick")
+            picked = validate.whole("shape", "object", data["object"], 0, count - 1)
+            trial.select(picked)
+        spec = await self.work.call(self.work.parse, protocol.parse_shape, data, trial.spec)
         trial.set_spec(spec)
         await self.work.call(self.work.parse, param_ranges, spec)  # the sliders' spans (kept with the spec)
         await self._library(trial.scene())
@@ -187,11 +194,15 @@ class Session:
             fitted = fit.clip_for(far) if data.get("fit") is True else None
             unbounded = far is not None and math.isinf(far)
         self.doc.spec, self.doc.values = trial.spec, trial.values
+        self.doc.leaf, self.doc.edits = trial.leaf, trial.edits  # a scene's link picked the object first
         self._shown = None  # an accepted shape is drawn coarse first, even the same one again
         self._cost = None  # measured anew by the new shape's first render
         self.pace.new_shape()
         self._shape_id += 1
-        await self.send(self._shape_reply(fit=fitted, unbounded=unbounded, objects=self.doc.objects()))
+        picked_part = {} if picked is None else {"object": picked}
+        await self.send(
+            self._shape_reply(fit=fitted, unbounded=unbounded, objects=self.doc.objects(), **picked_part)
+        )
 
     # ------------------------------------------------------------------ rendering
 

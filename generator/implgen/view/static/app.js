@@ -141,6 +141,7 @@
     const text = implgenLink.encode({
       equation: acceptedEquation, name: $("shape-name").value, params: $("params-text").value,
       values: state.values, orbit: state.orbit, options: state.options,
+      object: sceneMode ? Number($("object").value) : undefined, // a scene's: the picked object's edits
     });
     history.replaceState(null, "", `${location.pathname}${location.search}#${text}`);
   }
@@ -148,6 +149,7 @@
   // A share link's view, applied once the page has its first state from the server: its equation is sent as a
   // new shape (its clip is the user's own: not fitted), its slider values wait for the shape's reply.
   let linkValues = null;
+  let linkObject = null; // a scene link's object: its equation is sent for that object
   let linkRanges = null; // the server's ranges of the view's numbers (the hello): a link's are read within them
   function openLink() {
     const { view, bad } = implgenLink.decode(location.hash, linkRanges);
@@ -159,7 +161,11 @@
       if (view.options.clip !== undefined) userClip = true; // the link's clip (and camera) stay as they are
       if (view.options.clip_size !== undefined) goodClipSize = view.options.clip_size;
     }
-    if (view.equation === undefined) return false;
+    linkObject = sceneMode && view.object !== undefined ? view.object : null;
+    if (view.equation === undefined) {
+      if (linkObject !== null) { send({ type: "object", index: linkObject }); linkObject = null; }
+      return false;
+    }
     $("equation").value = view.equation;
     if (view.params !== undefined) $("params-text").value = view.params;
     if (view.name !== undefined) { $("shape-name").value = view.name; userName = true; }
@@ -205,8 +211,10 @@
     const name = userName ? $("shape-name").value.trim()
       : (text === acceptedEquation || sceneMode ? $("shape-name").value : "surface");
     sentEquation = text;
+    const object = linkObject !== null ? { object: linkObject } : {};
+    linkObject = null;
     send({ type: "shape", equation: text, name, params: parseParamsText($("params-text").value),
-      fit: !userClip });
+      fit: !userClip, ...object });
   }
 
   function fitClip(size) {
@@ -601,8 +609,11 @@
   });
   $("copy-link").addEventListener("click", () => {
     keepLink();
-    navigator.clipboard.writeText(location.href).then(() => showMessage("link copied: it reopens this view", false),
-      () => showMessage(`the link: ${location.href}`, false));
+    // with a scene file: the link names the file's page, and holds the camera and the picked object's edits
+    const what = sceneMode ? "this scene's view: the camera, the picked object and its edits (not other objects' "
+      + "edits; the scene file is the server's)" : "this view";
+    navigator.clipboard.writeText(location.href).then(() => showMessage(`link copied: it reopens ${what}`, false),
+      () => showMessage(`the link (it reopens ${what}): ${location.href}`, false));
   });
   const pageRanges = () => {
     const ranges = byName();
