@@ -200,9 +200,7 @@ class Session:
         self.pace.new_shape()
         self._shape_id += 1
         picked_part = {} if picked is None else {"object": picked}
-        await self.send(
-            self._shape_reply(fit=fitted, unbounded=unbounded, objects=self.doc.objects(), **picked_part)
-        )
+        await self.send(self._shape_reply(fit=fitted, unbounded=unbounded, objects=self.doc.objects(), **picked_part))
 
     # ------------------------------------------------------------------ rendering
 
