@@ -172,6 +172,7 @@ def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
             "params": {"r": 1.5},
             "values": {"r": 1.5},
             "degree": 2,
+            "object_clip": None,  # a scene's picked object's clip (a shape page's clip is the Look's)
             "ranges": {"r": [0.0, 3.0]},  # the slider's span: r only squared (a radius), 0 where the ball shrinks away
             "shape_id": 1,  # the first shape accepted since the hello (the GPU preview's GLSL names it)
             "fit": None,  # not asked for
@@ -629,3 +630,27 @@ def test_the_docs_count_the_runtime_s_files_as_the_page_does() -> None:
     text = (ROOT / "docs" / "viewer.md").read_text()
     assert "of N files" in text
     assert all(int(n) == runtime_ready()[1] for n in re.findall(r"\d+ of (\d+) files", text))
+
+
+def test_a_scene_s_top_level_object_takes_the_page_s_clip_and_a_csg_part_does_not(tmp_path) -> None:
+    """The Look's clip gives a scene's picked top-level object its own clip (the picture, Save YAML and Save mesh
+    use it); inside CSG the other parts bound a leaf, so it takes none; a shape page has no objects to clip."""
+    from implgen.view import meshsave
+    from implgen.view.document import Options
+
+    scene = dict(
+        BALLS_SCENE,
+        objects=[*BALLS_SCENE["objects"], {"difference": [{"equation": "x^2 + y^2 - 1"}, {"equation": "z"}]}],
+    )
+    doc = Document.for_scene(parse_scene(scene, tmp_path / "s.yaml"))
+    assert doc.object_clip() == {"clip": "none", "size": 3.0, "clippable": True}  # the floor
+    doc.set_clip("box", 2.5)
+    assert doc.scene().objects[0].clip.size == 2.5 and doc.scene().objects[1].clip is None
+    assert meshsave.job_for(doc, 64, doc.values, Options()).clips  # Save mesh: the floor in its box
+    doc.select(3)  # a CSG part
+    with pytest.raises(UserError, match="top-level object"):
+        doc.set_clip("sphere", 1.0)
+    doc.select(0)
+    assert doc.object_clip()["clip"] == "box"  # kept with its object
+    with pytest.raises(UserError, match="top-level object"):
+        Document.for_spec(parse_spec(_starter(), "starter")).set_clip("sphere", 1.0)

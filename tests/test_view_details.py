@@ -468,3 +468,52 @@ def test_a_scene_s_link_reopens_the_same_view_of_the_same_scene(tmp_path) -> Non
             d.switch_to.window(first)
     finally:
         d.quit()
+
+
+def test_a_scene_object_that_runs_on_without_end_is_said_and_gets_a_clip(tmp_path) -> None:
+    """An unbounded equation typed into a scene's object turned the picture to its material with no word, and
+    Save mesh on the floor said the scene gives no clip with no way to give one. Now the page says so, and the
+    Look's clip gives the picked object its own clip: the picture, Save YAML and Save mesh use it."""
+    import yaml
+    from selenium.webdriver.support.ui import Select
+
+    from test_view_page import apply
+    from view_fixtures import BALLS_SCENE
+
+    path = tmp_path / "balls.yaml"
+    path.write_text(yaml.safe_dump(BALLS_SCENE))
+    d = chromium(1280, 800)
+    try:
+        with view_process(str(path)) as url:
+            seq = open_page(d, url)
+            Select(d.find_element("id", "object")).select_by_index(1)
+            wait(d, lambda d: d.find_element("id", "shape-name").get_attribute("value") == "left", "no pick")
+            apply(d, "(x + 2)^2 + y^2 - z^2")
+            wait(d, lambda d: "left runs on without end" in text(d, "message"), "no word on an endless object")
+            assert (
+                d.find_element("id", "clip").is_enabled()
+                and d.find_element("id", "clip").get_attribute("value") == "none"
+            )
+            seq = wait_full_after(d, seq)
+            set_field(d, "clip-size", "1.5")
+            set_field(d, "clip", "sphere")
+            wait(d, lambda d: text(d, "message") == "", "the word stayed after the clip was given")
+            seq = wait_full_after(d, seq)
+            saved = yaml.safe_load(saved_text(d))
+            assert saved["objects"][1]["clip"] == {"sphere": 1.5} and "clip" not in saved["objects"][0]
+
+            Select(d.find_element("id", "object")).select_by_index(0)  # the floor: a plane
+            wait(d, lambda d: d.find_element("id", "shape-name").get_attribute("value") == "floor", "no pick")
+            wait(d, lambda d: d.find_element("id", "clip").get_attribute("value") == "none", "the floor's clip")
+            set_field(d, "clip", "box")
+            set_field(d, "clip-size", "3")  # the slab -3 < y < -2 of the cube
+            keep_downloads(d)
+            set_field(d, "mesh-cells", "64")
+            d.find_element("id", "save-mesh").click()
+            wait(d, lambda d: text(d, "message").startswith(("saved floor.stl", "save_mesh")), "no mesh")
+            assert text(d, "message").startswith("saved floor.stl"), text(d, "message")
+            Select(d.find_element("id", "object")).select_by_index(1)  # the left object keeps its clip
+            wait(d, lambda d: d.find_element("id", "clip").get_attribute("value") == "sphere", "left's clip lost")
+            assert d.find_element("id", "clip-size").get_attribute("value") == "1.5"
+    finally:
+        d.quit()

@@ -13,6 +13,7 @@ from pathlib import PurePath
 
 import numpy as np
 
+from implgen.errors import UserError
 from implgen.scene.model import Camera, Clip, Csg, Leaf, Light, Material, Node, Scene
 from implgen.share.page import MATERIAL  # the shape's material, both sides: the shared page's too
 from implgen.spec.entry import parse_spec
@@ -113,6 +114,8 @@ class Document:
     # the slider ranges the page sent with a save or an export (the user's own spans): name -> (low, high)
     ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
     frame: bool = True  # the page frames the clip at the start (not a saved view's camera, nor a scene's)
+    # a scene file's top-level leaves whose clip the page set: id(leaf) -> the clip (None: no clip)
+    clips: dict[int, Clip | None] = field(default_factory=dict)
 
     @staticmethod
     def for_spec(spec: Spec) -> Document:
@@ -152,6 +155,7 @@ class Document:
             "values": self.values,
             "degree": spec.degree,
             "ranges": {k: list(r) for k, r in param_ranges(spec).items()},  # the sliders' spans (paramrange.py)
+            "object_clip": self.object_clip(),
         }
 
     def scene_name(self) -> str:
@@ -200,6 +204,36 @@ class Document:
         if self.base is None:
             return None
         return next(i for i, leaf in enumerate(self.base.leaves()) if leaf is self.leaf)
+
+    def clippable(self) -> bool:
+        """Whether the page may give the scene's picked leaf a clip: a top-level object (inside CSG the other parts
+        bound it)."""
+        return self.base is not None and any(obj is self.leaf for obj in self.base.objects)
+
+    def leaf_clip(self) -> Clip | None:
+        """The scene's picked leaf's clip, the page's if it set one."""
+        if self.leaf is None:
+            return None
+        return self.clips[id(self.leaf)] if id(self.leaf) in self.clips else self.leaf.clip
+
+    def set_clip(self, kind: str, size: float) -> None:
+        """Give the scene's picked (top-level) leaf a clip of `kind` (none, sphere, box) about its clip's centre."""
+        if not self.clippable():
+            raise UserError("clip", "only a scene's top-level object takes a clip (in CSG the other parts bound it)")
+        old = self.leaf_clip()
+        clip = None if kind == "none" else Clip(kind=kind, size=size, center=old.center if old else (0.0, 0.0, 0.0))
+        self.clips = {**self.clips, id(self.leaf): clip}  # a new dict: a trial document shares the old one
+
+    def object_clip(self) -> dict | None:
+        """A scene's picked object's clip as the page shows it, and whether it can take one; None for a shape."""
+        if self.base is None:
+            return None
+        clip = self.leaf_clip()
+        return {
+            "clip": clip.kind if clip else "none",
+            "size": clip.size if clip else self.options.clip_size,
+            "clippable": self.clippable(),
+        }
 
     def select(self, index: int) -> None:
         """Edit the scene file's leaf `index` (in leaves() order) from now on; the edits of the one edited so
@@ -269,7 +303,7 @@ class Document:
         else:
             sc = replace(self.base, width=width, height=height, spp=spp)
             edits = {**self.edits, id(self.leaf): (self.spec, self.values)}
-            sc.objects = [_with_leaf(obj, edits) for obj in self.base.objects]
+            sc.objects = [_with_leaf(obj, edits, self.clips) for obj in self.base.objects]
         sc.camera = self.orbit.camera()
         sc.lights = self.lights()
         sc.background = self.options.background
@@ -344,13 +378,18 @@ def saved_view(scene: Scene) -> Document | None:
     return None
 
 
-def _with_leaf(node: Node, edits: dict[int, tuple[Spec, dict[str, float]]]) -> Node:
-    """A copy of the tree with each edited leaf given its spec and params."""
+def _with_leaf(
+    node: Node, edits: dict[int, tuple[Spec, dict[str, float]]], clips: dict[int, Clip | None] | None = None
+) -> Node:
+    """A copy of the tree with each edited leaf given its spec and params, and its clip where the page set one."""
     if isinstance(node, Leaf):
-        if id(node) in edits:
-            spec, values = edits[id(node)]
-            return replace(node, spec=spec, params=dict(values))
+        key = id(node)
+        if key in edits:
+            spec, values = edits[key]
+            node = replace(node, spec=spec, params=dict(values))
+        if clips and key in clips:
+            node = replace(node, clip=clips[key])
         return node
-    left = _with_leaf(node.left, edits)
-    right = _with_leaf(node.right, edits)
+    left = _with_leaf(node.left, edits, clips)
+    right = _with_leaf(node.right, edits, clips)
     return Csg(op=node.op, left=left, right=right, material=node.material, where=node.where)

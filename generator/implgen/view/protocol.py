@@ -22,6 +22,8 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
     {"type": "glsl"}                                                  the GPU preview: the shape's GLSL (gpu.py)
     {"type": "pick", "x": 120, "y": 80, "width": 640, "height": 480}  a scene file: edit the object at a pixel
     {"type": "object", "index": 2}                                    a scene file: edit this leaf
+    {"type": "clip", "clip": "sphere", "size": 2.5}                   a scene file: the picked (top-level)
+                                                                      object's clip (none, sphere, box)
 
 Bad values raise UserError naming the message field; the session sends the line back to the page. Every
 error reply, whatever failed, is built here (`error`, `error_for`). An equation's parse (seconds of SymPy at
@@ -54,7 +56,19 @@ MAX_SAVE = (8192, 8192)  # the largest saved picture
 MAX_SAVE_PIXELS = 8192 * 4608  # 8K at 16:9
 MAX_SAVE_SPP = 64
 MESH_TYPES = ("save_mesh", "stop_mesh")  # meshsave.py
-TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object", "export_page", "glsl", *MESH_TYPES)
+TYPES = (
+    "shape",
+    "render",
+    "save_png",
+    "save_yaml",
+    "show_c",
+    "pick",
+    "object",
+    "clip",
+    "export_page",
+    "glsl",
+    *MESH_TYPES,
+)
 PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
 # The ranges of the view's numbers, stated once: the checks below use them, and the hello sends them to the page,
 # whose share link (static/share.js) drops a number outside them instead of keeping a range of its own.
@@ -217,6 +231,14 @@ def parse_ranges(raw: Any, spec: Spec, values: dict[str, float]) -> dict[str, tu
             continue
         out[name] = (lo, hi)
     return out
+
+
+def parse_clip(data: dict) -> tuple[str, float]:
+    """A scene object's clip: (kind, size)."""
+    kind = data.get("clip")
+    if kind not in CLIPS:
+        raise UserError("clip", f"expected one of {', '.join(CLIPS)}")
+    return kind, validate.number("clip", "size", data.get("size"), *RANGES["clip_size"])
 
 
 def parse_orbit(raw: Any) -> Orbit:

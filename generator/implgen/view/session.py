@@ -132,6 +132,8 @@ class Session:
                 await self.send({"type": "yaml", "mode": self._mode(), "text": text})
             elif kind in ("pick", "object"):
                 await self._pick(data)
+            elif kind == "clip":  # the page renders it next, as for any change of the view
+                self.doc.set_clip(*protocol.parse_clip(data))
             elif kind == "export_page":
                 doc = replace(self.doc)
                 doc.ranges = protocol.parse_ranges(data.get("ranges"), doc.spec, doc.values)

@@ -150,6 +150,7 @@
   // new shape (its clip is the user's own: not fitted), its slider values wait for the shape's reply.
   let linkValues = null;
   let linkObject = null; // a scene link's object: its equation is sent for that object
+  let linkClip = null; // ... and its clip, given to it once its shape is back (when it can take one)
   let linkRanges = null; // the server's ranges of the view's numbers (the hello): a link's are read within them
   function openLink() {
     const { view, bad } = implgenLink.decode(location.hash, linkRanges);
@@ -162,6 +163,7 @@
       if (view.options.clip_size !== undefined) goodClipSize = view.options.clip_size;
     }
     linkObject = sceneMode && view.object !== undefined ? view.object : null;
+    linkClip = sceneMode && view.options && view.options.clip !== undefined ? readOptions() : null;
     if (view.equation === undefined) {
       if (linkObject !== null) { send({ type: "object", index: linkObject }); linkObject = null; }
       return false;
@@ -261,6 +263,33 @@
     const caret = Object.assign(document.createElement("pre"), { className: "caret" });
     caret.textContent = `${line}\n${" ".repeat(column)}^`;
     box.append(caret);
+  }
+
+  // A scene's picked object: its clip in the Look controls, which give it one when it is a top-level object (in
+  // CSG the other parts bound it); the cut solid and the colours stay the file's.
+  function showObjectClip(msg) {
+    const c = sceneMode ? msg.object_clip : null;
+    if (!c) return;
+    $("clip").value = c.clip;
+    $("clip-size").value = c.size;
+    $("clip-size").classList.remove("bad");
+    goodClipSize = c.size;
+    for (const id of ["clip", "clip-size"]) $(id).disabled = !c.clippable;
+  }
+  function sendObjectClip() {
+    const size = Number($("clip-size").value);
+    if (!(size > 0)) return; // readOptions says so
+    send({ type: "clip", clip: $("clip").value, size });
+    if (endlessWarned) { endlessWarned = false; showMessage("", "note"); }
+  }
+  // a typed equation that runs on without end, in an object with no clip, can cover the whole picture
+  let endlessWarned = false;
+  function warnEndless(msg) {
+    const c = msg.object_clip;
+    if (!msg.unbounded || !c || c.clip !== "none" || !c.clippable) return;
+    showMessage(`${msg.name} runs on without end and has no clip: it can cover the picture. Give it a clip `
+      + "(Look: clip and size) to show the part inside a ball or a box.", "keep");
+    endlessWarned = true;
   }
 
   // ---------------------------------------------------------------- messages in
@@ -427,7 +456,8 @@
       $("object-row").hidden = !sceneMode;
       if (sceneMode) showObjects(msg.objects, msg.object);
       if (msg.mode !== "scene") $("lights").querySelector("option[value=scene]").disabled = true;
-      else for (const id of ["clip", "clip-size", "cut", "color", "inside"]) $(id).disabled = true; // the file's own
+      else for (const id of ["cut", "color", "inside"]) $(id).disabled = true; // the file's own
+      showObjectClip(msg);
       showShape(msg);
       if (gpu) gpu.hello(msg, send);
       if (!openLink()) requestRender(true); // with a link's equation: drawn once it is built
@@ -448,6 +478,14 @@
       showShape(msg);
       if (gpu) gpu.shape(msg);
       if ("fit" in msg) fitClip(msg.fit);
+      showObjectClip(msg);
+      if (linkClip && msg.object_clip && msg.object_clip.clippable) {
+        $("clip").value = linkClip.clip;
+        $("clip-size").value = linkClip.clip_size;
+        sendObjectClip();
+      }
+      linkClip = null;
+      if (sceneMode) warnEndless(msg);
       overlay.unbounded = msg.unbounded === true;
       showOverlay();
       if (fresh && !linkCamera) frameClip();
@@ -562,7 +600,12 @@
   $("apply").addEventListener("click", applyShape);
   $("clip-size").addEventListener("input", () => { userClip = true; });
   for (const id of ["clip", "clip-size", "cut", "color", "inside", "background", "lights"]) {
-    $(id).addEventListener("input", () => { acted(); moved(); showOverlay(); });
+    $(id).addEventListener("input", () => {
+      acted();
+      if (sceneMode && (id === "clip" || id === "clip-size")) sendObjectClip(); // the picked object's own
+      moved();
+      showOverlay();
+    });
     $(id).addEventListener("change", () => requestRender(true));
   }
   $("reset-view").addEventListener("click", () => {
