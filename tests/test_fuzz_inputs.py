@@ -179,6 +179,7 @@ def test_equation_parser_refuses_with_one_line(text):
             parse_expression(rhs, VARIABLES, SYMBOLS, 24)
         except ParseError as err:
             assert str(err) and "\n" not in str(err)
+            assert err.position is None or 0 <= err.position <= len(err.text)  # the caret's place is in the text
 
 
 # -------------------------------------------------------------------------------------------- specs

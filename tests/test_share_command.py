@@ -114,8 +114,8 @@ def test_a_page_holds_the_shape_and_runtime_and_fetches_nothing(tmp_path, capsys
     assert data["runtime"] == runtime_text()
     assert data["name"] == "torus_y"
     assert [(q["name"], q["value"], q["min"], q["max"]) for q in data["params"]] == [
-        ("a", 1.0, 0.0, 2.0),
-        ("b", 0.25, -0.75, 1.25),
+        ("a", 1.0, 0.25, 1.75),  # where the ring torus stays one (spec/paramrange.py, as the viewer's sliders)
+        ("b", 0.25, 0.003, 1.0),
     ]
     # nothing from elsewhere: no URL, no element that loads anything
     assert not re.search(r"https?:|//[a-z0-9.-]+\.[a-z]{2,}/", html, re.I)
@@ -136,8 +136,8 @@ def test_a_page_holds_the_shape_and_runtime_and_fetches_nothing(tmp_path, capsys
     assert "degree 4" in text
     sliders = [a for t, a in p.tags if t == "input" and a.get("type") == "range"]
     assert [(a["aria-label"], a["min"], a["max"], a["value"]) for a in sliders] == [
-        ("a", "0.0", "2.0", "1.0"),
-        ("b", "-0.75", "1.25", "0.25"),
+        ("a", "0.25", "1.75", "1.0"),
+        ("b", "0.003", "1.0", "0.25"),
     ]
 
 
@@ -186,7 +186,7 @@ def test_params_ranges_and_clip_from_the_options(tmp_path, capsys):
     _, p = parse_page(out)
     data = page_data(p)
     assert [(q["name"], q["value"], q["min"], q["max"]) for q in data["params"]] == [
-        ("a", 1.0, 0.0, 2.0),
+        ("a", 1.0, 0.25, 1.75),
         ("b", 0.4, 0.05, 0.5),
     ]
     assert data["clip"] == {"kind": "box", "size": 1.5, "cut": False}  # the viewer's default: cut open

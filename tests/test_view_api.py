@@ -172,8 +172,11 @@ def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
             "params": {"r": 1.5},
             "values": {"r": 1.5},
             "degree": 2,
+            "object_clip": None,  # a scene's picked object's clip (a shape page's clip is the Look's)
+            "ranges": {"r": [0.0, 3.0]},  # the slider's span: r only squared (a radius), 0 where the ball shrinks away
             "shape_id": 1,  # the first shape accepted since the hello (the GPU preview's GLSL names it)
             "fit": None,  # not asked for
+            "unbounded": False,  # a ball: the probe finds all of it (a cone would run on without end)
             "objects": [],  # a scene file's, to pick from
         }
         ws.send_text(
@@ -264,7 +267,9 @@ def test_save_yaml_is_a_scene_that_renders_to_the_page_s_full_frame(client, tmp_
     rendered = np.asarray(Image.open(tmp_path / "out.png").convert("RGB"))
     assert np.array_equal(rendered, full)  # the same picture, pixel for pixel
     assert full.std() > 10
-    doc = document_factory(path)()  # `implgen view saved.yaml`: the same view
+    doc = document_factory(path)()  # `implgen view saved.yaml`: the same view, on the page it was saved from
+    assert doc.base is None and (doc.options.clip, doc.options.cut, doc.options.lights) == (clip, cut, "studio")
+    assert doc.options.color == (0.2, 0.7, 0.4) and doc.options.clip_size == (3.5 if clip != "none" else 3.0)
     again = to_uint8(render(doc.scene(96, 72, 4), threads=2))
     assert np.abs(again.astype(int) - full).mean() < 0.5
 
@@ -309,7 +314,9 @@ def test_failures_are_one_error_reply_and_the_page_keeps_going(client, monkeypat
             assert reply(ws) == {"type": "error", "field": "message", "message": line}
         ws.send_text(json.dumps({"type": "shape", "equation": "x^2 +"}))
         err = reply(ws)
-        assert err["field"] == "equation" and "syntax error in 'x^2 +'" in err["message"], err
+        assert err["field"] == "equation" and "syntax error at column 5: '+' has nothing after it" in err["message"]
+        assert err["position"] == 4  # the page's caret goes under the '+'
+
         ws.send_bytes(b"{}")
         assert reply(ws) == {"type": "error", "field": "message", "message": "message: expected text (JSON)"}
         ws.send_text(render_msg(hello, seq=2, refine=False))
@@ -611,3 +618,39 @@ def test_the_gallery_list_is_served_as_plain_json(client) -> None:
     kummer = next(g for g in listing if g["name"] == "kummer")
     assert kummer["ranges"] == {"mu": [0.65, 1.7]} and kummer["params"] == {"mu": 1.3}
     assert set(kummer) == {"name", "title", "description", "reference", "equation", "params", "ranges", "bounds"}
+
+
+def test_the_docs_count_the_runtime_s_files_as_the_page_does() -> None:
+    """The first run's line counts the runtime's files as the build does ("3 of N files"); the docs said "of 9"
+    when the page said "of 14". A number the docs give is the build's count."""
+    import re
+
+    from implgen.scene.build import runtime_ready
+
+    text = (ROOT / "docs" / "viewer.md").read_text()
+    assert "of N files" in text
+    assert all(int(n) == runtime_ready()[1] for n in re.findall(r"\d+ of (\d+) files", text))
+
+
+def test_a_scene_s_top_level_object_takes_the_page_s_clip_and_a_csg_part_does_not(tmp_path) -> None:
+    """The Look's clip gives a scene's picked top-level object its own clip (the picture, Save YAML and Save mesh
+    use it); inside CSG the other parts bound a leaf, so it takes none; a shape page has no objects to clip."""
+    from implgen.view import meshsave
+    from implgen.view.document import Options
+
+    scene = dict(
+        BALLS_SCENE,
+        objects=[*BALLS_SCENE["objects"], {"difference": [{"equation": "x^2 + y^2 - 1"}, {"equation": "z"}]}],
+    )
+    doc = Document.for_scene(parse_scene(scene, tmp_path / "s.yaml"))
+    assert doc.object_clip() == {"clip": "none", "size": 3.0, "clippable": True}  # the floor
+    doc.set_clip("box", 2.5)
+    assert doc.scene().objects[0].clip.size == 2.5 and doc.scene().objects[1].clip is None
+    assert meshsave.job_for(doc, 64, doc.values, Options()).clips  # Save mesh: the floor in its box
+    doc.select(3)  # a CSG part
+    with pytest.raises(UserError, match="top-level object"):
+        doc.set_clip("sphere", 1.0)
+    doc.select(0)
+    assert doc.object_clip()["clip"] == "box"  # kept with its object
+    with pytest.raises(UserError, match="top-level object"):
+        Document.for_spec(parse_spec(_starter(), "starter")).set_clip("sphere", 1.0)

@@ -156,8 +156,9 @@ def test_the_page_in_a_real_browser(server, driver) -> None:
     eq.send_keys("x^2 + * y")
     eq.send_keys(Keys.ENTER)
     wait(driver, lambda d: d.find_element("id", "equation-error").text, "no message for a bad equation")
-    message = driver.find_element("id", "equation-error").text
-    assert "syntax error" in message and "\n" not in message
+    message, excerpt, caret = driver.find_element("id", "equation-error").text.split("\n")
+    assert "syntax error at column 7: '*' has nothing before it" in message  # one line, then where: a caret
+    assert excerpt == "x^2 + * y" and caret == "      ^"
     time.sleep(0.3)
     assert frame_state(driver)[0] == moved and np.array_equal(canvas_pixels(driver), after)
     params.clear()

@@ -12,12 +12,15 @@ OUT_OF_FILES = (errno.EMFILE, errno.ENFILE)  # this process's descriptors, or th
 class UserError(Exception):
     """Bad input from a user file or the command line.
 
-    `source` names the file (or option) at fault; `message` says what is wrong, in one line.
+    `source` names the file (or option) at fault; `message` says what is wrong, in one line. `position`, when
+    known, is the index of the character at fault in the text the message is about (an equation: the viewer puts
+    a caret under it).
     """
 
-    def __init__(self, source: str | Path | None, message: str) -> None:
+    def __init__(self, source: str | Path | None, message: str, position: int | None = None) -> None:
         self.source = _one_line(str(source)) if source is not None else None
         self.message = _one_line(str(message))
+        self.position = position
         super().__init__(str(self))
 
     def __str__(self) -> str:

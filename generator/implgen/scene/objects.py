@@ -24,7 +24,7 @@ MAX_CSG_NESTING = 32  # CSG operations nested inside each other, as written in t
 MAX_CSG_CHILDREN = 1024  # objects in one CSG list (a list becomes a balanced binary tree)
 MAX_OBJECTS = 10_000  # shapes placed in one scene, CSG operands included (each is one BVH leaf)
 CSG_OPS = ("union", "intersection", "difference")
-LEAF_KEYS = ("shape", "equation", "name", "params", "bounds", "transform", "material", "clip")
+LEAF_KEYS = ("shape", "equation", "name", "params", "bounds", "ranges", "transform", "material", "clip")
 CLIP_KEYS = (*CLIP_KINDS, "center")
 
 
@@ -62,7 +62,7 @@ def _leaf(ctx: Reader, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
             f"or a CSG operation ({', '.join(CSG_OPS)})",
         )
     if "shape" in raw:
-        for k in ("name", "bounds"):
+        for k in ("name", "bounds", "ranges"):
             if k in raw:
                 raise ctx.fail(f"{key}.{k}", "only for an inline 'equation' (a spec file has its own)")
         path = _resolve_shape_path(ctx, f"{key}.shape", raw["shape"])
@@ -78,8 +78,9 @@ def _leaf(ctx: Reader, key: str, raw: dict, named: dict[str, Material]) -> Leaf:
         ctx.count_shape(f"{key}.equation")
         ctx.inline_count += 1
         mapping = {"name": raw.get("name", f"inline{ctx.inline_count}"), "equation": raw["equation"]}
-        if "bounds" in raw:
-            mapping["bounds"] = raw["bounds"]
+        for k in ("bounds", "ranges"):  # ranges: a slider's span per param (the viewer's saved view keeps them)
+            if k in raw:
+                mapping[k] = raw[k]
         overrides: Any = {}
         if "params" in raw:
             mapping["params"], overrides = keys.inline_params(ctx, f"{key}.params", raw["params"])

@@ -20,6 +20,7 @@ from implgen.outputs import atomic_write, check_output_file
 from implgen.share.page import CLIPS, Look, Slider, framing, render_page, slider
 from implgen.spec.entry import parse_spec
 from implgen.spec.model import Spec
+from implgen.spec.paramrange import param_ranges
 from implgen.spec.paramvalues import named_items
 from implgen.yamlfile import read_yaml
 
@@ -71,7 +72,7 @@ def sliders(
             if not lo <= value <= hi:
                 raise UserError(label, f"the range does not hold {name}'s value {value:g}")
         else:
-            out.append(slider(name, value, spec.ranges))
+            out.append(slider(name, value, param_ranges(spec)))  # the spec's own, else the viewer's rule
             continue
         out.append(Slider(name, value, lo, hi))
     return out

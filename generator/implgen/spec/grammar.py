@@ -21,7 +21,6 @@ from __future__ import annotations
 import ast
 import math
 import re
-import string
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -29,6 +28,9 @@ from fractions import Fraction
 
 import sympy
 from sympy.printing.str import StrPrinter
+
+from implgen.spec import syntaxplace
+from implgen.spec.syntaxplace import ALPHABET, ParseError, check_alphabet, place_in  # noqa: F401 -- its names
 
 MAX_TEXT_LENGTH = 20_000
 MAX_NESTING = 100  # parentheses / operator nesting a user could mean
@@ -40,11 +42,6 @@ MAX_TERMS = 20_000  # terms of the expanded polynomial: (x+y+z+1)^24 has 2925; (
 _TERMS_CAP = 10**9
 MAX_EXPONENT = 400  # |e| in 1.5e-7 as written; every constant stays within 2^±256 anyway
 _EXPONENT = re.compile(r"[eE]([-+]?[0-9_]+)$")
-ALPHABET = frozenset(string.ascii_letters + string.digits + " \t\n._+-*/^()=")
-
-
-class ParseError(ValueError):
-    """The text is not an acceptable polynomial expression; the message says why."""
 
 
 @dataclass(frozen=True)
@@ -79,8 +76,10 @@ class _Builder:
         params: Mapping[str, sympy.Symbol],
         max_degree: int,
         max_param_degree: int,
+        original: str = "",
     ) -> None:
         self.text = text
+        self.original = original  # the text as given (`^`, leading space): where errors point
         self.variables = variables
         self.params = params
         self.max_degree = max_degree
@@ -107,19 +106,25 @@ class _Builder:
         if isinstance(node, ast.Constant):
             return Parsed(self._number(node), 0, 0)
         if isinstance(node, ast.Name):
-            return self._name(node.id)
+            return self._name(node)
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
             inner = self.build(node.operand, depth + 1)
             expr = -inner.expr if isinstance(node.op, ast.USub) else inner.expr
             return Parsed(expr, inner.degree_bound, inner.param_degree_bound, inner.terms, inner.names)
         if isinstance(node, ast.BinOp):
             return self._binop(node, depth)
-        raise ParseError(self._refusal(node))
+        raise self._refused(node)
+
+    def _refused(self, node: ast.AST) -> ParseError:
+        """The refusal of `node`, the caret's place at its start (the message quotes it)."""
+        error = ParseError(self._refusal(node))
+        error.position, error.text = self._where(node), self.original
+        return error
 
     def _refusal(self, node: ast.AST) -> str:
         segment = self._segment(node) or type(node).__name__
         if isinstance(node, ast.Call):
-            what = "function calls are not allowed"
+            what = "function calls are not allowed (a product is written with *: a*(b + c))"
         elif isinstance(node, ast.Attribute):
             what = "attribute access is not allowed"
         elif isinstance(node, (ast.Lambda, ast.ListComp, ast.SetComp, ast.DictComp, ast.GeneratorExp)):
@@ -150,20 +155,28 @@ class _Builder:
             return _bounded(sympy.Rational(frac.numerator, frac.denominator))
         return _bounded(sympy.Integer(value))
 
-    def _name(self, name: str) -> Parsed:
+    def _name(self, node: ast.Name) -> Parsed:
+        name = node.id
         if name in self.variables:
             return Parsed(self.variables[name], 1, 0, 1, frozenset([name]))
         if name in self.params:
             return Parsed(self.params[name], 0, 1, 1, frozenset([name]))
         known = ", ".join([*self.variables, *self.params]) or "none"
-        raise ParseError(f"unknown symbol {name!r} (known: {known})")
+        where = self._where(node)
+        raise ParseError(f"unknown symbol {name!r}", where, self.original, f" (known: {known})")
+
+    def _where(self, node: ast.AST) -> int | None:
+        """The index in the original text of `node`'s first character."""
+        if not self.original or self._segment(node) is None:
+            return None
+        return syntaxplace.original_index(self.original, self._line_starts[node.lineno - 1] + node.col_offset)
 
     def _binop(self, node: ast.BinOp, depth: int) -> Parsed:
         op = node.op
         if isinstance(op, ast.Pow):
             return self._power(node, depth)
         if not isinstance(op, (ast.Add, ast.Sub, ast.Mult, ast.Div)):
-            raise ParseError(self._refusal(node))
+            raise self._refused(node)
         if isinstance(op, (ast.Add, ast.Sub, ast.Mult)):
             return self._chain(node, depth)
         left = self.build(node.left, depth + 1)
@@ -267,20 +280,6 @@ def _bounded(value: sympy.Rational) -> sympy.Rational:
     return value
 
 
-def _show(ch: str) -> str:
-    return repr(ch) if " " < ch < "\x7f" else f"U+{ord(ch):04X}"
-
-
-def check_alphabet(text: str) -> None:
-    """Refuse the first character outside the grammar's alphabet (comments, quotes, escapes, non-ASCII)."""
-    for i, ch in enumerate(text):
-        if ch not in ALPHABET:
-            raise ParseError(
-                f"character {_show(ch)} at position {i + 1} is not allowed (an equation uses "
-                "letters, digits, spaces, . _ + - * / ^ ( ) and one =)"
-            )
-
-
 def parse_expression(
     text: str,
     variables: Mapping[str, sympy.Symbol],
@@ -304,10 +303,10 @@ def parse_expression(
             warnings.simplefilter("error")
             tree = ast.parse(source, mode="eval")
     except (SyntaxError, SyntaxWarning, ValueError) as err:
-        raise ParseError(f"syntax error in {text.strip()[:60]!r}") from err
+        raise syntaxplace.syntax_error(text, source, err) from None
     except (RecursionError, MemoryError) as err:
         raise ParseError("expression is nested too deeply") from err
-    builder = _Builder(source, variables, params, max_degree, max_param_degree)
+    builder = _Builder(source, variables, params, max_degree, max_param_degree, text)
     try:
         parsed = builder.build(tree)
     except RecursionError as err:

@@ -161,15 +161,16 @@ def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[s
     if not isinstance(text, (str, int, float)) or isinstance(text, bool):
         raise UserError(source, "equation: must be text such as 'x^2 + y^2 + z^2 - 1'")
     symbols = {p: param_symbol(p) for p in params}
+    text = str(text)
     try:
-        lhs_text, rhs_text = split_equation(str(text))
-        lhs = parse_expression(lhs_text, VARIABLES, symbols, MAX_DEGREE)
-        rhs = parse_expression(rhs_text, VARIABLES, symbols, MAX_DEGREE)
+        lhs_text, rhs_text = split_equation(text)
+        lhs = _side(text, lhs_text, 0, symbols)
+        rhs = _side(text, rhs_text, len(lhs_text) + 1, symbols)  # a bare expr's right side is "0": no error
         check_terms(lhs.terms + rhs.terms)
         f = lhs.expr - rhs.expr
         check_depth(f)  # lhs - rhs: the right side negated can be a level deeper than either side
     except ParseError as err:
-        raise UserError(source, f"equation: {err}") from None
+        raise UserError(source, f"equation: {err}", err.position) from None
     poly = exact_polynomial(f, list(symbols.values()))
     if poly == 0:
         raise UserError(source, "equation: is identically zero (every point would be on the surface)")
@@ -193,6 +194,14 @@ def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[s
                 f"or below 2^-{MAX_COEFF_BITS} in size (not a normal double)",
             )
     return f, degree
+
+
+def _side(text: str, part: str, offset: int, symbols: dict[str, sympy.Symbol]):
+    """One side of the equation `text`, which starts at `offset` in it (an error points into `text`)."""
+    try:
+        return parse_expression(part, VARIABLES, symbols, MAX_DEGREE)
+    except ParseError as err:
+        raise err.within(text, offset) from None
 
 
 def exact_polynomial(f: sympy.Expr, params: list[sympy.Symbol]):

@@ -22,6 +22,7 @@ from pathlib import Path
 from implgen.args import ArgumentParser
 from implgen.errors import UserError
 from implgen.spec.entry import parse_spec
+from implgen.spec.paramrange import param_ranges
 from implgen.view.document import STARTER, Document
 from implgen.view.work import Limits
 from implgen.yamlfile import read_yaml
@@ -38,17 +39,21 @@ def document_factory(path: Path | None):
 
     if path is None:
         spec = parse_spec(STARTER, "starter")
+        param_ranges(spec)  # the sliders' spans, found once now (kept with the spec), not on the event loop
         return lambda: Document.for_spec(spec)
     data = read_yaml(path, what="spec or scene")
     if isinstance(data, dict) and "objects" in data:
         scene_path = path
 
         def scene_document() -> Document:
-            return Document.for_scene(parse_scene(read_yaml(scene_path, what="scene"), scene_path))
+            doc = Document.for_file(parse_scene(read_yaml(scene_path, what="scene"), scene_path))
+            param_ranges(doc.spec)  # on the parse pool, as this function is
+            return doc
 
         scene_document.reads_files = True
         return scene_document
     spec = parse_spec(data, str(path))
+    param_ranges(spec)
     return lambda: Document.for_spec(spec)
 
 

@@ -9,12 +9,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from pathlib import PurePath
 
 import numpy as np
 
+from implgen.errors import UserError
 from implgen.scene.model import Camera, Clip, Csg, Leaf, Light, Material, Node, Scene
 from implgen.share.page import MATERIAL  # the shape's material, both sides: the shared page's too
 from implgen.spec.entry import parse_spec
+from implgen.spec.paramrange import param_ranges
 from implgen.spec.parse import Spec
 
 CLIPS = ("none", "sphere", "box")
@@ -108,18 +111,23 @@ class Document:
     leaf: Leaf | None = None
     # a scene file's leaves edited so far, other than `leaf`: id(leaf) -> (its spec, its param values)
     edits: dict[int, tuple[Spec, dict[str, float]]] = field(default_factory=dict)
+    # the slider ranges the page sent with a save or an export (the user's own spans): name -> (low, high)
+    ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
+    frame: bool = True  # the page frames the clip at the start (not a saved view's camera, nor a scene's)
+    # a scene file's top-level leaves whose clip the page set: id(leaf) -> the clip (None: no clip)
+    clips: dict[int, Clip | None] = field(default_factory=dict)
 
     @staticmethod
     def for_spec(spec: Spec) -> Document:
         doc = Document(spec=spec, values=dict(spec.params))
         box = spec.box()
         if box is not None and all(math.isfinite(v) for v in box):
-            # frame the spec's box: the camera sees its bounding sphere
+            # a clip ball about the origin that holds the spec's box (its bounding sphere, and a margin)
             radius = 0.5 * math.dist(box[:3], box[3:])
             center = tuple(0.5 * (lo + hi) for lo, hi in zip(box[:3], box[3:]))
-            doc.orbit.target = center
-            doc.orbit.distance = max(1e-3, radius / math.sin(math.radians(doc.orbit.fov / 2)) * 1.1)
-            doc.options.clip_size = max(1e-3, round(radius * 1.2, 3))
+            doc.options.clip_size = max(1e-3, round(radius * 1.2 + math.dist(center, (0.0, 0.0, 0.0)), 3))
+        # the camera frames the clip ball (the page frames it again for its picture's narrower direction)
+        doc.orbit.distance = max(1e-3, doc.options.clip_size / math.sin(math.radians(doc.orbit.fov / 2)) * 1.1)
         return doc
 
     @staticmethod
@@ -131,6 +139,12 @@ class Document:
         doc.options = Options(clip="none", lights="scene", background=scene.background)
         return doc
 
+    @staticmethod
+    def for_file(scene: Scene) -> Document:
+        """A scene file's document: the page's own saved view (Save YAML of a shape) reopens as that page, a spec
+        with its clip, colours, light preset and camera; any other scene is edited as a scene."""
+        return saved_view(scene) or Document.for_scene(scene)
+
     def shape_state(self) -> dict:
         """The shape the page shows: its name, equation, params, their values and the degree."""
         spec = self.spec
@@ -140,7 +154,13 @@ class Document:
             "params": spec.params,
             "values": self.values,
             "degree": spec.degree,
+            "ranges": {k: list(r) for k, r in param_ranges(spec).items()},  # the sliders' spans (paramrange.py)
+            "object_clip": self.object_clip(),
         }
+
+    def scene_name(self) -> str:
+        """What a scene file's saved files are called: its file's name without the folder and the suffix."""
+        return PurePath(self.base.source).stem if self.base is not None else ""
 
     def state(self) -> dict:
         """What the page starts from: the shape, its values, the camera, the options (and a scene's objects)."""
@@ -148,6 +168,8 @@ class Document:
         return {
             **self.shape_state(),
             "mode": "spec" if self.base is None else "scene",
+            "frame": self.base is None and self.frame,
+            "scene_name": self.scene_name(),
             "objects": self.objects(),
             "object": self.object_index(),
             "orbit": {
@@ -182,6 +204,36 @@ class Document:
         if self.base is None:
             return None
         return next(i for i, leaf in enumerate(self.base.leaves()) if leaf is self.leaf)
+
+    def clippable(self) -> bool:
+        """Whether the page may give the scene's picked leaf a clip: a top-level object (inside CSG the other parts
+        bound it)."""
+        return self.base is not None and any(obj is self.leaf for obj in self.base.objects)
+
+    def leaf_clip(self) -> Clip | None:
+        """The scene's picked leaf's clip, the page's if it set one."""
+        if self.leaf is None:
+            return None
+        return self.clips[id(self.leaf)] if id(self.leaf) in self.clips else self.leaf.clip
+
+    def set_clip(self, kind: str, size: float) -> None:
+        """Give the scene's picked (top-level) leaf a clip of `kind` (none, sphere, box) about its clip's centre."""
+        if not self.clippable():
+            raise UserError("clip", "only a scene's top-level object takes a clip (in CSG the other parts bound it)")
+        old = self.leaf_clip()
+        clip = None if kind == "none" else Clip(kind=kind, size=size, center=old.center if old else (0.0, 0.0, 0.0))
+        self.clips = {**self.clips, id(self.leaf): clip}  # a new dict: a trial document shares the old one
+
+    def object_clip(self) -> dict | None:
+        """A scene's picked object's clip as the page shows it, and whether it can take one; None for a shape."""
+        if self.base is None:
+            return None
+        clip = self.leaf_clip()
+        return {
+            "clip": clip.kind if clip else "none",
+            "size": clip.size if clip else self.options.clip_size,
+            "clippable": self.clippable(),
+        }
 
     def select(self, index: int) -> None:
         """Edit the scene file's leaf `index` (in leaves() order) from now on; the edits of the one edited so
@@ -251,20 +303,93 @@ class Document:
         else:
             sc = replace(self.base, width=width, height=height, spp=spp)
             edits = {**self.edits, id(self.leaf): (self.spec, self.values)}
-            sc.objects = [_with_leaf(obj, edits) for obj in self.base.objects]
+            sc.objects = [_with_leaf(obj, edits, self.clips) for obj in self.base.objects]
         sc.camera = self.orbit.camera()
         sc.lights = self.lights()
         sc.background = self.options.background
         return sc
 
 
-def _with_leaf(node: Node, edits: dict[int, tuple[Spec, dict[str, float]]]) -> Node:
-    """A copy of the tree with each edited leaf given its spec and params."""
+def _saved_shape(node: Node) -> tuple[Leaf, Material, str | None, float, bool] | None:
+    """The shape of a view Save YAML wrote and its clip: (leaf, material, clip kind or None, size, cut), or None
+    when the object is not one (a transform, a material of another kind, a clip off the origin)."""
+    clip, size, cut = None, 3.0, False
+    if isinstance(node, Csg):  # the cut solid: the shape intersected with the clip solid, its cut face inside
+        right = node.right
+        kind = next((k for k, c in CLIP_SPECS.items() if isinstance(right, Leaf) and right.spec.name == c.name), None)
+        if node.op != "intersection" or not isinstance(node.left, Leaf) or kind is None:
+            return None
+        if right.spec.equation != CLIP_SPECS[kind].equation or set(right.params) != {"r"}:
+            return None
+        leaf, material, clip, size, cut = node.left, node.material, kind, float(right.params["r"]), True
+        if leaf.material is not None or right.material != replace(material, color=material.inside):
+            return None
+    else:
+        leaf, material = node, node.material
+        if leaf.clip is not None:
+            if any(leaf.clip.center):
+                return None
+            clip, size = leaf.clip.kind, leaf.clip.size
+    if not isinstance(leaf, Leaf) or leaf.clip is not None and cut or not np.array_equal(leaf.matrix, np.eye(3, 4)):
+        return None
+    if (
+        material is None
+        or material.inside is None
+        or material != Material(material.color, inside=material.inside, **MATERIAL)
+    ):
+        return None
+    return leaf, material, clip, size, cut
+
+
+def _close(a, b, scale: float) -> bool:
+    return bool(np.allclose(np.asarray(a, float), np.asarray(b, float), rtol=0.0, atol=1e-9 * scale))
+
+
+def saved_view(scene: Scene) -> Document | None:
+    """The page a scene file was saved from (dump.yaml_text of a shape, not of a scene): one shape, untransformed,
+    in the viewer's two-sided material, clipped about the origin or not at all, seen by an orbit camera under one of
+    the light presets. None for any other scene."""
+    if len(scene.objects) != 1 or scene.animation.frames > 1:
+        return None
+    found = _saved_shape(scene.objects[0])
+    if found is None:
+        return None
+    leaf, material, clip, size, cut = found
+    doc = Document(spec=leaf.spec, values=dict(leaf.params), orbit=Orbit.looking(scene.camera), frame=False)
+    cam, scale = doc.orbit.camera(), max(1.0, doc.orbit.distance)
+    if not (_close(cam.position, scene.camera.position, scale) and _close(cam.up, scene.camera.up, 1.0)):
+        return None
+    doc.options = Options(
+        clip=clip or "none",
+        clip_size=size,
+        cut=cut,
+        color=material.color,
+        inside=material.inside,
+        background=scene.background,
+    )
+    for preset in LIGHT_PRESETS:
+        doc.options.lights = preset
+        lights = doc.lights()
+        if len(lights) == len(scene.lights) and all(
+            _close(a.position, b.position, scale) and _close(a.color, b.color, 1.0)
+            for a, b in zip(lights, scene.lights)
+        ):
+            return doc
+    return None
+
+
+def _with_leaf(
+    node: Node, edits: dict[int, tuple[Spec, dict[str, float]]], clips: dict[int, Clip | None] | None = None
+) -> Node:
+    """A copy of the tree with each edited leaf given its spec and params, and its clip where the page set one."""
     if isinstance(node, Leaf):
-        if id(node) in edits:
-            spec, values = edits[id(node)]
-            return replace(node, spec=spec, params=dict(values))
+        key = id(node)
+        if key in edits:
+            spec, values = edits[key]
+            node = replace(node, spec=spec, params=dict(values))
+        if clips and key in clips:
+            node = replace(node, clip=clips[key])
         return node
-    left = _with_leaf(node.left, edits)
-    right = _with_leaf(node.right, edits)
+    left = _with_leaf(node.left, edits, clips)
+    right = _with_leaf(node.right, edits, clips)
     return Csg(op=node.op, left=left, right=right, material=node.material, where=node.where)

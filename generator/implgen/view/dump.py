@@ -33,6 +33,11 @@ def spec_mapping(spec: Spec, values: dict[str, float] | None = None) -> dict:
         out["bounds"] = {
             a: [format_expression(lo, names), format_expression(hi, names)] for a, (lo, hi) in spec.bounds.items()
         }
+    if spec.ranges:  # a slider's span, holding the value the file gives
+        given = values or {}
+        out["ranges"] = {
+            k: [_num(min(lo, given.get(k, lo))), _num(max(hi, given.get(k, hi)))] for k, (lo, hi) in spec.ranges.items()
+        }
     if spec.description:
         out["description"] = spec.description
     return out

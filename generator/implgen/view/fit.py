@@ -49,6 +49,17 @@ def _nice(r: float) -> float:
 def fit_clip(sc: Scene, lib: BuildResult) -> float | None:
     """The radius of a clip ball holding the probe scene's surface, or None: no real point found, or the surface
     runs on beyond the probe ball (on a pool thread)."""
+    return clip_for(reach(sc, lib))
+
+
+def clip_for(far: float | None) -> float | None:
+    """The fitted clip radius for a surface whose farthest point found is `far` (reach), or None."""
+    return None if far is None or math.isinf(far) else _nice(far * MARGIN)
+
+
+def reach(sc: Scene, lib: BuildResult) -> float | None:
+    """How far from the origin the probe scene's surface reaches: its farthest hit, math.inf when it runs on
+    beyond the probe ball, None when no ray meets it (on a pool thread)."""
     cs = CScene(sc, lib.for_scene(sc, fold=False))
     try:
         rng = np.random.default_rng(0)
@@ -63,6 +74,6 @@ def fit_clip(sc: Scene, lib: BuildResult) -> float | None:
                 farthest = max(farthest, math.dist(hit.p, (0.0, 0.0, 0.0)))
     finally:
         cs.close()
-    if hits == 0 or farthest > UNBOUNDED * PROBE or farthest <= 0.0:
+    if hits == 0 or farthest <= 0.0:
         return None
-    return _nice(farthest * MARGIN)
+    return math.inf if farthest > UNBOUNDED * PROBE else farthest

@@ -80,7 +80,7 @@ def job_for(doc: Document, cells: int, values: dict[str, float], options: Option
         clips, matrix = _clips(options.clip, options.clip_size), None
     else:
         leaf = doc.leaf
-        clip = leaf.clip if leaf is not None else None
+        clip = doc.leaf_clip()  # the file's, or the one the page gave it
         clips = _clips(clip.kind, clip.size, clip.center) if clip is not None else []
         matrix = np.asarray(leaf.matrix, dtype=np.float64) if leaf is not None else None
     box = doc.spec.box(dict(values))

@@ -3,14 +3,17 @@
 A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
 
     {"type": "shape", "equation": "...", "params": {"a": 1.0}}        a new equation and its param defaults
-                                                                      (optional "bounds" as in a spec)
+                                                                      (optional "bounds" as in a spec; "object":
+                                                                      a scene's leaf it is for, picked first)
     {"type": "render", "seq": 7, "refine": true, "width": 640, "height": 480,
      "values": {"a": 1.2}, "orbit": {...}, "options": {...},
      "gpu": false}                                                    the view to show (the newest wins); gpu:
                                                                       the page draws the live picture itself,
                                                                       so no coarse frames, only the refined
     {"type": "save_png", "width": 1920, "height": 1080, "spp": 16}    the current view through render()
-    {"type": "save_yaml", "width": 640, "height": 480}               the view as a scene file (its full frame)
+    {"type": "save_yaml", "width": 640, "height": 480,
+     "ranges": {"a": [0, 2]}}                                         the view as a scene file (its full frame),
+                                                                      with the page's slider ranges
     {"type": "save_mesh", "cells": 128, "values": {...},
      "options": {...}}                                                the shape as a closed STL (meshsave.py)
     {"type": "stop_mesh"}                                             stop the mesh in progress
@@ -19,19 +22,23 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
     {"type": "glsl"}                                                  the GPU preview: the shape's GLSL (gpu.py)
     {"type": "pick", "x": 120, "y": 80, "width": 640, "height": 480}  a scene file: edit the object at a pixel
     {"type": "object", "index": 2}                                    a scene file: edit this leaf
+    {"type": "clip", "clip": "sphere", "size": 2.5}                   a scene file: the picked (top-level)
+                                                                      object's clip (none, sphere, box)
 
 Bad values raise UserError naming the message field; the session sends the line back to the page. Every
 error reply, whatever failed, is built here (`error`, `error_for`). An equation's parse (seconds of SymPy at
 high degree) is remembered, refusal included, for the last PARSE_CACHE mappings of text, params and bounds: the
 session runs it on its parse pool, never on the event loop.
 
-    {"type": "error", "field": "equation" | "message", "message": "..."}
+    {"type": "error", "field": "equation" | "message", "message": "...",
+     "position": 12}                                                  (an equation's: the character at fault)
 """
 
 from __future__ import annotations
 
 import functools
 import json
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -49,7 +56,19 @@ MAX_SAVE = (8192, 8192)  # the largest saved picture
 MAX_SAVE_PIXELS = 8192 * 4608  # 8K at 16:9
 MAX_SAVE_SPP = 64
 MESH_TYPES = ("save_mesh", "stop_mesh")  # meshsave.py
-TYPES = ("shape", "render", "save_png", "save_yaml", "show_c", "pick", "object", "export_page", "glsl", *MESH_TYPES)
+TYPES = (
+    "shape",
+    "render",
+    "save_png",
+    "save_yaml",
+    "show_c",
+    "pick",
+    "object",
+    "clip",
+    "export_page",
+    "glsl",
+    *MESH_TYPES,
+)
 PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
 # The ranges of the view's numbers, stated once: the checks below use them, and the hello sends them to the page,
 # whose share link (static/share.js) drops a number outside them instead of keeping a range of its own.
@@ -103,8 +122,9 @@ def error_for(err: Exception) -> dict:
         err = out_of_files_error(None, err)
     if not isinstance(err, UserError):
         return error("message", f"internal error: {type(err).__name__}")
-    if err.source == "equation":
-        return error("equation", err.message)
+    if err.source == "equation":  # beside the equation box, a caret under the character at fault when known
+        reply = error("equation", err.message)
+        return reply if err.position is None else {**reply, "position": err.position}
     return error("message", str(err))
 
 
@@ -134,7 +154,7 @@ def _parse(mapping: dict[str, Any]) -> Spec:
     """parse_spec(mapping, "equation"), remembered by the mapping's JSON text (the last PARSE_CACHE of them)."""
     hit = _parse_text(json.dumps(mapping, sort_keys=True))
     if isinstance(hit, UserError):
-        raise UserError(hit.source, hit.message)
+        raise UserError(hit.source, hit.message, hit.position)
     return hit
 
 
@@ -188,6 +208,37 @@ def parse_values(raw: Any, spec: Spec) -> dict[str, float]:
         if name in spec.params:  # a stale slider of a param that is gone is ignored
             values[name] = validate.number("values", str(name), v, *RANGES["value"])
     return values
+
+
+def parse_ranges(raw: Any, spec: Spec, values: dict[str, float]) -> dict[str, tuple[float, float]]:
+    """The page's slider ranges (Save YAML keeps them): for the shape's params, low below high, widened to hold the
+    value; a range at whose ends a coefficient would not stay a finite double is left out."""
+    out = {}
+    for name, pair in _mapping("ranges", raw if raw is not None else {}).items():
+        if name not in spec.params:
+            continue
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise UserError("ranges", f"{name}: expected [low, high]")
+        lo, hi = (validate.number("ranges", str(name), v, *RANGES["value"]) for v in pair)
+        value = values.get(name, spec.params[name])
+        lo, hi = min(lo, value), max(hi, value)
+        if not lo < hi:
+            continue
+        try:
+            spec.check_values({name: lo}, "ranges", name)
+            spec.check_values({name: hi}, "ranges", name)
+        except UserError:
+            continue
+        out[name] = (lo, hi)
+    return out
+
+
+def parse_clip(data: dict) -> tuple[str, float]:
+    """A scene object's clip: (kind, size)."""
+    kind = data.get("clip")
+    if kind not in CLIPS:
+        raise UserError("clip", f"expected one of {', '.join(CLIPS)}")
+    return kind, validate.number("clip", "size", data.get("size"), *RANGES["clip_size"])
 
 
 def parse_orbit(raw: Any) -> Orbit:
@@ -255,7 +306,12 @@ def parse_save(data: dict) -> tuple[int, int, int]:
     w = validate.whole("save_png", "width", data.get("width", 1920), 1, MAX_SAVE[0])
     h = validate.whole("save_png", "height", data.get("height", 1080), 1, MAX_SAVE[1])
     if w * h > MAX_SAVE_PIXELS:
-        raise UserError("save_png", f"more than {MAX_SAVE_PIXELS} pixels")
+        k = math.sqrt(MAX_SAVE_PIXELS / (w * h))  # the same shape, within the bound
+        raise UserError(
+            "save_png",
+            f"{w} × {h} is {w * h:,} pixels, more than the {MAX_SAVE_PIXELS:,} (8192 × 4608) a saved picture may "
+            f"have: {int(w * k)} × {int(h * k)} would do",
+        )
     spp = validate.whole("save_png", "spp", data.get("spp", 16), 1, MAX_SAVE_SPP)
     return w, h, spp
 

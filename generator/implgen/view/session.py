@@ -23,6 +23,7 @@ from __future__ import annotations
 import asyncio
 import functools
 import logging
+import math
 import struct
 import time
 from collections.abc import Awaitable, Callable
@@ -34,6 +35,7 @@ from implgen.errors import UserError
 from implgen.scene.build import BuildResult, build_scene, runtime_ready
 from implgen.scene.model import Scene
 from implgen.scene.render import usable_cores
+from implgen.spec.paramrange import param_ranges
 from implgen.view import dump, fit, frames, gpu, ladder, pick, protocol, sharepage
 from implgen.view.document import Document
 from implgen.view.meshsave import MeshSaver
@@ -129,12 +131,19 @@ class Session:
                 self.meshes.stop()
             elif kind == "save_yaml":
                 width, height = protocol.parse_size(data, "save_yaml")
-                text = await self.work.call(self.work.parse, dump.yaml_text, replace(self.doc), width, height, FULL_SPP)
+                doc = replace(self.doc)
+                ranges = protocol.parse_ranges(data.get("ranges"), doc.spec, doc.values)
+                doc.spec = replace(doc.spec, ranges={**doc.spec.ranges, **ranges})  # for the file only
+                text = await self.work.call(self.work.parse, dump.yaml_text, doc, width, height, FULL_SPP)
                 await self.send({"type": "yaml", "mode": self._mode(), "text": text})
             elif kind in ("pick", "object"):
                 await self._pick(data)
+            elif kind == "clip":  # the page renders it next, as for any change of the view
+                self.doc.set_clip(*protocol.parse_clip(data))
             elif kind == "export_page":
-                name, html, note = await self.work.derive_glsl(sharepage.page_text, replace(self.doc))
+                doc = replace(self.doc)
+                doc.ranges = protocol.parse_ranges(data.get("ranges"), doc.spec, doc.values)
+                name, html, note = await self.work.derive_glsl(sharepage.page_text, doc)
                 await self.send({"type": "page", "name": name, "text": html, **({"note": note} if note else {})})
             elif kind == "glsl":  # the GPU preview asks for the current shape's GLSL: derived (SymPy) in a task of
                 if self._glsl is not None:  # its own, so the renders behind it are read meanwhile; a newer ask wins
@@ -162,6 +171,7 @@ class Session:
             index = validate.whole("object", "index", data.get("index"), 0, count - 1)
         self.doc.select(index)
         self._final = None
+        await self.work.call(self.work.parse, param_ranges, self.doc.spec)  # the sliders' spans, off the loop
         self._cost = None
         self.pace.new_shape()
         self._shape_id += 1
@@ -171,20 +181,35 @@ class Session:
         return "spec" if self.doc.base is None else "scene"
 
     async def _shape(self, data: dict) -> None:
-        spec = await self.work.call(self.work.parse, protocol.parse_shape, data, self.doc.spec)
         trial = replace(self.doc)  # the page keeps showing the current shape until the new one is built
+        picked = None
+        if data.get("object") is not None:  # a scene's link: the equation is that object's
+            count = len(self.doc.objects())
+            if count == 0:
+                raise UserError("shape", "object: only a scene file has objects to pick")
+            picked = validate.whole("shape", "object", data["object"], 0, count - 1)
+            trial.select(picked)
+        spec = await self.work.call(self.work.parse, protocol.parse_shape, data, trial.spec)
         trial.set_spec(spec)
+        await self.work.call(self.work.parse, param_ranges, spec)  # the sliders' spans (kept with the spec)
         await self._library(trial.scene())
-        fitted = None
-        if data.get("fit") is True:  # the page's clip size is not the user's own: fit it to the new surface
+        fitted, unbounded = None, False
+        box = spec.box(trial.values) if spec.params else spec.box()
+        if data.get("fit") is True or box is None or not all(map(math.isfinite, box)):
+            # where its real points are: the clip fitted to them (when the size is not the user's own), or that
+            # it runs on without end (the page says so when there is no clip)
             probe = fit.probe_scene(spec, trial.values)
-            fitted = await self.work.call(self.work.render, fit.fit_clip, probe, await self._library(probe))
+            far = await self.work.call(self.work.render, fit.reach, probe, await self._library(probe))
+            fitted = fit.clip_for(far) if data.get("fit") is True else None
+            unbounded = far is not None and math.isinf(far)
         self.doc.spec, self.doc.values = trial.spec, trial.values
+        self.doc.leaf, self.doc.edits = trial.leaf, trial.edits  # a scene's link picked the object first
         self._shown = self._final = None  # an accepted shape is drawn coarse first, even the same one again
         self._cost = None  # measured anew by the new shape's first render
         self.pace.new_shape()
         self._shape_id += 1
-        await self.send(self._shape_reply(fit=fitted, objects=self.doc.objects()))
+        picked_part = {} if picked is None else {"object": picked}
+        await self.send(self._shape_reply(fit=fitted, unbounded=unbounded, objects=self.doc.objects(), **picked_part))
 
     # ------------------------------------------------------------------ rendering
 
@@ -208,7 +233,7 @@ class Session:
 
     async def _tell_build(self) -> None:
         """While a build lasts more than a moment: what it does, for the page's status ("compiling the runtime
-        (first run only): 3 of 9 files", once per build cache; then the shape)."""
+        (first run only): 3 of N files", once per build cache; then the shape)."""
         await asyncio.sleep(BUILD_QUIET)
         while True:
             done, total = await asyncio.to_thread(runtime_ready)

@@ -1,7 +1,8 @@
 """The viewer's "Export page": the view as the stand-alone page of `implgen share` (share/page.py), with the
 shape, its param values, the camera, the clip and the colours the page shows now.
 
-Sliders run over the spec's `ranges` where it names them, else the value +- max(1, |value|) as on the page.
+Sliders run over the page's own ranges (the user's, sent with the request), else the spec's `ranges`, else the
+range spec/paramrange.py finds: the ones the viewer's sliders show.
 A clip the shared page cannot draw (a scene file's own) falls back to its sphere.
 """
 
@@ -12,6 +13,7 @@ from dataclasses import asdict
 
 from implgen.codegen.backends.glsl import chebform
 from implgen.share.page import CLIPS, Look, render_page, slider
+from implgen.spec.paramrange import param_ranges
 from implgen.view import gpu
 from implgen.view.document import Document
 
@@ -22,7 +24,8 @@ def page_text(
     """(file name, the page's HTML, a note for the viewer's page or None) for the document's current view; its GLSL
     derived under `budget` seconds (None: unbounded) as the GPU preview's is (gpu.shape_glsl)."""
     spec, o = doc.spec, doc.options
-    sliders = [slider(name, float(doc.values.get(name, default)), spec.ranges) for name, default in spec.params.items()]
+    ranges = {**param_ranges(spec), **doc.ranges}
+    sliders = [slider(name, float(doc.values.get(name, default)), ranges) for name, default in spec.params.items()]
     clip = o.clip if o.clip in CLIPS else "sphere"
     look = Look(clip=clip, clip_size=o.clip_size, cut=o.cut, outside=o.color, inside=o.inside, background=o.background)
     orbit = asdict(doc.orbit)

@@ -35,11 +35,12 @@
     options: {},
     home: null, // the orbit to go back to
   };
+  const userRanges = new Set(); // the params whose slider span the user set by hand
   let ws = null;
   let lastError = ""; // the server's last error line, kept when the socket closes after it
   let messageIsError = false; // the message line holds an error: the next picture clears it
   let errorSeq = 0; // ... a picture of a request sent after the error came, not an older one still on its way
-  const overlay = { connect: "connecting...", build: "", empty: false }; // what the picture's overlay says
+  const overlay = { connect: "connecting...", build: "", empty: false, unbounded: false }; // the overlay's words
   let lastBitmap = null; // the picture drawn last, drawn again when the canvas changes size
   let seq = 0;
   let drawnSeq = -1;
@@ -56,15 +57,36 @@
   const fromHex = (hex) => [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16) / 255);
 
   // ---------------------------------------------------------------- what the page says
-  function showMessage(text, isError) {
-    $("message").textContent = text;
-    messageIsError = isError && text !== "";
-    if (isError) { lastError = text; errorSeq = seq; }
+  // The message line lies over the top of the picture. `kind`: "error" (true) stays until a newer picture;
+  // "note" (false: a file saved, a link copied) goes with the user's next action, or after NOTE_MS; "keep" (work
+  // in progress, the connection lost) stays until something replaces it.
+  const NOTE_MS = 8000;
+  let messageKind = "";
+  let noteTimer = 0;
+  function showMessage(text, kind) {
+    kind = kind === true ? "error" : kind === false || kind === undefined ? "note" : kind;
+    const line = $("message");
+    line.textContent = text;
+    line.classList.toggle("bad", kind === "error");
+    messageKind = text ? kind : "";
+    messageIsError = kind === "error" && text !== "";
+    if (kind === "error") { lastError = text; errorSeq = seq; }
+    clearTimeout(noteTimer);
+    if (messageKind === "note") noteTimer = setTimeout(() => showMessage("", "note"), NOTE_MS);
+  }
+
+  // the user did something new: a note on what was done before (a link copied, a file saved) is stale
+  function acted() {
+    if (messageKind === "note") showMessage("", "note");
   }
 
   function showOverlay() {
-    // the most pressing first: a build in progress, the connection, an empty picture
-    $("overlay").textContent = overlay.build || overlay.connect || (overlay.empty ? "no real points in view" : "");
+    // the most pressing first: a build in progress, the connection, an empty picture, a surface without a clip
+    // that runs on without end (it may fill the view with one colour)
+    const endless = overlay.unbounded && !sceneMode && $("clip").value === "none"
+      ? "this surface runs on without end: with clip none it can fill the view; choose a sphere or box clip" : "";
+    $("overlay").textContent = overlay.build || overlay.connect || (overlay.empty ? "no real points in view" : "")
+      || endless;
   }
 
   function showEmpty(empty) {
@@ -104,6 +126,7 @@
       const q = queued;
       queued = null;
       seq += 1;
+      if (holdNext && q.refine) { holdSeq = seq; holdNext = false; }
       state.options = readOptions();
       if (q.refine) keepLink();
       sentAt.set(seq, { t: performance.now(), clip: state.options.clip_size });
@@ -123,6 +146,7 @@
     const text = implgenLink.encode({
       equation: acceptedEquation, name: $("shape-name").value, params: $("params-text").value,
       values: state.values, orbit: state.orbit, options: state.options,
+      object: sceneMode ? Number($("object").value) : undefined, // a scene's: the picked object's edits
     });
     history.replaceState(null, "", `${location.pathname}${location.search}#${text}`);
   }
@@ -130,18 +154,25 @@
   // A share link's view, applied once the page has its first state from the server: its equation is sent as a
   // new shape (its clip is the user's own: not fitted), its slider values wait for the shape's reply.
   let linkValues = null;
+  let linkObject = null; // a scene link's object: its equation is sent for that object
+  let linkClip = null; // ... and its clip, given to it once its shape is back (when it can take one)
   let linkRanges = null; // the server's ranges of the view's numbers (the hello): a link's are read within them
   function openLink() {
     const { view, bad } = implgenLink.decode(location.hash, linkRanges);
     // a note, not an error: the picture that follows does not clear it
     if (bad.length) showMessage(`share link: left out what did not read: ${bad.join(", ")}`, false);
-    if (view.orbit) state.orbit = view.orbit;
+    if (view.orbit) { state.orbit = view.orbit; linkCamera = true; }
     if (view.options) {
       setOptions(Object.assign(readOptions(), view.options));
       if (view.options.clip !== undefined) userClip = true; // the link's clip (and camera) stay as they are
       if (view.options.clip_size !== undefined) goodClipSize = view.options.clip_size;
     }
-    if (view.equation === undefined) return false;
+    linkObject = sceneMode && view.object !== undefined ? view.object : null;
+    linkClip = sceneMode && view.options && view.options.clip !== undefined ? readOptions() : null;
+    if (view.equation === undefined) {
+      if (linkObject !== null) { send({ type: "object", index: linkObject }); linkObject = null; }
+      return false;
+    }
     $("equation").value = view.equation;
     if (view.params !== undefined) $("params-text").value = view.params;
     if (view.name !== undefined) { $("shape-name").value = view.name; userName = true; }
@@ -184,25 +215,88 @@
   let acceptedEquation = null; // the equation text the server last accepted (as the box showed it)
   function applyShape() {
     clearTimeout(typing);
+    acted();
     const text = $("equation").value;
     const name = userName ? $("shape-name").value.trim()
       : (text === acceptedEquation || sceneMode ? $("shape-name").value : "surface");
+    sentEquation = text;
+    const object = linkObject !== null ? { object: linkObject } : {};
+    linkObject = null;
     send({ type: "shape", equation: text, name, params: parseParamsText($("params-text").value),
-      fit: !userClip });
+      fit: !userClip, ...object });
   }
 
   function fitClip(size) {
     if (userClip) return;
     const r = size ?? DEFAULT_CLIP; // none: the surface runs on (or has no real point): the default ball
-    const before = Number($("clip-size").value);
     $("clip-size").value = r;
     $("clip-size").classList.remove("bad");
     goodClipSize = r;
-    if (!(before > 0) || Math.abs(r - before) > 0.2 * before) { // a new size: frame the ball
-      const o = state.orbit;
-      o.target = [0, 0, 0];
-      o.distance = r / Math.sin(o.fov * Math.PI / 360) * 1.1;
+  }
+
+  // The camera frames the clip at the start, for each new equation and on Reset: the clip's bounding ball (about
+  // the origin; a box's is sqrt(3) times its half-edge) whole in the picture's narrower direction, with a margin,
+  // whether the size was fitted or set by hand. A link's or a saved file's camera is kept.
+  let linkCamera = false; // a link gave the camera: its shape keeps it
+  function frameClip() {
+    const o = state.orbit;
+    const typed = Number($("clip-size").value);
+    const size = typed > 0 ? typed : (goodClipSize ?? DEFAULT_CLIP);
+    const r = $("clip").value === "box" ? size * Math.sqrt(3) : size;
+    const aspect = canvas.clientWidth > 0 && canvas.clientHeight > 0 ? canvas.clientWidth / canvas.clientHeight : 1;
+    const half = Math.atan(Math.tan(o.fov * Math.PI / 360) * Math.min(1, aspect));
+    o.target = [0, 0, 0];
+    o.distance = Math.min(1e6, r / Math.sin(half) * 1.1);
+  }
+
+  // The parser's line under the equation box; where it knows the character at fault, that line of the equation
+  // (at most CARET_WIDE characters of it about the place) with a caret under it.
+  const CARET_WIDE = 34;
+  let sentEquation = ""; // the equation text last sent: an error's position is in it
+  function showEquationError(message, position) {
+    const box = $("equation-error");
+    box.replaceChildren(document.createTextNode(message));
+    const text = sentEquation;
+    if (!Number.isInteger(position) || position < 0 || position > text.length) return;
+    const start = text.lastIndexOf("\n", position - 1) + 1;
+    const stop = text.indexOf("\n", position);
+    let line = text.slice(start, stop < 0 ? text.length : stop).replace(/\t/g, " ");
+    let column = position - start;
+    if (line.length > CARET_WIDE) {
+      const from = Math.max(0, Math.min(column - CARET_WIDE / 2, line.length - CARET_WIDE));
+      line = (from > 0 ? "\u2026" : "") + line.slice(from, from + CARET_WIDE) + (from + CARET_WIDE < line.length ? "\u2026" : "");
+      column += from > 0 ? 1 - from : 0;
     }
+    const caret = Object.assign(document.createElement("pre"), { className: "caret" });
+    caret.textContent = `${line}\n${" ".repeat(column)}^`;
+    box.append(caret);
+  }
+
+  // A scene's picked object: its clip in the Look controls, which give it one when it is a top-level object (in
+  // CSG the other parts bound it); the cut solid and the colours stay the file's.
+  function showObjectClip(msg) {
+    const c = sceneMode ? msg.object_clip : null;
+    if (!c) return;
+    $("clip").value = c.clip;
+    $("clip-size").value = c.size;
+    $("clip-size").classList.remove("bad");
+    goodClipSize = c.size;
+    for (const id of ["clip", "clip-size"]) $(id).disabled = !c.clippable;
+  }
+  function sendObjectClip() {
+    const size = Number($("clip-size").value);
+    if (!(size > 0)) return; // readOptions says so
+    send({ type: "clip", clip: $("clip").value, size });
+    if (endlessWarned) { endlessWarned = false; showMessage("", "note"); }
+  }
+  // a typed equation that runs on without end, in an object with no clip, can cover the whole picture
+  let endlessWarned = false;
+  function warnEndless(msg) {
+    const c = msg.object_clip;
+    if (!msg.unbounded || !c || c.clip !== "none" || !c.clippable) return;
+    showMessage(`${msg.name} runs on without end and has no clip: it can cover the picture. Give it a clip `
+      + "(Look: clip and size) to show the part inside a ball or a box.", "keep");
+    endlessWarned = true;
   }
 
   // ---------------------------------------------------------------- messages in
@@ -211,8 +305,12 @@
     $("equation-error").textContent = "";
     state.params = byName(msg.params);
     state.values = byName(msg.values);
+    const given = byName(msg.ranges);
     for (const [k, v] of Object.entries(state.params)) {
-      if (!Object.hasOwn(state.ranges, k)) {
+      const r = given[k];
+      if (!userRanges.has(k) && Array.isArray(r) && r.length === 2) {
+        state.ranges[k] = [Math.min(r[0], state.values[k]), Math.max(r[1], state.values[k])];
+      } else if (!Object.hasOwn(state.ranges, k)) {
         const span = Math.max(1, Math.abs(v));
         state.ranges[k] = [v - span, v + span];
       }
@@ -249,12 +347,13 @@
       const show = () => { value.textContent = Number(state.values[name]).toPrecision(4); };
       show();
       // coarse while it moves, refined when it rests: even when it is let go where it started (no "change")
-      slider.addEventListener("input", () => { state.values[name] = parseFloat(slider.value); show(); moved(); });
+      slider.addEventListener("input", () => { acted(); state.values[name] = parseFloat(slider.value); show(); moved(); });
       slider.addEventListener("change", () => requestRender(true));
       const setRange = () => {
         const a = parseFloat(min.value), b = parseFloat(max.value);
         if (Number.isFinite(a) && Number.isFinite(b) && a < b) {
           state.ranges[name] = [a, b];
+          userRanges.add(name); // the user's own span stays while the param does
           slider.min = a; slider.max = b; slider.step = (b - a) / 1000;
           slider.value = state.values[name];
         }
@@ -278,16 +377,27 @@
     $("lights").value = o.lights;
   }
 
-  async function drawFrame(buf) {
+  // A new shape's first request (no drag) holds its coarse frame up to HOLD_MS for the full-size one behind it:
+  // the first picture after a gallery pick was an 84 x 71 blur. A drag's frames are never held.
+  const HOLD_MS = 1500;
+  let holdNext = false, holdSeq = -1, held = null;
+  async function drawFrame(buf, released = false) {
     const view = new DataView(buf);
     const fseq = view.getUint32(0), kind = view.getUint8(4), flags = view.getUint8(5);
+    if (kind === KIND_COARSE && fseq === holdSeq && !released) {
+      held = buf;
+      setTimeout(() => { if (held === buf) { held = null; drawFrame(buf, true); } }, HOLD_MS);
+      return;
+    }
+    if (kind !== KIND_COARSE && fseq >= holdSeq) held = null; // the sharp one came: the held one is stale
     const samples = view.getUint16(6), w = view.getUint16(8), h = view.getUint16(10);
     const bytes = new Uint8Array(buf, HEADER);
     lastError = "";
     if (kind === KIND_MESH) { implgenMesh.received(bytes); return; } // Save mesh (mesh.js)
     if (kind === KIND_SAVE) {
-      download(new Blob([bytes], { type: "image/png" }), "implgen-view.png");
-      showMessage(`saved ${w} x ${h} PNG`, false);
+      const name = `${fileName()}.png`;
+      download(new Blob([bytes], { type: "image/png" }), name);
+      showMessage(`saved ${name}: ${w} \u00d7 ${h} pixels`, "note");
       return;
     }
     if (RANK[kind] === undefined) return;
@@ -315,6 +425,13 @@
     for (const k of sentAt.keys()) if (k < fseq) sentAt.delete(k);
   }
 
+  // saved files are named after the shape, or in a scene after the scene file (they hold the whole scene)
+  let sceneName = "";
+  function fileName() {
+    const name = sceneMode ? sceneName : $("shape-name").value;
+    return String(name).replace(/[^A-Za-z0-9_-]/g, "") || "surface";
+  }
+
   function download(blob, name) {
     const a = Object.assign(document.createElement("a"), { href: URL.createObjectURL(blob), download: name });
     document.body.append(a);
@@ -340,23 +457,22 @@
       linkRanges = msg.limits.ranges;
       fitCanvas();
       setOptions(msg.options);
+      if (msg.frame) { frameClip(); state.home = JSON.parse(JSON.stringify(state.orbit)); }
       sceneMode = msg.mode === "scene";
+      sceneName = typeof msg.scene_name === "string" ? msg.scene_name : "scene";
       $("gallery-row").hidden = sceneMode || gallery.length === 0;
       $("object-row").hidden = !sceneMode;
       if (sceneMode) showObjects(msg.objects, msg.object);
       if (msg.mode !== "scene") $("lights").querySelector("option[value=scene]").disabled = true;
-      else for (const id of ["clip", "clip-size", "cut", "color", "inside"]) $(id).disabled = true; // the file's own
+      else for (const id of ["cut", "color", "inside"]) $(id).disabled = true; // the file's own
+      showObjectClip(msg);
       showShape(msg);
       if (gpu) gpu.hello(msg, send);
       if (!openLink()) requestRender(true); // with a link's equation: drawn once it is built
     } else if (msg.type === "shape") {
       if (linkValues) { // the link's slider values, for the params the shape has
         for (const [k, v] of Object.entries(linkValues)) {
-          if (Object.hasOwn(msg.values, k)) {
-            msg.values[k] = v;
-            const span = Math.max(1, Math.abs(msg.params[k]));
-            state.ranges[k] = [Math.min(v, msg.params[k] - span), Math.max(v, msg.params[k] + span)];
-          }
+          if (Object.hasOwn(msg.values, k)) msg.values[k] = v; // its slider's span widened to hold it
         }
         linkValues = null;
       }
@@ -366,9 +482,23 @@
         $("equation").classList.remove("bad");
       }
       if (sceneMode && msg.objects) showObjects(msg.objects, msg.object ?? Number($("object").value));
+      const fresh = !sceneMode && $("equation").value !== acceptedEquation; // a new equation, not new defaults
       showShape(msg);
       if (gpu) gpu.shape(msg);
       if ("fit" in msg) fitClip(msg.fit);
+      showObjectClip(msg);
+      if (linkClip && msg.object_clip && msg.object_clip.clippable) {
+        $("clip").value = linkClip.clip;
+        $("clip-size").value = linkClip.clip_size;
+        sendObjectClip();
+      }
+      linkClip = null;
+      if (sceneMode) warnEndless(msg);
+      overlay.unbounded = msg.unbounded === true;
+      showOverlay();
+      if (fresh && !linkCamera) frameClip();
+      if (fresh) holdNext = true; // its first picture: not a blur of a few pixels when a sharp one is near
+      linkCamera = false;
       requestRender(true);
     } else if (msg.type === "glsl") {
       if (gpu) gpu.program(msg);
@@ -378,17 +508,20 @@
     } else if (msg.type === "error") {
       if (msg.field === "equation") {
         $("equation").classList.add("bad");
-        $("equation-error").textContent = msg.message;
+        showEquationError(msg.message, msg.position);
       } else {
         showMessage(msg.message, true);
       }
     } else if (msg.type === "mesh") {
       implgenMesh.message(msg);
     } else if (msg.type === "yaml") {
-      download(new Blob([msg.text], { type: "application/yaml" }), `${$("shape-name").value.replace(/[^A-Za-z0-9_]/g, "") || "scene"}.yaml`);
+      const name = `${fileName()}.yaml`;
+      download(new Blob([msg.text], { type: "application/yaml" }), name);
+      showMessage(`saved ${name}: the view as a scene file (implgen render draws it, implgen view reopens it)`, "note");
     } else if (msg.type === "page") {
       download(new Blob([msg.text], { type: "text/html" }), msg.name);
-      if (typeof msg.note === "string") showMessage(msg.note, false); // its shader cut by the GLSL budget
+      const cut = typeof msg.note === "string" ? `; ${msg.note}` : ""; // its shader cut by the GLSL budget
+      showMessage(`saved ${msg.name}: this view as a page that draws it with WebGL2, no server needed${cut}`, "note");
     } else if (msg.type === "c") {
       $("code").textContent = msg.text;
       $("code-dialog").showModal();
@@ -409,7 +542,7 @@
       // the error the server closed after stays in view (a scene file that no longer reads, too many pages)
       const text = e.code === 1013 && lastError ? lastError
         : `${lastError ? lastError + " - " : ""}disconnected from the server${why}`;
-      showMessage(text, false);
+      showMessage(text, "keep");
       overlay.connect = e.code === 1013 ? "too many pages open" : "disconnected";
       showOverlay();
     });
@@ -418,6 +551,7 @@
   // ---------------------------------------------------------------- the picture: orbit, pan, zoom
   let drag = null;
   canvas.addEventListener("pointerdown", (e) => {
+    acted();
     drag = { x: e.clientX, y: e.clientY, pan: e.shiftKey, x0: e.clientX, y0: e.clientY, moved: false };
     canvas.setPointerCapture(e.pointerId);
     canvas.classList.add("dragging");
@@ -460,6 +594,7 @@
   canvas.addEventListener("pointercancel", endDrag);
   canvas.addEventListener("wheel", (e) => {
     e.preventDefault();
+    acted();
     state.orbit.distance = Math.max(1e-3, Math.min(1e6, state.orbit.distance * Math.exp(e.deltaY * 0.001)));
     moved();
   }, { passive: false });
@@ -473,22 +608,30 @@
   $("apply").addEventListener("click", applyShape);
   $("clip-size").addEventListener("input", () => { userClip = true; });
   for (const id of ["clip", "clip-size", "cut", "color", "inside", "background", "lights"]) {
-    $(id).addEventListener("input", moved);
+    $(id).addEventListener("input", () => {
+      acted();
+      if (sceneMode && (id === "clip" || id === "clip-size")) sendObjectClip(); // the picked object's own
+      moved();
+      showOverlay();
+    });
     $(id).addEventListener("change", () => requestRender(true));
   }
   $("reset-view").addEventListener("click", () => {
+    acted();
     state.orbit = JSON.parse(JSON.stringify(state.home));
+    if (!sceneMode) frameClip(); // the clip as it is now
     requestRender(true);
   });
   $("save-png").addEventListener("click", () => {
-    showMessage("rendering...", false);
+    acted();
+    showMessage(`rendering ${$("save-width").value} \u00d7 ${$("save-height").value} pixels...`, "keep");
     lastError = "";
     send({ type: "save_png", width: parseInt($("save-width").value, 10), height: parseInt($("save-height").value, 10),
       spp: parseInt($("save-spp").value, 10) });
   });
   // a link pasted into this page's address (only the part after "#" differs: no reload) opens its view too
   window.addEventListener("hashchange", () => { if (ws && !openLink()) requestRender(true); });
-  $("object").addEventListener("change", () => send({ type: "object", index: Number($("object").value) }));
+  $("object").addEventListener("change", () => { acted(); send({ type: "object", index: Number($("object").value) }); });
 
   // ---------------------------------------------------------------- the gallery (gallery.json: docs/surfaces.md)
   let gallery = [];
@@ -503,25 +646,43 @@
     const g = gallery[Number($("gallery").value)];
     $("gallery").value = "";
     if (!g) return;
+    acted();
     const params = g.params || {};
     $("equation").value = g.equation;
     $("params-text").value = Object.entries(params).map(([k, v]) => `${k} = ${v}`).join(", ");
     state.ranges = byName(g.ranges);
+    userRanges.clear();
     $("gallery-note").textContent = `${g.title}: ${g.description} (${g.reference})`;
     userName = false;
+    sentEquation = g.equation;
     send({ type: "shape", equation: g.equation, name: g.name, params, ranges: g.ranges || {}, bounds: g.bounds || null,
       fit: !userClip });
   });
   $("copy-link").addEventListener("click", () => {
     keepLink();
-    navigator.clipboard.writeText(location.href).then(() => showMessage("link copied: it reopens this view", false),
-      () => showMessage(`the link: ${location.href}`, false));
+    // with a scene file: the link names the file's page, and holds the camera and the picked object's edits
+    const what = sceneMode ? "this scene's view: the camera, the picked object and its edits (not other objects' "
+      + "edits; the scene file is the server's)" : "this view";
+    navigator.clipboard.writeText(location.href).then(() => showMessage(`link copied: it reopens ${what}`, false),
+      () => showMessage(`the link (it reopens ${what}): ${location.href}`, false));
   });
-  $("save-yaml").addEventListener("click", () => send({ type: "save_yaml", width: canvas.width, height: canvas.height }));
+  const pageRanges = () => {
+    const ranges = byName();
+    for (const k of Object.keys(state.params)) ranges[k] = state.ranges[k];
+    return ranges;
+  };
+  $("save-yaml").addEventListener("click", () => {
+    acted();
+    send({ type: "save_yaml", width: canvas.width, height: canvas.height, ranges: pageRanges() });
+  });
   $("shape-name").addEventListener("input", () => { userName = true; });
   $("shape-name").addEventListener("keydown", (e) => { if (e.key === "Enter") applyShape(); });
   $("show-c").addEventListener("click", () => send({ type: "show_c" }));
-  $("export-page").addEventListener("click", () => send({ type: "export_page" }));
+  $("export-page").addEventListener("click", () => {
+    showMessage("making the page (its GLSL)...", "keep");
+    send({ type: "export_page", ranges: pageRanges() }); // the sliders' spans as the page shows them
+  });
+  $("message").addEventListener("click", () => showMessage("", "note")); // dismissed
   $("close-code").addEventListener("click", () => $("code-dialog").close());
 
   // ---------------------------------------------------------------- the picture's size: the window's

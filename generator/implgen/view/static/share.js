@@ -1,6 +1,7 @@
 // implgen view: the share link. The page's whole view lives in its address after "#", in readable fields:
 //   #v=1&eq=x^2+...&name=surface&params=a = 1&values=a:1.2&cam=yaw,pitch,distance,tx,ty,tz,fov
-//     &clip=sphere:3[:cut]&color=f2bf4d&inside=5a8cf2&bg=1f1f24&lights=studio
+//     &clip=sphere:3[:cut]&color=f2bf4d&inside=5a8cf2&bg=1f1f24&lights=studio[&obj=2]
+// (obj: with a scene file, the picked object, whose equation, name, params and values the link holds)
 // A link is text from anywhere: decode() reads it as untrusted input, bounded in length, each field checked
 // by its own pattern and range and dropped when it does not pass (the server checks everything again); it
 // never evaluates anything. The numbers' ranges are the server's, sent in its hello (view/protocol.py RANGES,
@@ -40,6 +41,7 @@ window.implgenLink = (() => {
     q.set("inside", hex(op.inside));
     q.set("bg", hex(op.background));
     q.set("lights", op.lights);
+    if (Number.isInteger(view.object)) q.set("obj", String(view.object));
     return q.toString();
   }
 
@@ -99,6 +101,8 @@ window.implgenLink = (() => {
     const lights = q.get("lights");
     if (lights !== null) { if (LIGHTS.includes(lights)) options.lights = lights; else bad.push("lights"); }
     if (Object.keys(options).length) view.options = options;
+    const obj = q.get("obj");
+    if (obj !== null) { if (/^[0-9]{1,5}$/.test(obj)) view.object = Number(obj); else bad.push("obj"); }
     return { view, bad };
   }
 
