@@ -23,6 +23,7 @@ from implgen.scene.load import parse_scene
 from implgen.scene.render import render
 from implgen.scene.tracer import CScene
 from implgen.spec.entry import parse_spec
+from implgen.view import builds as builds_mod
 from implgen.view import frames as view_frames
 from implgen.view import session as session_mod
 from implgen.view.command import document_factory
@@ -141,8 +142,8 @@ def test_a_slider_rerenders_without_building(client, monkeypatch) -> None:
         ws.send_text(render_msg(hello, seq=1, refine=False))
         _, _, before = frame(picture(ws))
         calls = []
-        real = session_mod.build_scene
-        monkeypatch.setattr(session_mod, "build_scene", lambda *a, **k: calls.append(1) or real(*a, **k))
+        real = builds_mod.build_scene
+        monkeypatch.setattr(builds_mod, "build_scene", lambda *a, **k: calls.append(1) or real(*a, **k))
         ws.send_text(render_msg(hello, seq=2, refine=False, values={"a": 1.0, "b": 0.6}))
         seq, _, after = frame(picture(ws))
         assert seq == 2 and calls == []

@@ -32,11 +32,10 @@ from pathlib import Path
 
 from implgen import validate
 from implgen.errors import UserError
-from implgen.scene.build import BuildResult, build_scene, runtime_ready
-from implgen.scene.model import Scene
 from implgen.scene.render import usable_cores
 from implgen.spec.paramrange import param_ranges
 from implgen.view import dump, fit, frames, gpu, ladder, pick, protocol, sharepage
+from implgen.view.builds import Builds
 from implgen.view.document import Document
 from implgen.view.meshsave import MeshSaver
 from implgen.view.pace import CUT, Pace
@@ -48,7 +47,6 @@ KIND_COARSE, KIND_FULL, KIND_SAVE, KIND_ONE = 0, 1, 2, 3  # KIND_ONE: full size 
 KIND_MESH = 4  # Save mesh's STL (meshsave.py)
 KIND_QUARTER, KIND_MORE = 5, 6  # the refinement's half-size picture; full size at 2 to FULL_SPP - 1 samples
 LADDER_KINDS = {"quarter": KIND_QUARTER, "one": KIND_ONE, "more": KIND_MORE, "full": KIND_FULL}  # ladder.py's steps
-BUILD_QUIET, BUILD_POLL = 0.2, 0.4  # seconds: a build says nothing before the first, then repeats its progress
 HEADER = struct.Struct(">IBBxxHH")  # seq, kind, flags, width, height; the image bytes follow
 SAMPLES = struct.Struct(">IBBHHH")  # HEADER with its spare bytes read: the samples a pixel of a KIND_MORE frame
 FLAG_EMPTY = 1  # no pixel of the frame shows anything but the background: no real points in view
@@ -84,7 +82,6 @@ class Session:
         self._final: tuple | None = None  # (view, width, height, bytes, empty) of the last refined frame sent
         self.pace = Pace()  # the coarse frames' size
         self._seconds = 0.0  # the last render's wall time, encoding included
-        self._told = False  # the page was told a build is going on
         self._save: Ticket | None = None  # the save's render in progress
         self._cost: float | None = None  # core seconds a sample of the last render of this shape
         self._last_start = 0.0
@@ -92,6 +89,7 @@ class Session:
         self._saving: asyncio.Task | None = None
         self._glsl: asyncio.Task | None = None
         self.frames = 0  # frames sent (for tests)
+        self.builds = Builds(self.work, send)  # the scenes' libraries, a long build told to the page
         self.meshes = MeshSaver(self.work, send, lambda stl: send(HEADER.pack(0, KIND_MESH, 0, 0, 0) + stl))
         self._shape_id = 0  # numbers the shapes sent to the page (hello, shape replies), for the GPU preview
 
@@ -164,7 +162,7 @@ class Session:
         if data["type"] == "pick":
             x, y, width, height = protocol.parse_pick(data)
             sc = self.doc.scene(width, height, 1)
-            index = await self.work.call(self.work.render, pick.pick_leaf, sc, await self._library(sc), x, y)
+            index = await self.work.call(self.work.render, pick.pick_leaf, sc, await self.builds.library(sc), x, y)
             if index is None:
                 raise UserError("pick", "nothing there: the ray through that pixel meets no object")
         else:
@@ -192,14 +190,14 @@ class Session:
         spec = await self.work.call(self.work.parse, protocol.parse_shape, data, trial.spec)
         trial.set_spec(spec)
         await self.work.call(self.work.parse, param_ranges, spec)  # the sliders' spans (kept with the spec)
-        await self._library(trial.scene())
+        await self.builds.library(trial.scene())
         fitted, unbounded = None, False
         box = spec.box(trial.values) if spec.params else spec.box()
         if data.get("fit") is True or box is None or not all(map(math.isfinite, box)):
             # where its real points are: the clip fitted to them (when the size is not the user's own), or that
             # it runs on without end (the page says so when there is no clip)
             probe = fit.probe_scene(spec, trial.values)
-            far = await self.work.call(self.work.render, fit.reach, probe, await self._library(probe))
+            far = await self.work.call(self.work.render, fit.reach, probe, await self.builds.library(probe))
             fitted = fit.clip_for(far) if data.get("fit") is True else None
             unbounded = far is not None and math.isinf(far)
         self.doc.spec, self.doc.values = trial.spec, trial.values
@@ -212,38 +210,6 @@ class Session:
         await self.send(self._shape_reply(fit=fitted, unbounded=unbounded, objects=self.doc.objects(), **picked_part))
 
     # ------------------------------------------------------------------ rendering
-
-    async def _library(self, sc: Scene) -> BuildResult:
-        """The scene's library: built (or found in the build cache) once per set of shapes on the parse pool,
-        then reused by every page showing those shapes (each render maps the scene's leaves onto it on its own
-        thread)."""
-        specs = sc.specs()
-        built = self.work.library(specs)
-        if built is None:
-            telling = asyncio.get_running_loop().create_task(self._tell_build())
-            try:
-                built = await self.work.call(self.work.parse, build_scene, sc)
-            finally:
-                telling.cancel()
-                if self._told:
-                    self._told = False
-                    await self.send({"type": "status", "text": ""})
-            self.work.keep_library(specs, built)
-        return built
-
-    async def _tell_build(self) -> None:
-        """While a build lasts more than a moment: what it does, for the page's status ("compiling the runtime
-        (first run only): 3 of N files", once per build cache; then the shape)."""
-        await asyncio.sleep(BUILD_QUIET)
-        while True:
-            done, total = await asyncio.to_thread(runtime_ready)
-            if done < total:
-                text = f"compiling the runtime (first run only): {done} of {total} files"
-            else:
-                text = "compiling the shape"
-            self._told = True
-            await self.send({"type": "status", "text": text})
-            await asyncio.sleep(BUILD_POLL)
 
     def request(self, req: protocol.RenderRequest) -> None:
         """The newest request wins: it replaces the waiting one and cancels the running refined render (a
@@ -313,7 +279,7 @@ class Session:
         small = not req.gpu and self._shown_pixels * 4 < req.width * req.height
         steps = ladder.plan(req.width, req.height, FULL_SPP, self.pace.seconds_per_pixel, small)
         sc = self.doc.scene(req.width, req.height, FULL_SPP)
-        lib = await self._library(sc)
+        lib = await self.builds.library(sc)
         if self._pending is not None:  # overtaken while the scene was being built
             return
         ticket = self._ticket(req.width, req.height, FULL_SPP, "render", "render", self.work.limits.render_budget)
@@ -347,7 +313,7 @@ class Session:
         refined frame) or when it was `cut` after pace.CUT seconds (a coarse frame: ticket.expired says so).
         Over the render budget: a UserError saying what the surface costs."""
         sc = self.doc.scene(width, height, spp)
-        lib = await self._library(sc)
+        lib = await self.builds.library(sc)
         if full and self._pending is not None:  # overtaken while the scene was being built
             return None, None
         budget = min(CUT, self.work.limits.render_budget) if cut else self.work.limits.render_budget
@@ -375,7 +341,7 @@ class Session:
         write_png uses (the same bytes as `implgen render` writes for this scene)."""
         try:
             sc = self.doc.scene(width, height, spp)
-            lib = await self._library(sc)
+            lib = await self.builds.library(sc)
             ticket = self._ticket(width, height, spp, "save", "save_png", self.work.limits.save_budget)
             ticket.check_rows(self._cost)
             self._save = ticket
