@@ -91,7 +91,7 @@ def test_the_mesh_is_what_implgen_mesh_writes(tmp_path):
 @pytest.mark.parametrize(
     ("equation", "clip", "message"),
     [
-        ("x^2 + w", "sphere:3", "equation: unknown symbol 'w' (known: x, y, z)"),
+        ("x^2 + w", "sphere:3", "equation: unknown symbol 'w' at column 7 (known: x, y, z)"),
         ('x"}, "bounds": {"x": [0, 1]}, "z": {"y', "sphere:3", "equation:"),  # text stays text in the spec
         ("x^2 + y^2 - 1", "", "the shape is unbounded along some axis"),
         ("x^2 + y^2 + z^2 - 1", "cube:2", "--clip cube:2: expected sphere:R or box:H"),
@@ -155,7 +155,7 @@ def test_in_blender_headless(tmp_path):
     assert torus["vertices"] - torus["edges"] + torus["faces"] == 0  # closed, genus 1
     assert torus["volume"] == pytest.approx(2 * np.pi**2 * 0.35**2, rel=0.06)  # > 0: normals outward
     errors = out["errors"]
-    assert errors["equation"] == "Error: equation: unknown symbol 'w' (known: x, y, z)\n"
+    assert errors["equation"] == "Error: equation: unknown symbol 'w' at column 7 (known: x, y, z)\n"
     assert errors["params"] == "Error: params: a: 'one' is not a number\n"
     assert errors["clip"].startswith("Error: --clip cube:2: expected sphere:R or box:H")
     assert errors["unbounded"].startswith("Error: the shape is unbounded along some axis")

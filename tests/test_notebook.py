@@ -99,7 +99,7 @@ def test_a_scene_is_the_tracers_frames_and_turns():
 @pytest.mark.parametrize(
     ("args", "params", "message"),
     [
-        (("x^2 + w",), {}, "<equation>: equation: unknown symbol 'w' (known: x, y, z)"),
+        (("x^2 + w",), {}, "<equation>: equation: unknown symbol 'w' at column 7 (known: x, y, z)"),
         (("x^2 + y^2 + z^2 - r",), {"r": "1"}, "implgen.show: param 'r': expected a finite number"),
         (("x^2 + y^2 + z^2 - r",), {"r": math.nan}, "implgen.show: param 'r': expected a finite number"),
         ((str(SHAPES_DIR / "torus_y.yaml"),), {"q": 1}, "no param 'q' (params: a, b)"),

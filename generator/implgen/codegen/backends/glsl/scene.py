@@ -95,7 +95,7 @@ def _tables(t: SceneTables) -> dict[str, str]:
     rows = [[_vec(leaf.inverse[4 * r : 4 * r + 4]) for leaf in leaves] for r in range(3)]
     zero3, zero4 = "vec3(0.0)", "vec4(0.0)"
     return {
-        "leaf_shape": _array("int", [str(leaf.shape) for leaf in leaves], "0"),
+        "shape_of_leaf": _array("int", [str(leaf.shape) for leaf in leaves], "0"),
         "leaf_minv0": _array("vec4", rows[0], zero4),
         "leaf_minv1": _array("vec4", rows[1], zero4),
         "leaf_minv2": _array("vec4", rows[2], zero4),
