@@ -517,3 +517,32 @@ def test_a_scene_object_that_runs_on_without_end_is_said_and_gets_a_clip(tmp_pat
             assert d.find_element("id", "clip-size").get_attribute("value") == "1.5"
     finally:
         d.quit()
+
+
+def test_equations_are_shown_as_the_user_wrote_them(server, tmp_path) -> None:
+    """Saved specs and exported pages showed SymPy's order (`-k*(-x - y + z - 1)...` for `(x + y + z - 1)`), and
+    so did the equation box of a reopened file: now the user's own tree, printed back."""
+    import html as html_text
+
+    import yaml
+
+    from test_view_page import apply
+
+    written = "4*(x^2 + y^2 + z^2 - 1) - k*(z - x)"  # SymPy: -k*(-x + z) + 4*x^2 + 4*y^2 + 4*z^2 - 4
+    d = chromium(1280, 800)
+    try:
+        seq = open_page(d, server)
+        apply(d, "4*(x^2+y^2+z^2-1) - k*(z-x)", "k = 0.5")
+        wait(d, lambda d: text(d, "degree") == "degree 2", "the shape was not accepted")
+        seq = wait_full_after(d, seq)
+        saved = saved_text(d)
+        assert yaml.safe_load(saved)["objects"][0]["equation"] == written
+        page = html_text.unescape(saved_text(d, "export-page"))
+        assert f"{written} = 0" in page
+        path = tmp_path / "surface.yaml"
+        path.write_text(saved)
+        with view_process(str(path)) as url:
+            open_page(d, url)
+            assert d.find_element("id", "equation").get_attribute("value") == written
+    finally:
+        d.quit()

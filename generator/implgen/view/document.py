@@ -150,7 +150,7 @@ class Document:
         spec = self.spec
         return {
             "name": spec.name,
-            "equation": spec.equation,
+            "equation": spec.as_written,  # the user's own tree printed back, not SymPy's order
             "params": spec.params,
             "values": self.values,
             "degree": spec.degree,
