@@ -99,6 +99,7 @@ embree-picture: install embree-example
 # The README's picture of `implgen view`, taken by the browser test.
 screenshot: install browser
 	IMPLGEN_SCREENSHOT=docs/gallery/view.png $(BIN)/python -m pytest -q tests/test_view_browser.py
+	IMPLGEN_VIEW_SHOTS=docs/gallery $(BIN)/python -m pytest -q tests/test_view_details.py -k three_window_sizes
 	IMPLGEN_SHARE_SCREENSHOT=docs/gallery/share.png $(BIN)/python -m pytest -q tests/test_share_browser.py -k draws
 
 # An sdist and a wheel (built from the sdist) in dist/, checked by twine: what `pip install` takes elsewhere.

@@ -162,7 +162,10 @@ def test_parsed_equations_print_back_to_the_same_polynomial(text):
             return
         shown = format_expression(parsed.expr, {s: p for p, s in SYMBOLS.items()})
         again = parse_expression(shown, VARIABLES, SYMBOLS, 24)
+        as_written = parse_expression(parsed.text, VARIABLES, SYMBOLS, 24)  # the user's tree printed back
     assert exact_polynomial(again.expr - parsed.expr, list(SYMBOLS.values())) == 0
+    assert exact_polynomial(as_written.expr - parsed.expr, list(SYMBOLS.values())) == 0
+    assert as_written.text == parsed.text  # printed back, it prints the same again
     poly = exact_polynomial(parsed.expr, list(SYMBOLS.values()))
     degree = max((sum(m[:3]) for m in poly.monoms()), default=0) if poly != 0 else 0
     assert degree <= parsed.degree_bound

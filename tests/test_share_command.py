@@ -132,7 +132,7 @@ def test_a_page_holds_the_shape_and_runtime_and_fetches_nothing(tmp_path, capsys
         assert f"'sha256-{digest}'" in csp
     # the line saying what was parsed: the equation printed back from the tree
     text = " ".join(" ".join(p.text).split())
-    assert f"{spec.equation} = 0" in text
+    assert f"{spec.as_written} = 0" in text  # the equation as written, printed back from the parsed tree
     assert "degree 4" in text
     sliders = [a for t, a in p.tags if t == "input" and a.get("type") == "range"]
     assert [(a["aria-label"], a["min"], a["max"], a["value"]) for a in sliders] == [

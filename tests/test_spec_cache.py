@@ -89,7 +89,7 @@ def test_a_spec_file_and_the_same_content_share_one_entry(cache: Path) -> None:
     cached = load_spec(path, cache=True)
     assert cached.symbolic_part.deferred and cached.source == str(path)
     full = load_spec(path)
-    assert cached.spec_key == full.spec_key and cached.equation == full.equation
+    assert cached.spec_key == full.spec_key and cached.equation == full.equation and cached.written == full.written
 
 
 def test_content_types_are_part_of_the_key(cache: Path) -> None:

@@ -169,7 +169,7 @@ def test_bad_equation_keeps_the_last_shape_and_the_server_up(client) -> None:
         assert ok == {
             "type": "shape",
             "name": "torus",  # no name sent: the current shape's
-            "equation": "-r^2 + x^2 + y^2 + z^2",
+            "equation": "x^2 + y^2 + z^2 - r^2",  # the user's tree printed back, in the user's order
             "params": {"r": 1.5},
             "values": {"r": 1.5},
             "degree": 2,
@@ -524,7 +524,7 @@ def test_a_scene_s_object_is_picked_in_the_picture_or_from_the_list(tmp_path) ->
         assert [o["name"] for o in hello["objects"]] == ["floor", "left", "right"] and hello["object"] == 0
         ws.send_text(json.dumps({"type": "pick", "x": pixel(2.0), "y": 239.5, "width": 640, "height": 480}))
         got = reply(ws)
-        assert (got["object"], got["name"], got["equation"]) == (2, "right", "y^2 + z^2 + (x - 2)^2 - 1")
+        assert (got["object"], got["name"], got["equation"]) == (2, "right", "(x - 2)^2 + y^2 + z^2 - 1")  # as written
         ws.send_text(json.dumps({"type": "shape", "equation": "(x - 2)^2 + y^2 + z^2 - 0.25"}))
         assert reply(ws)["name"] == "right"  # a scene's shape keeps its name
         ws.send_text(json.dumps({"type": "pick", "x": pixel(-2.0), "y": 239.5, "width": 640, "height": 480}))
@@ -533,7 +533,7 @@ def test_a_scene_s_object_is_picked_in_the_picture_or_from_the_list(tmp_path) ->
         assert "nothing there" in reply(ws)["message"]
         ws.send_text(json.dumps({"type": "object", "index": 2}))
         back = reply(ws)
-        assert back["object"] == 2 and back["equation"] == "y^2 + z^2 + (x - 2)^2 - 1/4"  # its edit was kept
+        assert back["object"] == 2 and back["equation"] == "(x - 2)^2 + y^2 + z^2 - 0.25"  # its edit was kept
         ws.send_text(json.dumps({"type": "object", "index": 3}))
         assert "index" in reply(ws)["message"]
     with TestClient(create_app(document_factory(None), threads=2)) as c, c.websocket_connect("/ws") as ws:

@@ -517,3 +517,67 @@ def test_a_scene_object_that_runs_on_without_end_is_said_and_gets_a_clip(tmp_pat
             assert d.find_element("id", "clip-size").get_attribute("value") == "1.5"
     finally:
         d.quit()
+
+
+def test_equations_are_shown_as_the_user_wrote_them(server, tmp_path) -> None:
+    """Saved specs and exported pages showed SymPy's order (`-k*(-x - y + z - 1)...` for `(x + y + z - 1)`), and
+    so did the equation box of a reopened file: now the user's own tree, printed back."""
+    import html as html_text
+
+    import yaml
+
+    from test_view_page import apply
+
+    written = "4*(x^2 + y^2 + z^2 - 1) - k*(z - x)"  # SymPy: -k*(-x + z) + 4*x^2 + 4*y^2 + 4*z^2 - 4
+    d = chromium(1280, 800)
+    try:
+        seq = open_page(d, server)
+        apply(d, "4*(x^2+y^2+z^2-1) - k*(z-x)", "k = 0.5")
+        wait(d, lambda d: text(d, "degree") == "degree 2", "the shape was not accepted")
+        seq = wait_full_after(d, seq)
+        saved = saved_text(d)
+        assert yaml.safe_load(saved)["objects"][0]["equation"] == written
+        page = html_text.unescape(saved_text(d, "export-page"))
+        assert f"{written} = 0" in page
+        path = tmp_path / "surface.yaml"
+        path.write_text(saved)
+        with view_process(str(path)) as url:
+            open_page(d, url)
+            assert d.find_element("id", "equation").get_attribute("value") == written
+    finally:
+        d.quit()
+
+
+SHOTS = [(800, 600), (1280, 800), (1920, 1080)]
+
+
+@pytest.mark.parametrize("size", SHOTS, ids=[f"{w}x{h}" for w, h in SHOTS])
+def test_the_page_at_three_window_sizes(server, size) -> None:
+    """Barth's sextic from the gallery at 800×600, 1280×800 and 1920×1080: no sideways scroll, the picture the
+    larger part of the window, the controls' header and the gallery's line in view. With IMPLGEN_VIEW_SHOTS=DIR
+    set (`make screenshot`), the page is saved as DIR/view-WxH.png (docs/viewer.md shows them)."""
+    import os
+
+    from selenium.webdriver.support.ui import Select
+
+    d = chromium(*size)
+    try:
+        seq = open_page(d, server)
+        Select(d.find_element("id", "gallery")).select_by_visible_text("Barth sextic")
+        wait(d, lambda d: text(d, "degree") == "degree 6", "Barth's sextic was not accepted")
+        wait_full_after(d, seq)
+        import time
+
+        time.sleep(1.0)
+        wait(d, lambda d: frame_state(d)[1] == "full", "the picture did not rest")
+        layout = d.execute_script(
+            "const root = document.documentElement, s = document.getElementById('stage').getBoundingClientRect();"
+            "return [root.scrollWidth <= root.clientWidth, s.width * s.height / (innerWidth * innerHeight)];"
+        )
+        assert layout[0] and layout[1] > 0.4, layout
+        assert heading_in_view(d) and "Barth" in text(d, "gallery-note")
+        shots = os.environ.get("IMPLGEN_VIEW_SHOTS")
+        if shots:
+            d.save_screenshot(os.path.join(shots, f"view-{size[0]}x{size[1]}.png"))
+    finally:
+        d.quit()

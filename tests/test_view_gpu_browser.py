@@ -392,8 +392,9 @@ def test_past_the_glsl_budget_the_page_says_the_gpu_draws_the_tree(tmp_path, dri
         note = view_state(d)["note"]
         assert "the GLSL evaluates f as written" in note and "0.01 s GLSL budget" in note, note
         d.find_element("id", "export-page").click()
-        message = "return document.getElementById('message').textContent"
-        until(d, lambda d: js(d, message).startswith("the exported page's shader: "), "Export page said nothing")
+        said = "const m = document.getElementById('message').textContent;"
+        said += "return m.startsWith('saved power.html: ') && m.includes(\"; the exported page's shader: \");"
+        until(d, lambda d: js(d, said), "Export page said nothing")
 
 
 def test_params_named_as_object_prototype_s_members(driver) -> None:

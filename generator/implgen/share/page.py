@@ -209,7 +209,7 @@ def render_page(spec: Spec, sliders: list[Slider], look: Look, source_name: str,
             version=__version__,
             csp=_csp(scripts, css),
             name=spec.name,
-            equation=spec.equation,
+            equation=spec.as_written if "=" in spec.as_written else f"{spec.as_written} = 0",  # as written
             degree=spec.degree,
             box=_box_text(box),
             description=description,

@@ -37,7 +37,7 @@ from implgen.spec.fingerprint import implgen_fingerprint
 from implgen.spec.model import Spec, Symbolic
 from implgen.spec.names import check_identifier, check_shape_name
 
-FORMAT = 3
+FORMAT = 4
 MAX_ENTRY_BYTES = 8 << 20  # an entry holds the printed equation of a spec file of at most 1 MiB
 MAX_NESTING = 8  # a spec mapping is four levels deep (bounds -> axis -> pair -> end); deeper is never valid
 _ENTRY_KEYS = {
@@ -45,6 +45,7 @@ _ENTRY_KEYS = {
     "key",
     "name",
     "equation",
+    "written",
     "params",
     "degree",
     "description",
@@ -77,6 +78,7 @@ def _cached_spec(entry: dict, content: str, source: str) -> Spec:
     return Spec(
         name=entry["name"],
         equation=entry["equation"],
+        written=entry["written"],
         params={k: v for k, v in entry["params"]},
         degree=entry["degree"],
         param_terms=[(c, tuple(e)) for c, e in entry["terms"]],
@@ -186,7 +188,7 @@ def _entry_ok(entry: Any, key: str, data: dict) -> bool:
         return False
     if not isinstance(degree, int) or isinstance(degree, bool) or not 1 <= degree <= abi.value("IG_MAX_DEGREE"):
         return False
-    if not isinstance(entry["equation"], str) or not entry["equation"]:
+    if not isinstance(entry["equation"], str) or not entry["equation"] or not isinstance(entry["written"], str):
         return False
     if not all(isinstance(entry[k], str) for k in ("description", "title", "reference")):
         return False
@@ -250,6 +252,7 @@ def _write_entry(path: Path, key: str, spec: Spec) -> None:
         "key": key,
         "name": spec.name,
         "equation": spec.equation,
+        "written": spec.written,
         "params": [[k, v] for k, v in spec.params.items()],
         "degree": spec.degree,
         "description": spec.description,

@@ -23,13 +23,13 @@ import math
 import re
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from fractions import Fraction
 
 import sympy
 from sympy.printing.str import StrPrinter
 
-from implgen.spec import syntaxplace
+from implgen.spec import syntaxplace, written
 from implgen.spec.syntaxplace import ALPHABET, ParseError, check_alphabet, place_in  # noqa: F401 -- its names
 
 MAX_TEXT_LENGTH = 20_000
@@ -51,6 +51,7 @@ class Parsed:
     param_degree_bound: int
     terms: int = 1  # upper bound of the number of terms once expanded (capped at _TERMS_CAP)
     names: frozenset[str] = frozenset()  # the variables and params it uses
+    text: str = ""  # the user's own tree printed back (spec/written.py), set once the whole text has parsed
 
 
 def _joined(a: Parsed, b: Parsed) -> frozenset[str]:
@@ -313,7 +314,8 @@ def parse_expression(
         raise ParseError("expression is nested too deeply") from err
     check_depth(parsed.expr)
     check_terms(parsed.terms)
-    return parsed
+    as_written = written.written(tree, lambda node: Fraction(int((r := builder._number(node)).p), int(r.q)))
+    return replace(parsed, text=as_written)
 
 
 def expression_depth(expr: sympy.Basic) -> int:

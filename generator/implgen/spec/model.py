@@ -73,6 +73,14 @@ class Spec:
     title: str = ""  # shown, never generated: the title, the literature reference, a slider's range per param
     reference: str = ""
     ranges: dict[str, tuple[float, float]] = field(default_factory=dict)
+    # the equation as the user wrote it (`lhs = rhs` or `expr`): the parsed tree printed back in the user's order
+    # (spec/written.py), for what people read; "" where there is none (params folded): `equation` then
+    written: str = ""
+
+    @property
+    def as_written(self) -> str:
+        """The equation to show a person: as written, else the canonical `equation` (meaning `= 0`)."""
+        return self.written or self.equation
 
     @staticmethod
     def parsed(symbolic: Symbolic) -> _Once:

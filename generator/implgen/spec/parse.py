@@ -102,6 +102,7 @@ def make_spec(
     folded: dict[str, float] | None = None,
     texts: Mapping[str, str] | None = None,
     ranges: Mapping[str, tuple[float, float]] | None = None,
+    written: str = "",
 ) -> Spec:
     """A `Spec` with its symbolic part at hand, and the plain data a scene reads computed from it."""
     symbols = [param_symbol(p) for p in params]
@@ -130,6 +131,7 @@ def make_spec(
         title=(texts or {}).get("title", ""),
         reference=(texts or {}).get("reference", ""),
         ranges=dict(ranges or {}),
+        written=written,
     )
     return spec
 
@@ -157,7 +159,8 @@ def canonical_equation(f: sympy.Expr, params: Mapping[str, float]) -> str:
     return format_expression(f, {param_symbol(p): p for p in params})
 
 
-def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[sympy.Expr, int]:
+def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[sympy.Expr, int, str]:
+    """f = lhs - rhs, its degree, and the equation as written (the user's tree printed back: spec/written.py)."""
     if not isinstance(text, (str, int, float)) or isinstance(text, bool):
         raise UserError(source, "equation: must be text such as 'x^2 + y^2 + z^2 - 1'")
     symbols = {p: param_symbol(p) for p in params}
@@ -169,6 +172,7 @@ def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[s
         check_terms(lhs.terms + rhs.terms)
         f = lhs.expr - rhs.expr
         check_depth(f)  # lhs - rhs: the right side negated can be a level deeper than either side
+        as_written = f"{lhs.text} = {rhs.text}" if "=" in text else lhs.text
     except ParseError as err:
         raise UserError(source, f"equation: {err}", err.position) from None
     poly = exact_polynomial(f, list(symbols.values()))
@@ -193,7 +197,7 @@ def _parse_equation(source: str, text: Any, params: dict[str, float]) -> tuple[s
                 f"equation: a coefficient of the expanded polynomial is beyond 2^{MAX_COEFF_BITS} "
                 f"or below 2^-{MAX_COEFF_BITS} in size (not a normal double)",
             )
-    return f, degree
+    return f, degree, as_written
 
 
 def _side(text: str, part: str, offset: int, symbols: dict[str, sympy.Symbol]):
@@ -257,12 +261,12 @@ def parse_full(data: Any, source: str = "<spec>") -> Spec:
             raise UserError(source, f"missing key {key!r}")
     name = check_shape_name(source, "name", data["name"])
     params = _parse_params(source, data.get("params"))
-    f, degree = _parse_equation(source, data["equation"], params)
+    f, degree, as_written = _parse_equation(source, data["equation"], params)
     bounds = _parse_bounds(source, data.get("bounds"), params)
     texts = {key: _parse_text(source, key, data.get(key, "")) for key in MAX_TEXT}
     description = texts.pop("description")
     ranges = _parse_ranges(source, data.get("ranges"), params)
-    spec = make_spec(name, f, params, degree, bounds, description, source, None, texts, ranges)
+    spec = make_spec(name, f, params, degree, bounds, description, source, None, texts, ranges, as_written)
     spec.check_values({}, source, "params")  # the defaults
     for key, (lo, hi) in ranges.items():  # every coefficient stays a finite double at both ends of a range
         spec.check_values({key: lo}, source, f"ranges.{key}")

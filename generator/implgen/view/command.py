@@ -54,7 +54,10 @@ def document_factory(path: Path | None):
         return scene_document
     spec = parse_spec(data, str(path))
     param_ranges(spec)
-    return lambda: Document.for_spec(spec)
+    from implgen.view import fit
+
+    size = fit.fitted(spec)  # a shape without a box: its clip fitted as a new equation's is (and framed)
+    return lambda: Document.for_spec(spec, size)
 
 
 def bind(host: str, port: int) -> socket.socket:

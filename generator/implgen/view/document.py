@@ -118,8 +118,11 @@ class Document:
     clips: dict[int, Clip | None] = field(default_factory=dict)
 
     @staticmethod
-    def for_spec(spec: Spec) -> Document:
+    def for_spec(spec: Spec, fitted: float | None = None) -> Document:
+        """A spec's document; `fitted`: the clip fitted to a shape without a box (view/fit.py), else its box's."""
         doc = Document(spec=spec, values=dict(spec.params))
+        if fitted is not None:
+            doc.options.clip_size = fitted
         box = spec.box()
         if box is not None and all(math.isfinite(v) for v in box):
             # a clip ball about the origin that holds the spec's box (its bounding sphere, and a margin)
@@ -150,7 +153,7 @@ class Document:
         spec = self.spec
         return {
             "name": spec.name,
-            "equation": spec.equation,
+            "equation": spec.as_written,  # the user's own tree printed back, not SymPy's order
             "params": spec.params,
             "values": self.values,
             "degree": spec.degree,

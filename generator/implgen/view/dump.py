@@ -25,7 +25,7 @@ def _vec(v) -> list[float | int]:
 
 def spec_mapping(spec: Spec, values: dict[str, float] | None = None) -> dict:
     """A spec file's mapping; `values` become the params' defaults."""
-    out: dict = {"name": spec.name, "equation": spec.equation}
+    out: dict = {"name": spec.name, "equation": spec.as_written}  # the parsed tree, in the user's order
     if spec.params:
         out["params"] = {k: _num((values or {}).get(k, v)) for k, v in spec.params.items()}
     if spec.bounds is not None:

@@ -52,6 +52,18 @@ def fit_clip(sc: Scene, lib: BuildResult) -> float | None:
     return clip_for(reach(sc, lib))
 
 
+def fitted(spec: Spec) -> float | None:
+    """The clip fitted to a spec file's shape at its defaults, as to a new equation, or None (no box needed: it
+    has one; or the probe found nothing to fit). Builds the shape's library (the build cache keeps it)."""
+    from implgen.scene.build import build_scene
+
+    box = spec.box()
+    if box is not None and all(map(math.isfinite, box)):
+        return None
+    probe = probe_scene(spec, dict(spec.params))
+    return fit_clip(probe, build_scene(probe))
+
+
 def clip_for(far: float | None) -> float | None:
     """The fitted clip radius for a surface whose farthest point found is `far` (reach), or None."""
     return None if far is None or math.isinf(far) else _nice(far * MARGIN)

@@ -322,6 +322,9 @@
     buildSliders();
   }
 
+  // a slider moves in decimal steps, a thousandth of its span or finer (0.5 is a value it can take)
+  const sliderStep = (lo, hi) => 10 ** (Math.floor(Math.log10(hi - lo)) - 3);
+
   function buildSliders() {
     const box = $("sliders");
     box.replaceChildren();
@@ -338,7 +341,7 @@
       const min = Object.assign(document.createElement("input"), { type: "number", value: lo, step: "any" });
       const max = Object.assign(document.createElement("input"), { type: "number", value: hi, step: "any" });
       const slider = Object.assign(document.createElement("input"), {
-        type: "range", min: lo, max: hi, step: (hi - lo) / 1000, value: state.values[name],
+        type: "range", min: lo, max: hi, step: sliderStep(lo, hi), value: state.values[name],
       });
       slider.dataset.name = name;
       slider.setAttribute("aria-label", name);
@@ -354,7 +357,7 @@
         if (Number.isFinite(a) && Number.isFinite(b) && a < b) {
           state.ranges[name] = [a, b];
           userRanges.add(name); // the user's own span stays while the param does
-          slider.min = a; slider.max = b; slider.step = (b - a) / 1000;
+          slider.min = a; slider.max = b; slider.step = sliderStep(a, b);
           slider.value = state.values[name];
         }
       };
