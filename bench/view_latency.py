@@ -399,16 +399,12 @@ GLASS_PER_PIXEL = 2.4e-6  # s: a pixel at one sample, as the live frames measure
 
 
 def glass_work(rounds: int) -> dict:
-    """In this process, this tree's runtime: the core seconds (process CPU time: every thread) from the start of
-    a refinement to each of its pictures, encoding included, the way before (a 1-sample render at the pixel
-    centres, then a 4-sample render from nothing) and the ladder, interleaved round by round. Load inflates CPU
-    time less than wall time, and both ways alike."""
-    import time as _time
-
+    """In this process, this tree's runtime: the core seconds (process CPU time: every thread) and the rays traced
+    from the start of a refinement to each of its pictures, encoding included, the way before (a 1-sample render
+    at the pixel centres, then a 4-sample render from nothing) and the ladder, interleaved round by round. Load
+    inflates CPU time less than wall time, and both ways alike; the rays do not depend on it."""
     from implgen.scene.build import build_scene
-    from implgen.scene.renderjob import PIXELS_EVEN, RenderJob
     from implgen.scene.tracer import CScene
-    from implgen.view import frames, ladder
     from implgen.view.command import document_factory
 
     doc = document_factory(GLASSWARE)()
@@ -418,47 +414,64 @@ def glass_work(rounds: int) -> dict:
             sc = doc.scene(w, h, 4)
             cs = CScene(sc, build_scene(sc))
             for way in ("before", "ladder"):
-                t0, got = _time.process_time(), out.setdefault((w, h, way), {})
-                if way == "before":
-                    for stage, spp in (("one", 1), ("full", 4)):
-                        with RenderJob(cs, w, h, spp, sc.max_depth, 2) as job:
-                            frames.live_png(frames.eight_bits(job.run()))
-                        got.setdefault(stage, []).append(_time.process_time() - t0)
-                else:
-                    steps = ladder.plan(w, h, 4, max(GLASS_PER_PIXEL, 1.0 / (w * h)), True)  # a pass a sample
-                    with RenderJob(cs, w, h, 4, sc.max_depth, 2) as job:
-                        for step in steps:
-                            img = job.run_pass(step.k0, step.k1, step.pixels)
-                            frames.live_png(frames.eight_bits(img[::2, ::2] if step.pixels == PIXELS_EVEN else img))
-                            got.setdefault(step.role + (str(step.k1) if step.role == "more" else ""), []).append(
-                                _time.process_time() - t0
-                            )
+                got = out.setdefault((w, h, way), {})
+                for stage, (cpu, rays) in (_before if way == "before" else _ladder)(cs, sc, w, h):
+                    got.setdefault(stage, []).append(cpu)
+                    got.setdefault("rays " + stage, []).append(rays)
             cs.close()
+    return out
+
+
+def _before(cs, sc, w: int, h: int) -> list[tuple[str, tuple[float, float]]]:
+    """The refinement before the ladder: a 1-sample render, then a 4-sample one; (stage, (CPU, rays)) of each."""
+    from implgen.scene.renderjob import RenderJob
+    from implgen.view import frames
+
+    t0, rays, out = time.process_time(), 0.0, []
+    for stage, spp in (("one", 1), ("full", 4)):
+        with RenderJob(cs, w, h, spp, sc.max_depth, 2) as job:
+            frames.live_png(frames.eight_bits(job.run()))
+            rays += sum(job.stats().rays.values())
+        out.append((stage, (time.process_time() - t0, rays)))
+    return out
+
+
+def _ladder(cs, sc, w: int, h: int) -> list[tuple[str, tuple[float, float]]]:
+    """The ladder, a pass a sample: (stage, (CPU, rays)) of each picture."""
+    from implgen.scene.renderjob import PIXELS_EVEN, RenderJob
+    from implgen.view import frames, ladder
+
+    t0, out = time.process_time(), []
+    with RenderJob(cs, w, h, 4, sc.max_depth, 2) as job:
+        for step in ladder.plan(w, h, 4, max(GLASS_PER_PIXEL, 1.0 / (w * h)), True):
+            img = job.run_pass(step.k0, step.k1, step.pixels)
+            frames.live_png(frames.eight_bits(img[::2, ::2] if step.pixels == PIXELS_EVEN else img))
+            stage = step.role + (str(step.k1) if step.role == "more" else "")
+            out.append((stage, (time.process_time() - t0, sum(job.stats().rays.values()))))
     return out
 
 
 def work_lines(work: dict) -> list[str]:
     lines = [
-        "Work (load-robust): core seconds from the start of the refinement to each picture, encoding included, "
-        "rendered in the benchmark's own process with this tree's runtime on 2 threads, the way before (a "
-        "1-sample render, then a 4-sample render from nothing) and the ladder interleaved; *quiet estimate*: "
-        f"{QUIET_ONE} s (the 1-sample picture at 640×480 on a quiet 2-core machine) times the ratio to the "
-        "1-sample render before.",
+        "Work, independent of the load: the core seconds and the rays (all kinds, millions) from the start of the "
+        "refinement to each picture, encoding included, rendered in the benchmark's own process with this tree's "
+        "runtime on 2 threads, the way before (a 1-sample render, then a 4-sample render from nothing) and the "
+        f"ladder, interleaved. *Quiet estimate*: {QUIET_ONE} s (the 1-sample picture at 640×480 on a quiet 2-core "
+        "machine, before) times the picture's rays over those of the 1-sample render before at 640×480.",
         "",
-        "| size | way | → half size | → 1 spp | → 2 spp | → 3 spp | → 4 spp | "
-        "quiet estimate: half size, 1 spp, 4 spp (s) |",
-        "|---|---|---|---|---|---|---|---|",
+        "| size | way | → half size (core s) | → 1 spp | → 2 spp | → 3 spp | → 4 spp | rays to half size, 1 spp, "
+        "4 spp (M) | quiet estimate: half size, 1 spp, 4 spp (s) |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
+    unit = statistics.median(work[640, 480, "before"]["rays one"])  # the rays of QUIET_ONE
     for w, h in GLASS_SIZES:
-        base = statistics.median(work[w, h, "before"]["one"])
-        scale = QUIET_ONE * (w * h) / (640 * 480) / base  # the quiet machine's seconds a core second here
         for way in ("before", "ladder"):
             m = work[w, h, way]
             cells = [_median(m[k]) if k in m else "–" for k in ("quarter", "one", "more2", "more3", "full")]
-            est = ", ".join(
-                f"{statistics.median(m[k]) * scale:.2f}" if k in m else "–" for k in ("quarter", "one", "full")
-            )
-            lines.append(f"| {w}×{h} | {way} | " + " | ".join(cells) + f" | {est} |")
+            rays = [statistics.median(m[f"rays {k}"]) if f"rays {k}" in m else None for k in ("quarter", "one", "full")]
+            cells.append(", ".join("–" if r is None else f"{r / 1e6:.2f}" for r in rays))
+            cells.append(", ".join("–" if r is None else f"{QUIET_ONE * r / unit:.2f}" for r in rays))
+            lines.append(f"| {w}×{h} | {way} | " + " | ".join(cells) + " |")
     return lines + [""]
 
 
