@@ -176,6 +176,15 @@ def _csp(scripts: list[str], css: str) -> str:
     )
 
 
+def slider_step(lo: float, hi: float) -> float:
+    """A slider's step: a power of ten, a thousandth of its span or finer, as the viewer's page (app.js) takes it,
+    so that the decimal values between its ends (0.45 of 0.004..1) are values it can take."""
+    span = hi - lo
+    if not (math.isfinite(span) and span > 0):
+        return span / 1000
+    return 10.0 ** (math.floor(math.log10(span)) - 3)
+
+
 def _slider_fields(s: Slider) -> dict:
     """A slider as the template writes its input: numbers as the page parses them, the ends as shown."""
     return {
@@ -183,7 +192,7 @@ def _slider_fields(s: Slider) -> dict:
         "value": _number(s.value),
         "min": _number(s.lo),
         "max": _number(s.hi),
-        "step": _number((s.hi - s.lo) / 1000),
+        "step": _number(slider_step(s.lo, s.hi)),
         "min_text": f"{s.lo:.6g}",
         "max_text": f"{s.hi:.6g}",
     }
