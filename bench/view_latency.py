@@ -317,8 +317,8 @@ def drag_lines(new: dict, old: dict | None, rounds: int, compare: Path | None = 
     lines = [
         f"Drags: mouse moves every {MOVE_GAP * 1e3:.0f} ms for {DRAG_SECONDS:g} s, sent whatever "
         f"comes back, 640×480 canvas, then the release; medians of {rounds} rounds. Targets: ≥ 15 coarse "
-        "frames/s, refined ≤ 0.4 s after the release for degree ≤ 8. The server sends the full size at 1 sample "
-        "per pixel first when its 4-sample frame is expected to take longer than 0.4 s.",
+        "frames/s, refined ≤ 0.4 s after the release for degree ≤ 8. When its 4-sample frame is expected to take "
+        "longer than 0.4 s, the server refines it pass by pass (the full size at 1 sample first).",
         "",
         head
         if old is None

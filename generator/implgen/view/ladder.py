@@ -1,7 +1,7 @@
 """The refinement ladder: how a resting view is refined, pass by pass, in one C render context.
 
 When the view rests, the page first gets a picture it can show at once, then better ones, and last the picture
-`implgen render` makes of the view at FULL samples a pixel, bit for bit:
+`implgen render` makes of the view at its samples a pixel (the viewer's 4), bit for bit:
 
     quarter  sample 0 of the pixels whose x and y are even: a half-size picture (a quarter of the pixels), sent
              when the page shows something smaller (the drag's last coarse frame)
