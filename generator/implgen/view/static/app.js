@@ -578,7 +578,8 @@
       o.yaw = (o.yaw - dx * 0.4) % 360;
       o.pitch = Math.max(-89, Math.min(89, o.pitch + dy * 0.4));
     }
-    movedFor(DRAG_REST);
+    // the GPU draws a held view itself: the server refines it once the button is released
+    if (gpu !== null && gpu.active()) { clearTimeout(restTimer); requestRender(false); } else movedFor(DRAG_REST);
   });
   const endDrag = (e) => {
     if (!drag) return;
