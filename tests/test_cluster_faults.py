@@ -302,7 +302,8 @@ def test_the_window_grows_with_workers_that_join_later(tmp_path):
     opts = FrameOptions(width=48, height=36, spp=1, max_depth=2, threads=1)
     with local_cluster(1) as cl, Client(cl) as client:
         client.wait_for_workers(1, timeout=60)
-        runner = Runner(client=client, task=functools.partial(_slow_frame, str(log)))
+        # one frame a task (a chunk of 48x36 frames would otherwise take half of them): the window is what is tested
+        runner = Runner(client=client, task=functools.partial(_slow_frame, str(log)), chunk=1)
         joined = []
 
         def grow(f):
