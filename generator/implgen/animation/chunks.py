@@ -38,6 +38,7 @@ TARGET_SECONDS = 0.25  # a chunk's render time: a task's fixed cost (a few ms on
 SHARES = 2  # a chunk takes at most 1/(SHARES x worker threads) of the frames left: the last round is balanced
 MAX_CHUNK = 256  # frames
 KEEP_RENDERERS = 4  # scene libraries a process keeps loaded for the chunks to come
+PER_LANE = 3  # chunks submitted ahead per render thread here, as cluster.PER_THREAD per worker thread
 SAMPLES_PER_THREAD = 20_000  # a tracer thread's least share of a frame here: smaller frames go side by side
 
 
@@ -208,9 +209,10 @@ def local_results(
     fn: Callable[..., Any], jobs: Iterable[tuple[Any, tuple]], lanes: int = 1
 ) -> Iterator[tuple[Any, Any]]:
     """cluster.ordered's contract in this process: fn(*args, stop=...) for each (index, args) of `jobs` on
-    `lanes` render threads, a job more than that ahead of the caller, results yielded in order. When the
-    caller stops early (Ctrl-C, an error), the frames in progress are cancelled and the threads waited for."""
-    depth = lanes + 1
+    `lanes` render threads, PER_LANE jobs a thread submitted ahead of the caller (so that a thread whose
+    chunk ended before the oldest one finds another waiting), results yielded in order. When the caller stops
+    early (Ctrl-C, an error), the frames in progress are cancelled and the threads waited for."""
+    depth = PER_LANE * lanes
     stop = Stop()
     pool = ThreadPoolExecutor(lanes, thread_name_prefix="implgen-render")
     pending: deque = deque()
