@@ -61,19 +61,17 @@ def wait(d, what, timeout: float = 600.0):
 
 
 def open_scene(d, url: str, size: tuple[int, int]) -> None:
+    """The page at `size`, its refined frame shown, then the GPU preview ticked and its rest fixed."""
     d.get(url)
-    wait(d, lambda d: d.execute_script(STATE)["kind"] == "full")
+    wait(d, lambda d: d.execute_script(STATE)["kind"] != "")  # a first frame: the page has its hello
     d.execute_script(
         "const s = document.getElementById('stage'); s.style.flex = 'none';"
         "s.style.width = arguments[0] + 'px'; s.style.height = arguments[1] + 'px';",
         *size,
     )
-    wait(
-        d,
-        lambda d: (
-            d.execute_script("const c = document.getElementById('view'); return [c.width, c.height]") == list(size)
-        ),
-    )
+    shape = "const c = document.getElementById('view'); return [c.width, c.height]"
+    wait(d, lambda d: d.execute_script(shape) == list(size))
+    wait(d, lambda d: d.execute_script(STATE)["kind"] == "full")
     set_gpu(d, True)
 
 
@@ -130,6 +128,7 @@ def main() -> int:
             drivers[name] = webdriver.Chrome(service=Service(shutil.which("chromedriver")), options=opts)
             drivers[name].set_script_timeout(600)
             open_scene(drivers[name], urls[name], size)
+            print(f"{name}: open", file=sys.stderr, flush=True)
         renderer = drivers[SCENES[0]].execute_script("return implgenGpu.renderer().info()[1]")
         for r in range(args.rounds):
             for name in SCENES:

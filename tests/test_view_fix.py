@@ -108,3 +108,21 @@ def test_a_bad_fix_message_gets_one_line(pixels, over, says) -> None:
             ws.send_text(_fix_msg(hello, pixels, **over))
             err = reply(ws)
     assert err["type"] == "error" and says in err["message"], err
+
+
+def test_a_part_asked_twice_is_refused_and_an_older_view_s_is_dropped() -> None:
+    """A page cannot queue more than MAX_PARTS traces for one rest: a part asked again gets one error line; a fix
+    of an older view than one already asked is dropped (no reply), a newer one answered."""
+    with TestClient(create_app(document_factory(str(SCENES / "csg_trio.yaml")), threads=2)) as client:
+        with client.websocket_connect("/ws") as ws:
+            hello = reply(ws)
+            ws.send_text(_fix_msg(hello, [1, 2], seq=5, part=0))
+            first = ws.receive_bytes()
+            ws.send_text(_fix_msg(hello, [3], seq=5, part=0))
+            again = reply(ws)
+            ws.send_text(_fix_msg(hello, [4], seq=4, part=1))  # older: dropped
+            ws.send_text(_fix_msg(hello, [7], seq=6, part=0))
+            newer = ws.receive_bytes()
+    assert SAMPLES.unpack(first[: SAMPLES.size])[0] == 5 and len(first) == SAMPLES.size + 6
+    assert again["type"] == "error" and "part 0 of this view was asked already" in again["message"]
+    assert SAMPLES.unpack(newer[: SAMPLES.size])[0] == 6 and len(newer) == SAMPLES.size + 3

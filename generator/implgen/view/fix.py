@@ -91,9 +91,20 @@ class Fixes:
     def __init__(self, work: Work, builds: Builds, send: Callable, failed: Callable) -> None:
         self.work, self.builds, self.send, self.failed = work, builds, send, failed
         self._by_seq: dict[int, tuple[asyncio.Task, threading.Event]] = {}
+        self._newest, self._parts = -1, set()  # the newest rest's seq and the parts it has asked
 
     def start(self, req: FixRequest, doc: Document, threads: int) -> None:
+        """Trace the request's pixels after the parts of its rest asked before; an older rest's are stopped, and a
+        request older than the newest rest's is dropped. A part asked twice is refused (so a rest holds at most
+        MAX_PARTS tasks)."""
         seq = req.view.seq
+        if seq < self._newest:
+            return
+        if seq > self._newest:
+            self._newest, self._parts = seq, set()
+        if req.part in self._parts:
+            raise UserError("fix", f"part {req.part} of this view was asked already")
+        self._parts.add(req.part)
         for old in [s for s in self._by_seq if s < seq]:  # an older rest's fix: stopped
             task, stop = self._by_seq.pop(old)
             stop.set()
