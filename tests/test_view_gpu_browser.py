@@ -451,6 +451,39 @@ def test_a_scene_is_drawn_on_the_gpu_and_the_server_fixes_its_flagged_pixels(tmp
         until(d, lambda d: view_state(d)["path"] == "gpu", "the GPU did not take the scene back after the pick")
         assert js(d, "return implgenGpu.renderer().prog === window.prog")
 
+        # an edit of the picked ball: a new program, compiled, and the GPU draws the smaller ball
+        js(d, "delete implgenGpu.renderer().setSceneProgram;")  # the prototype's again
+        js(
+            d,
+            "const e = document.getElementById('equation'); e.value = '(x + 2)^2 + y^2 + z^2 - 0.25';"
+            "e.dispatchEvent(new KeyboardEvent('keydown', {key: 'Enter'}));",
+        )
+        edited = "return implgenGpu.renderer().prog !== window.prog && window.implgenGpu.active()"
+        until(d, lambda d: js(d, edited), "no new program for the edited scene")
+        assert "(x + 2)^2 + y^2 + z^2 - 0.25" not in js(d, "return implgenGpu.renderer().fragment")  # as numbers
+        until(d, lambda d: view_state(d)["shown"] == "fixed", "no fixed picture of the edited scene")
+        js(d, "implgenGpu.renderer().draw({});")
+        hits = gl_pixels(d, "statusPixels")[..., 2]  # the object + 1 of each pixel's camera ray
+        assert (hits == 2).sum() < 0.5 * (status[..., 2] == 2).sum()  # the left ball (object 1) is smaller
+
+
+def test_past_the_glsl_budget_a_scene_is_the_server_s_and_the_page_says_so(tmp_path, driver) -> None:
+    """A scene holding Chmutov's degree-12 surface typed expanded in its box, under a 0.01 s GLSL budget: its
+    program is not done in time, the page says so, and the server draws every frame, a drag's coarse ones too."""
+    spec = chmutov(12, nested=False)
+    bounds = {a: [float(lo), float(hi)] for a, (lo, hi) in spec.bounds.items()}
+    scene = {**GPU_SCENE, "objects": [*GPU_SCENE["objects"][:2], {"equation": spec.equation, "bounds": bounds}]}
+    path = tmp_path / "slow.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    d = driver
+    with view_process(str(path), env={**os.environ, "IMPLGEN_VIEW_GLSL_BUDGET": "0.01"}) as url:
+        open_page(d, url)
+        said = "the scene's GLSL was not done within the 0.01 s GLSL budget"
+        until(d, lambda d: said in view_state(d)["note"], "the page did not say why")
+        assert view_state(d)["path"] == "server"
+        kinds = drag(d, during=lambda d: view_state(d))
+        assert "coarse" in drawn_while_dragging(d) and all(k["gl_frames"] == 0 for k in kinds)
+
 
 def test_past_the_glsl_budget_the_page_says_the_gpu_draws_the_tree(tmp_path, driver) -> None:
     """The GLSL derivation and Export page have a budget (IMPLGEN_VIEW_GLSL_BUDGET); past it the shader
