@@ -720,9 +720,10 @@ def main() -> int:
     old = args.output.read_text(encoding="utf-8") if args.output.exists() else ""
     for begin, end in (
         ("<!-- bench/view_gpu.py: begin -->", "<!-- bench/view_gpu.py: end -->"),
+        ("<!-- bench/view_scene_rest.py: begin -->", "<!-- bench/view_scene_rest.py: end -->"),
         (GLASS_BEGIN, GLASS_END),
     ):
-        if begin in old and end in old:  # the sections of bench/view_gpu.py and of --glass stay
+        if begin in old and end in old:  # the sections of bench/view_gpu.py, view_scene_rest.py and --glass stay
             text = text.rstrip("\n") + "\n\n" + old[old.index(begin) : old.index(end) + len(end)] + "\n"
     write_results(args.output, text)
     return 0

@@ -81,6 +81,10 @@ def test_every_example_scene_s_program_compiles(path, tmp_path):
     t = scene_tables(load_scene(path))
     for target, suffix in (("es", "es.frag"), ("450", "450.frag")):
         assert glslang_problems(scene_program(t, target), tmp_path / f"{path.stem}.{suffix}") == "", target
+    # the viewer's program: its lights and background uniforms (view/gpu.py)
+    live = scene_program(t, "es", live_lights=3)
+    assert "uniform vec3 ig_light_pos[IG_SCENE_LIGHTS];" in live
+    assert glslang_problems(live, tmp_path / f"{path.stem}.live.es.frag") == ""
 
 
 def test_a_scene_page_shows_its_file_name_as_text():

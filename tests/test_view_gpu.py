@@ -1,8 +1,9 @@
 """The server's side of the viewer's GPU preview (view/gpu.py; docs/viewer.md, "The GPU preview"), through
 Starlette's test client: the hello carries the GLSL ES header, the runtime, the light presets and the material;
 a `glsl` request answers with the current shape's generated GLSL (the same text `implgen SPEC --lang glsl`
-writes), numbered like the shape replies; a scene file is the server's, and the reply says why; a render
-request with `gpu` gets no coarse frames; the served surface.js and orbit.js are the shared page's files.
+writes), numbered like the shape replies; a scene file gets its whole scene program (past the GLSL budget the
+reply says the server draws); a render request with `gpu` gets no coarse frames; the served surface.js,
+orbit.js and scenerender.js are the shared page's files.
 The browser side is tests/test_view_gpu_browser.py."""
 
 from __future__ import annotations
@@ -17,9 +18,11 @@ from starlette.testclient import TestClient
 from conftest import ROOT
 from implgen.codegen.backends.glsl import chebform
 from implgen.codegen.backends.glsl.program import HEADERS, runtime_text
+from implgen.codegen.backends.glsl.scene import scene_program
 from implgen.codegen.emit import generate
 from implgen.measure.glslcases import chmutov
 from implgen.scene.load import load_scene
+from implgen.share.scenegpu import scene_tables
 from implgen.view import gpu
 from implgen.view.command import document_factory
 from implgen.view.document import LIGHT_PRESETS, Document
@@ -71,14 +74,54 @@ def test_the_hello_and_the_glsl_of_each_shape(client) -> None:
     assert "int ig_shape_ball_u_hit(vec3 o" in third["shape"]
 
 
-def test_a_scene_file_is_drawn_by_the_server_and_says_why(tmp_path) -> None:
-    """glassware.yaml has CSG, glass and several shapes: the reply names them and carries no GLSL."""
-    doc = Document.for_scene(load_scene(SCENES / "glassware.yaml"))
+def test_a_scene_file_gets_its_whole_program_with_live_lights() -> None:
+    """glassware.yaml (CSG, glass, several shapes): the reply is the scene tracer's program of the scene the
+    server would draw, its lights and background uniforms (slots for the file's lights or a preset's), and the
+    file's lights; the shape's GLSL is not in it."""
+    scene = load_scene(SCENES / "glassware.yaml")
+    doc = Document.for_scene(scene)
     msg = gpu.program_message(doc)
-    assert "shape" not in msg and msg["reason"].startswith("a scene file (")
+    assert "shape" not in msg and "reason" not in msg and msg["name"] == "glassware"
+    s = msg["scene"]
+    slots = max(len(scene.lights), max(len(v) for v in LIGHT_PRESETS.values()))
+    want = scene_program(scene_tables(doc.scene(16, 16, 1)), "es", live_lights=slots)
+    assert s["header"] == HEADERS["es"] and s["header"] + s["program"] == want and s["slots"] == slots
+    assert "uniform vec3 ig_light_pos[IG_SCENE_LIGHTS];" in s["program"]
+    assert f"#define IG_SCENE_LIGHTS {slots}\n" in s["program"] and "uniform vec3 ig_scene_background;" in s["program"]
+    assert s["lights"] == [{"position": list(li.position), "colour": list(li.color)} for li in scene.lights]
     for word in ("CSG", "glass", "shapes"):
-        assert word in msg["reason"], msg["reason"]
-    assert gpu.server_only(document_factory(None)()) is None
+        assert word in s["what"], s["what"]
+
+
+def test_a_scene_s_program_is_asked_with_the_page_s_values_and_past_the_budget_is_the_server_s(tmp_path) -> None:
+    """The ask's number comes back; the picked leaf's values from the ask are folded into the program; the same
+    program again is not derived again; past the GLSL budget (a Chebyshev form that takes longer) the reply says
+    the server draws."""
+    path = tmp_path / "two.yaml"
+    spec = chmutov(12, nested=False)
+    bounds = {a: [float(lo), float(hi)] for a, (lo, hi) in spec.bounds.items()}
+    path.write_text(
+        "camera: {position: [0, 0, 8], look_at: [0, 0, 0]}\n"
+        "objects:\n  - {equation: 'x^2 + y^2 + z^2 - r^2', params: {r: 1.0}}\n"
+        f"  - {{equation: '{spec.equation}', bounds: {json.dumps(bounds)}, transform: {{translate: [3, 0, 0]}}}}\n"
+    )
+    with TestClient(create_app(document_factory(str(path)), threads=2)) as c, c.websocket_connect("/ws") as ws:
+        hello = reply(ws)
+        ws.send_text(json.dumps({"type": "glsl", "ask": 7, "values": {"r": 1.0}}))
+        first = reply(ws)
+        ws.send_text(json.dumps({"type": "glsl", "ask": 8, "values": {"r": 1.0}}))
+        again = reply(ws)
+        ws.send_text(json.dumps({"type": "glsl", "ask": 9, "values": {"r": 0.625}}))
+        other = reply(ws)
+    assert hello["mode"] == "scene" and first["ask"] == 7 and again["ask"] == 8 and other["ask"] == 9
+    assert again["scene"] == first["scene"]
+    assert other["scene"]["program"] != first["scene"]["program"] and "0.625" in other["scene"]["program"]
+    app = create_app(document_factory(str(path)), threads=2, limits=Limits(glsl_budget=0.01))
+    with TestClient(app) as c, c.websocket_connect("/ws") as ws:
+        reply(ws)
+        ws.send_text(json.dumps({"type": "glsl", "ask": 1}))
+        cut = reply(ws)
+    assert "scene" not in cut and "the server draws" in cut["reason"] and "0.01 s GLSL budget" in cut["reason"]
 
 
 def test_the_presets_place_the_lights_the_tracer_gets() -> None:
@@ -215,7 +258,7 @@ def test_past_the_glsl_budget_the_shader_evaluates_the_tree_and_the_page_is_told
 
 
 def test_the_page_s_scripts_are_the_shared_page_s_files(client) -> None:
-    for name in ("surface.js", "orbit.js"):
+    for name in ("surface.js", "orbit.js", "scenerender.js"):
         r = client.get(f"/{name}")
         assert r.status_code == 200 and r.headers["content-type"].startswith("text/javascript")
         assert r.content == (SHARE_STATIC / name).read_bytes()

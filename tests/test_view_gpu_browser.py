@@ -2,8 +2,9 @@
 While the view moves the page draws the picture itself with the shape's GLSL, at rest the server's frame
 replaces it; the GPU's picture is checked against the double-precision tracer's (docs/viewer.md, "The GPU
 preview"); a slider only sets uniforms; "compare with server" paints the differing and the not-sure pixels;
-without WebGL2, with a shader the browser refuses, and for a CSG scene the server draws every frame, and the
-page says so. Frame rates: bench/view_gpu.py. Needs Debian's chromium and chromium-driver.
+without WebGL2 or with a shader the browser refuses the server draws every frame, and the page says so; a
+scene file is drawn by its GLSL program, at rest too, the server fixing the pixels it flags. Frame rates:
+bench/view_gpu.py. Needs Debian's chromium and chromium-driver.
 """
 
 from __future__ import annotations
@@ -53,11 +54,18 @@ WebGL2RenderingContext.prototype.getParameter = function (what) {
   return e && what === e.UNMASKED_RENDERER_WEBGL ? "ANGLE (a hardware GPU, said the test)" : original.call(this, what);
 };
 """
-CSG_SCENE = {
-    "image": {"width": 64, "height": 48},
-    "camera": {"position": [0, 1, 5], "look_at": [0, 0, 0], "fov": 40},
-    "lights": [{"position": [3, 5, 5], "color": [1, 1, 1]}],
-    "objects": [{"difference": [{"equation": "x^2 + y^2 + z^2 - 1"}, {"equation": "x^2 + (y - 0.8)^2 + z^2 - 0.36"}]}],
+GLASS = {"color": [1, 1, 1], "ambient": 0, "diffuse": 0, "specular": 0.8, "shininess": 200, "transparency": 1.0}
+# two balls (the right one glass) either side of a CSG solid, on a floor: the camera on the z axis
+GPU_SCENE = {
+    "image": {"width": 64, "height": 48, "max_depth": 4},
+    "camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "fov": 40},
+    "lights": [{"position": [0, 5, 5], "color": [1, 1, 1]}],
+    "objects": [
+        {"equation": "y + 2", "name": "floor"},
+        {"equation": "(x + 2)^2 + y^2 + z^2 - 1", "name": "left"},
+        {"equation": "(x - 2)^2 + y^2 + z^2 - 1", "name": "right", "material": {**GLASS, "ior": 1.5}},
+        {"difference": [{"equation": "x^2 + y^2 + z^2 - 1"}, {"equation": "x^2 + (y - 0.8)^2 + z^2 - 0.36"}]},
+    ],
 }
 
 
@@ -378,17 +386,103 @@ def test_with_a_hardware_gpu_the_preview_is_on_from_the_start(torus_server, driv
     until(d, lambda d: view_state(d)["shown"] == "server" and view_state(d)["seq"] > before["seq"], "no server frame")
 
 
-def test_a_csg_scene_is_the_server_s(tmp_path, driver) -> None:
-    path = tmp_path / "csg.yaml"
-    path.write_text(yaml.safe_dump(CSG_SCENE))
+def scene_reference(d, path: Path) -> np.ndarray:
+    """The double-precision tracer's picture of the page's view of a scene file at 1 sample a pixel."""
+    from implgen.scene.load import load_scene
+    from implgen.view.document import Document
+
+    state = js(d, "return window.implgenState()")
+    doc = Document.for_scene(load_scene(path))
+    doc.orbit = protocol.parse_orbit(state["orbit"])
+    doc.options = protocol.parse_options(state["options"])
+    return to_uint8(render(doc.scene(*SIZE, 1), threads=2)).astype(int)
+
+
+def fixed_state(d) -> tuple[int, int]:
+    """(the seq of the last rest the page fixed, how many pixels the server gave it)."""
+    return tuple(
+        js(d, "const v = document.getElementById('view').dataset; return [+(v.fixSeq ?? -1), +(v.fixed ?? -1)];")
+    )
+
+
+def test_a_scene_is_drawn_on_the_gpu_and_the_server_fixes_its_flagged_pixels(tmp_path, driver) -> None:
+    """A scene file with CSG, glass and several shapes: the GPU draws it at rest (once its program has come) and
+    while dragging (no server frame meanwhile); at rest the page keeps the GPU's picture and puts in the server's
+    double-precision pixels where the GLSL flagged "not sure" -- and, to test the compositing whatever the GPU
+    flags, every 9th pixel flagged as well by a wrapped status pass: those pixels are exactly the tracer's at one
+    sample, the others the GPU's. A click on a ball still picks it (its equation in the box), and the same scene's
+    program is not compiled again."""
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(GPU_SCENE))
     d = driver
+    more_flags = (
+        "window.addEventListener('load', () => { const f = IgSceneRenderer.prototype.statusPixels;"
+        "IgSceneRenderer.prototype.statusPixels = function (...a) { const s = f.apply(this, a);"
+        "for (let i = 0; i < s.length / 4; i += 9) s[4 * i + 1] = 255; return s; }; });"
+    )
     with view_process(str(path)) as url:
+        open_page(d, url, script=more_flags)
+        until(d, lambda d: view_state(d)["path"] == "gpu", "the GPU did not take the scene")
+        assert "the scene (5 shapes, CSG, glass), the GPU while the view moves" in view_state(d)["note"]
+        until(d, lambda d: view_state(d)["shown"] == "fixed", "no fixed picture at rest")
+        frames = view_state(d)["frames"]
+        js(d, "const r = implgenGpu.renderer(); window.prog = r.prog; r.draw({});")
+        gpu_picture, status = gl_pixels(d)[..., :3], gl_pixels(d, "statusPixels")
+        flagged = status[..., 1] > 127
+        picture, ref = png(d, "view"), scene_reference(d, path)
+        assert fixed_state(d)[1] == flagged.sum() and flagged.mean() > 0.1
+        assert (picture[flagged] == ref[flagged]).all()  # the server's pixels, exactly
+        assert (picture[~flagged] == gpu_picture[~flagged]).all()  # the GPU's elsewhere
+        hits = status[..., 0] > 127
+        assert hits.mean() > 0.3 and (np.abs(gpu_picture - ref).max(axis=2) > 24).mean() < 0.02  # and it is the scene
+
+        before = fixed_state(d)[0]
+        moving = drag(d, during=lambda d: view_state(d))
+        assert all(s["shown"] == "gpu" and not s["gl_hidden"] for s in moving), [s["shown"] for s in moving]
+        assert moving[-1]["gl_frames"] > moving[0]["gl_frames"] and drawn_while_dragging(d) == []
+        until(d, lambda d: fixed_state(d)[0] > before, "no fixed picture after the drag")
+        assert view_state(d)["frames"] == frames  # no server frame: only pixels
+
+        from selenium.webdriver.common.action_chains import ActionChains
+
+        js(d, "implgenGpu.renderer().setSceneProgram = () => 'compiled again';")  # the same program: not compiled
+        ActionChains(d).move_to_element_with_offset(d.find_element("id", "view"), -33, 0).click().perform()
+        until(d, lambda d: js(d, "return document.getElementById('equation').value").startswith("(x + 2)"), "no pick")
+        until(d, lambda d: view_state(d)["path"] == "gpu", "the GPU did not take the scene back after the pick")
+        assert js(d, "return implgenGpu.renderer().prog === window.prog")
+
+        # an edit of the picked ball: a new program, compiled, and the GPU draws the smaller ball
+        js(d, "delete implgenGpu.renderer().setSceneProgram;")  # the prototype's again
+        js(
+            d,
+            "const e = document.getElementById('equation'); e.value = '(x + 2)^2 + y^2 + z^2 - 0.25';"
+            "e.dispatchEvent(new KeyboardEvent('keydown', {key: 'Enter'}));",
+        )
+        edited = "return implgenGpu.renderer().prog !== window.prog && window.implgenGpu.active()"
+        until(d, lambda d: js(d, edited), "no new program for the edited scene")
+        assert "(x + 2)^2 + y^2 + z^2 - 0.25" not in js(d, "return implgenGpu.renderer().fragment")  # as numbers
+        until(d, lambda d: view_state(d)["shown"] == "fixed", "no fixed picture of the edited scene")
+        js(d, "implgenGpu.renderer().draw({});")
+        hits = gl_pixels(d, "statusPixels")[..., 2]  # the object + 1 of each pixel's camera ray
+        assert (hits == 2).sum() < 0.5 * (status[..., 2] == 2).sum()  # the left ball (object 1) is smaller
+
+
+def test_past_the_glsl_budget_a_scene_is_the_server_s_and_the_page_says_so(tmp_path, driver) -> None:
+    """A scene holding Chmutov's degree-12 surface typed expanded in its box, under a 0.01 s GLSL budget: its
+    program is not done in time, the page says so, and the server draws every frame, a drag's coarse ones too."""
+    spec = chmutov(12, nested=False)
+    bounds = {a: [float(lo), float(hi)] for a, (lo, hi) in spec.bounds.items()}
+    scene = {**GPU_SCENE, "objects": [*GPU_SCENE["objects"][:2], {"equation": spec.equation, "bounds": bounds}]}
+    path = tmp_path / "slow.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    d = driver
+    with view_process(str(path), env={**os.environ, "IMPLGEN_VIEW_GLSL_BUDGET": "0.01"}) as url:
         open_page(d, url)
-        until(d, lambda d: "a scene file (2 shapes, CSG)" in view_state(d)["note"], "the page did not say why")
-        assert view_state(d)["path"] == "server" and js(d, "return document.getElementById('gpu').checked")
+        said = "the scene's GLSL was not done within the 0.01 s GLSL budget"
+        until(d, lambda d: said in view_state(d)["note"], "the page did not say why")
+        assert view_state(d)["path"] == "server"
         kinds = drag(d, during=lambda d: view_state(d))
         assert "coarse" in drawn_while_dragging(d) and all(k["gl_frames"] == 0 for k in kinds)
-        assert png(d, "view").std() > 5  # a picture, drawn by the server
 
 
 def test_past_the_glsl_budget_the_page_says_the_gpu_draws_the_tree(tmp_path, driver) -> None:

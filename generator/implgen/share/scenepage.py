@@ -19,7 +19,7 @@ from implgen.scene.model import Scene
 from implgen.share.page import _csp, _environment, script_json, static_text
 from implgen.share.scenegpu import scene_tables
 
-SCRIPTS = ("surface.js", "orbit.js", "scene.js")  # in this order: scene.js uses the other two
+SCRIPTS = ("surface.js", "orbit.js", "scenerender.js", "scene.js")  # in this order: each uses those before it
 
 
 def scene_orbit(scene: Scene) -> dict:

@@ -19,7 +19,13 @@ A message is one JSON object of at most MAX_MESSAGE bytes with a `type`:
     {"type": "stop_mesh"}                                             stop the mesh in progress
     {"type": "show_c"}                                                the generated C
     {"type": "export_page"}                                           the view as `implgen share`'s page
-    {"type": "glsl"}                                                  the GPU preview: the shape's GLSL (gpu.py)
+    {"type": "glsl", "ask": 3, "values": {...}}                       the GPU preview: the shape's GLSL, or a
+                                                                      scene's program (its leaf at these values;
+                                                                      the reply carries `ask` back) (gpu.py)
+    {"type": "fix", "seq": 7, "width": 640, "height": 480,
+     "values": {...}, "orbit": {...}, "options": {...},
+     "part": 0, "pixels": [1234, ...]}                                a GPU-drawn scene at rest: these pixels
+                                                                      (y * width + x) in double (fix.py)
     {"type": "pick", "x": 120, "y": 80, "width": 640, "height": 480}  a scene file: edit the object at a pixel
     {"type": "object", "index": 2}                                    a scene file: edit this leaf
     {"type": "clip", "clip": "sphere", "size": 2.5}                   a scene file: the picked (top-level)
@@ -55,6 +61,8 @@ MAX_FRAME = (2048, 2048)  # the largest interactive frame
 MAX_SAVE = (8192, 8192)  # the largest saved picture
 MAX_SAVE_PIXELS = 8192 * 4608  # 8K at 16:9
 MAX_SAVE_SPP = 64
+MAX_FIX_PIXELS = 6000  # pixels one `fix` message may name (its JSON stays well below MAX_MESSAGE)
+MAX_FIX_PARTS = 16  # fix messages one rest may send: a page with more flagged pixels asks for the frame (gpu.js)
 MESH_TYPES = ("save_mesh", "stop_mesh")  # meshsave.py
 TYPES = (
     "shape",
@@ -67,6 +75,7 @@ TYPES = (
     "clip",
     "export_page",
     "glsl",
+    "fix",
     *MESH_TYPES,
 )
 PARSE_CACHE = 16  # parsed equations remembered (a degree-24 spec holds its SymPy expression: megabytes)
@@ -285,6 +294,34 @@ def parse_render(data: dict, spec: Spec) -> RenderRequest:
         options=parse_options(data.get("options", {})),
         gpu=data.get("gpu", False) is True,
     )
+
+
+@dataclass
+class FixRequest:
+    view: RenderRequest  # its seq, size and view (refine and gpu unused)
+    part: int  # which of the rest's fix messages this is (sent back in the reply's header)
+    pixels: list[int]  # y * width + x, each at most once
+
+
+def parse_fix(data: dict, spec: Spec, most: int = MAX_FIX_PIXELS, parts: int = MAX_FIX_PARTS) -> FixRequest:
+    """A `fix` message: the view (as a render request's), its part number (below `parts`) and at most `most`
+    distinct pixels of its frame."""
+    view = parse_render({**data, "refine": False, "gpu": True}, spec)
+    part = validate.whole("fix", "part", data.get("part", 0), 0, parts - 1)
+    raw = data.get("pixels")
+    if not isinstance(raw, list) or not 0 < len(raw) <= most:
+        raise UserError("fix", f"pixels: expected a list of 1 to {most} pixel numbers")
+    last = view.width * view.height - 1
+    pixels = [validate.whole("fix", "pixels", v, 0, last) for v in raw]
+    if len(set(pixels)) != len(pixels):
+        raise UserError("fix", "pixels: each pixel at most once")
+    return FixRequest(view, part, pixels)
+
+
+def parse_ask(data: dict, spec: Spec) -> tuple[int, dict[str, float]]:
+    """A `glsl` message's number (sent back with the reply) and the picked leaf's param values."""
+    ask = validate.whole("glsl", "ask", data.get("ask", 0), 0, 2**31 - 1)
+    return ask, parse_values(data.get("values"), spec)
 
 
 def parse_size(data: dict, what: str) -> tuple[int, int]:

@@ -50,6 +50,7 @@ STATIC = {
     # the GPU preview draws with the shared page's renderer and orbit camera: the same files, not copies
     "/surface.js": ("share:surface.js", "text/javascript; charset=utf-8"),
     "/orbit.js": ("share:orbit.js", "text/javascript; charset=utf-8"),
+    "/scenerender.js": ("share:scenerender.js", "text/javascript; charset=utf-8"),
 }
 HEADERS = {
     "Cache-Control": "no-store",

@@ -34,7 +34,7 @@ from implgen import validate
 from implgen.errors import UserError
 from implgen.scene.render import usable_cores
 from implgen.spec.paramrange import param_ranges
-from implgen.view import dump, fit, frames, gpu, ladder, pick, protocol, sharepage
+from implgen.view import dump, fit, fix, frames, gpu, ladder, pick, protocol, sharepage
 from implgen.view.builds import Builds
 from implgen.view.document import Document
 from implgen.view.meshsave import MeshSaver
@@ -88,8 +88,10 @@ class Session:
         self._task: asyncio.Task | None = None
         self._saving: asyncio.Task | None = None
         self._glsl: asyncio.Task | None = None
+        self._scenes = gpu.LastScene()  # the glsl messages: a scene's program sent last
         self.frames = 0  # frames sent (for tests)
         self.builds = Builds(self.work, send)  # the scenes' libraries, a long build told to the page
+        self.fixes = fix.Fixes(self.work, self.builds, send, self._failed)  # a GPU-drawn scene's rest (fix.py)
         self.meshes = MeshSaver(self.work, send, lambda stl: send(HEADER.pack(0, KIND_MESH, 0, 0, 0) + stl))
         self._shape_id = 0  # numbers the shapes sent to the page (hello, shape replies), for the GPU preview
 
@@ -146,7 +148,12 @@ class Session:
             elif kind == "glsl":  # the GPU preview asks for the current shape's GLSL: derived (SymPy) in a task of
                 if self._glsl is not None:  # its own, so the renders behind it are read meanwhile; a newer ask wins
                     self._glsl.cancel()
-                self._glsl = asyncio.get_running_loop().create_task(self._send_glsl(replace(self.doc), self._shape_id))
+                doc, ask = replace(self.doc), None
+                if doc.base is not None:  # a scene's program: at the page's values of the picked leaf
+                    ask, doc.values = protocol.parse_ask(data, doc.spec)
+                self._glsl = asyncio.get_running_loop().create_task(self._send_glsl(doc, self._shape_id, ask))
+            elif kind == "fix":
+                self.fixes.start(protocol.parse_fix(data, self.doc.spec), self.doc, self.threads)
             elif kind == "show_c":
                 await self.send(
                     {"type": "c", "text": await self.work.call(self.work.parse, dump.c_text, self.doc.spec)}
@@ -366,10 +373,11 @@ class Session:
             log.error(what, exc_info=err)
         await self.send(protocol.error_for(err))
 
-    async def _send_glsl(self, doc: Document, shape_id: int) -> None:
-        """The `glsl` message of `doc`'s shape, numbered as that shape was (never a newer shape's number)."""
+    async def _send_glsl(self, doc: Document, shape_id: int, ask: int | None = None) -> None:
+        """The `glsl` message of `doc`'s shape, numbered as that shape was (never a newer shape's number); a
+        scene's carries the page's `ask` back (gpu.LastScene: derived again only when its program would differ)."""
         try:
-            msg = await self.work.derive_glsl(gpu.program_message, doc)
+            msg = await self._scenes.message(doc, self.work.derive_glsl, ask)
             await self.send({**msg, "shape_id": shape_id})
         except UserError as err:
             await self.send(protocol.error_for(err))
@@ -380,7 +388,8 @@ class Session:
         for ticket in (self._live, self._save):
             if ticket is not None:
                 ticket.cancel()
-        tasks = [t for t in (self._task, self._saving, self._glsl) if t is not None and not t.done()]
+        running = (self._task, self._saving, self._glsl, *self.fixes.stop())
+        tasks = [t for t in running if t is not None and not t.done()]
         for t in tasks:
             t.cancel()
         await asyncio.gather(*tasks, return_exceptions=True)  # work.trace waits for the C threads to stop

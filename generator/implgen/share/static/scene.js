@@ -1,48 +1,7 @@
 // implgen share: a whole scene's page -- the scene's GLSL program (implgen.codegen.backends.glsl.scene) drawn by
-// IgSurface's renderer with the scene's uniforms, turned by IgOrbit. Everything comes from the JSON block #ig-data
-// that `implgen share SCENE.yaml` wrote; nothing is fetched.
+// IgSceneRenderer (scenerender.js) with the scene's uniforms, turned by IgOrbit. Everything comes from the JSON
+// block #ig-data that `implgen share SCENE.yaml` wrote; nothing is fetched.
 "use strict";
-
-/** IgSurface.Renderer drawing a scene program: its own program and uniforms, the renderer's drawing and
- * progressive redraw. The camera's basis is worked out here in double, as the C tracer's (tracer_render.c). */
-class IgSceneRenderer extends IgSurface.Renderer {
-  /** The scene's program: header and body (header + body is the fragment shader). '' or the compiler's log. */
-  setSceneProgram(header, body) {
-    if (typeof header !== "string" || !header.startsWith("#version 300 es\n")) return "no GLSL ES 3.00 header";
-    try {
-      const prog = IgSurface.compileProgram(this.gl, header + body);
-      if (this.prog) this.gl.deleteProgram(this.prog);
-      this.prog = prog;
-    } catch (err) {
-      return String(err.message || err);
-    }
-    this.fragment = header + body;
-    return "";
-  }
-
-  _uniforms(w, h, output = 0) {
-    const gl = this.gl;
-    const loc = (n) => gl.getUniformLocation(this.prog, n);
-    const c = this.camera;
-    const sub = (a, b) => a.map((v, i) => v - b[i]);
-    const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
-    const unit = (a) => {
-      const l = Math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-      return l > 0 ? a.map((v) => v / l) : null;
-    };
-    const back = unit(sub(c.eye, c.target)) || [0, 0, 1];
-    const right = unit(cross(c.up, back)) || unit(cross(Math.abs(back[0]) > 0.9 ? [0, 1, 0] : [1, 0, 0], back));
-    const up = cross(back, right);
-    const tanHalf = Math.tan((0.5 * c.fov * Math.PI) / 180);
-    gl.uniform2f(loc("ig_scene_size"), w, h);
-    gl.uniform3fv(loc("ig_scene_eye"), c.eye);
-    gl.uniform3fv(loc("ig_scene_right"), right.map((v) => v * tanHalf * (w / h)));
-    gl.uniform3fv(loc("ig_scene_upv"), up.map((v) => v * tanHalf));
-    gl.uniform3fv(loc("ig_scene_back"), back);
-    gl.uniform1f(loc("ig_scene_mark"), this.markUnsure ? 1 : 0);
-    gl.uniform1f(loc("ig_scene_output"), output);
-  }
-}
 
 (() => {
   const $ = (id) => document.getElementById(id);

@@ -8,6 +8,7 @@
   const ctx2d = canvas.getContext("2d");
   const HEADER = 12; // seq (u32), kind (u8), flags (u8), samples (u16: a KIND_MORE frame's), width (u16), height (u16)
   const KIND_COARSE = 0, KIND_FULL = 1, KIND_SAVE = 2, KIND_ONE = 3, KIND_MESH = 4, KIND_QUARTER = 5, KIND_MORE = 6;
+  const KIND_FIX = 7; // a GPU-drawn scene's flagged pixels in double (gpu.js composites them)
   // a better frame of the same request wins: the refinement's half-size picture, 1 sample, more (their count in
   // the header's spare bytes), all samples
   const RANK = { [KIND_COARSE]: 0, [KIND_QUARTER]: 1, [KIND_ONE]: 2, [KIND_MORE]: 2, [KIND_FULL]: 1000 };
@@ -17,8 +18,11 @@
     [KIND_FULL]: "full" }; // the canvas's data-kind, for tests
   const FLAG_EMPTY = 1; // the frame shows nothing but the background
   // the GPU preview (gpu.js): draws the live picture in this browser where it can, else null or inactive
+  // redraw: a scene's program has come; serverRest: too many flagged pixels at rest, the server's frame instead
   const gpu = window.ImplgenGpu ? ImplgenGpu.create({ stage: $("stage"), view: canvas, note: $("gpu-note"),
-    toggle: $("gpu"), compare: $("compare"), status: $("status") }) : null;
+    toggle: $("gpu"), compare: $("compare"), status: $("status"), redraw: () => requestRender(true),
+    serverRest: () => { serverRest = true; requestRender(true); } }) : null;
+  let serverRest = false; // the next refined request is the server's whatever draws the live picture
 
   // Everything keyed by a param's name is a map without a prototype: a param may be called constructor,
   // toString or __proto__, and state.ranges[name] must not find Object.prototype's member instead.
@@ -130,11 +134,14 @@
       state.options = readOptions();
       if (q.refine) keepLink();
       sentAt.set(seq, { t: performance.now(), clip: state.options.clip_size });
-      const onGpu = gpu !== null && gpu.draw({ orbit: state.orbit, values: state.values, options: state.options },
-        !q.refine);
+      const view = { orbit: state.orbit, values: state.values, options: state.options };
+      const onGpu = gpu !== null && !(q.refine && serverRest) && gpu.draw(view, !q.refine, seq);
+      if (q.refine) serverRest = false;
       if (onGpu) { drawnSeq = seq; drawnKind = -1; } // older server frames are stale; this request's are not
+      // a scene the GPU draws keeps its picture at rest: the server fixes its flagged pixels (gpu.js), no frame
+      const refine = q.refine && !(onGpu && gpu.fixesRest());
       send({
-        type: "render", seq, refine: q.refine, width: canvas.width, height: canvas.height,
+        type: "render", seq, refine, width: canvas.width, height: canvas.height,
         values: state.values, orbit: state.orbit, options: state.options, gpu: onGpu,
       });
     });
@@ -397,6 +404,7 @@
     const bytes = new Uint8Array(buf, HEADER);
     lastError = "";
     if (kind === KIND_MESH) { implgenMesh.received(bytes); return; } // Save mesh (mesh.js)
+    if (kind === KIND_FIX) { if (gpu) gpu.fixed(fseq, samples, w, h, bytes); return; } // samples: the part
     if (kind === KIND_SAVE) {
       const name = `${fileName()}.png`;
       download(new Blob([bytes], { type: "image/png" }), name);

@@ -124,13 +124,17 @@ def _tables(t: SceneTables) -> dict[str, str]:
     }
 
 
-def scene_text(t: SceneTables) -> str:
-    """The scene's part of the program: its tables, the shapes' dispatch, then the scene tracer."""
+def scene_text(t: SceneTables, live_lights: int = 0) -> str:
+    """The scene's part of the program: its tables, the shapes' dispatch, then the scene tracer. `live_lights` > 0:
+    the viewer's program, whose lights (up to that many; the tables' are not used) and background are uniforms
+    the page sets (ig_light_pos, ig_light_color, ig_scene_nlights, ig_scene_background)."""
+    if live_lights < 0:
+        raise ValueError("live_lights must be >= 0")
     counts = {
         "leaves": len(t.leaves),
         "nodes": len(t.nodes),
         "objects": len(t.objects),
-        "lights": len(t.lights),
+        "lights": int(live_lights) if live_lights else len(t.lights),
         "max_depth": int(t.max_depth),
         "csg_stack": max(1, int(t.csg_stack)),
     }
@@ -142,13 +146,15 @@ def scene_text(t: SceneTables) -> str:
             counts=counts,
             background=_vec(t.background),
             prefixes=[prefix for prefix, _ in t.shapes],
+            live_lights=int(live_lights),
         )
     )
 
 
-def scene_program(t: SceneTables, target: str = "es") -> str:
-    """A whole fragment shader: header, the runtime, the scene's shapes, its tables and the scene tracer."""
+def scene_program(t: SceneTables, target: str = "es", live_lights: int = 0) -> str:
+    """A whole fragment shader: header, the runtime, the scene's shapes, its tables and the scene tracer
+    (`live_lights`: scene_text's)."""
     if target not in HEADERS:
         raise ValueError(f"target must be one of {sorted(HEADERS)}, not {target!r}")
     shapes = "".join(text + "\n" for _, text in t.shapes)
-    return HEADERS[target] + runtime_text() + shapes + scene_text(t)
+    return HEADERS[target] + runtime_text() + shapes + scene_text(t, live_lights)
