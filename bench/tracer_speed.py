@@ -4,12 +4,14 @@
         [--width 800 --height 600] [-o bench/results/tracer_speed.md]
 
 Each scene (default: examples/scenes/glassware.yaml, examples/scenes/high_degree.yaml and the POV-Ray comparison's
-scenes, bench/scenes/*.yaml) is built twice, against the base runtime_c folder and against this checkout's, with
-the same generated shapes, and each built library renders it run by run in alternating order (base first on even
-runs), 1 sample per pixel, one thread, the C render loop alone (rt_render_run, as `implgen bench render` times it).
-Reported: medians of the wall time and of the process's CPU time during the loop, and base/this for both. On a
-machine shared with other work the CPU time is the steadier figure (the time the loop actually ran); both are
-given, with the load average before and after. The target checked is base/this >= TARGET on every scene.
+scenes, bench/scenes/*.yaml) is built against the base runtime_c folder and against this checkout's, with the same
+generated shapes, and a second time against the base: the control. Round by round the three render it, in an order
+that turns through all six, 1 sample per pixel, one thread, the C render loop alone (rt_render_run, as `implgen
+bench render` times it). Reported: medians of the wall time and of the process's CPU time during the loop, and the
+ratios of each round's CPU times -- base/this, and base/control, which differ only by the noise -- as their median
+and quartiles. On a machine shared with other work a round's three runs see about the same load, so the paired
+ratio is the steadier figure, and the control's spread says how far one can trust it; the load average before and
+after is given. The target checked is the paired base/this >= TARGET on every scene.
 
 The base folder is copied to a temporary one first; a file this checkout's runtime lists that the base lacks
 (tracer_floor.c, the floor report's, which the render loop never calls) is given an empty stand-in there.
@@ -18,6 +20,7 @@ The base folder is copied to a temporary one first; a file this checkout's runti
 from __future__ import annotations
 
 import argparse
+import itertools
 import shutil
 import statistics
 import tempfile
@@ -54,15 +57,20 @@ def built(scene: Path, runtime: Path) -> tuple[CScene, object]:
     return CScene(sc, build_scene(sc)), sc
 
 
+SIDES = 3  # base, this, control (the base again)
+ORDERS = list(itertools.permutations(range(SIDES)))
+
+
 def time_scene(scene: Path, runtimes: list[Path], size: argparse.Namespace, runs: int) -> dict[str, list[float]]:
-    """Wall and CPU seconds of the render loop per side ("wall0", "cpu0" base; "wall1", "cpu1" this)."""
-    sides = [built(scene, rt) for rt in runtimes]
-    got: dict[str, list[float]] = {f"{k}{i}": [] for k in ("wall", "cpu") for i in (0, 1)}
+    """Wall and CPU seconds of the render loop per side and round ("wall0", "cpu0" base; "wall1", "cpu1" this;
+    "wall2", "cpu2" the control: the base built again)."""
+    sides = [built(scene, rt) for rt in (runtimes[0], runtimes[1], runtimes[0])]
+    got: dict[str, list[float]] = {f"{k}{i}": [] for k in ("wall", "cpu") for i in range(SIDES)}
     try:
         for cs, sc in sides:  # warm: pages touched, threads' stacks mapped
             _measure(cs, sc, size, 1)
         for r in range(runs):
-            for i in (0, 1) if r % 2 == 0 else (1, 0):
+            for i in ORDERS[r % len(ORDERS)]:
                 wall, cpu, _ = _measure(*sides[i], size, 1)
                 got[f"wall{i}"].append(wall)
                 got[f"cpu{i}"].append(cpu)
@@ -72,14 +80,24 @@ def time_scene(scene: Path, runtimes: list[Path], size: argparse.Namespace, runs
     return got
 
 
+def paired(a: list[float], b: list[float]) -> tuple[float, float, float]:
+    """Median and quartiles of the round-by-round ratios a/b."""
+    ratios = [x / y for x, y in zip(a, b)]
+    med = statistics.median(ratios)
+    if len(ratios) < 2:
+        return med, med, med
+    q1, _, q3 = statistics.quantiles(ratios, n=4)
+    return med, q1, q3
+
+
 def row(name: str, t: dict[str, list[float]]) -> tuple[str, float]:
     m = {k: statistics.median(v) for k, v in t.items()}
-    cpu, wall = m["cpu0"] / m["cpu1"], m["wall0"] / m["wall1"]
+    this, control = paired(t["cpu0"], t["cpu1"]), paired(t["cpu0"], t["cpu2"])
     line = (
-        f"| {name} | {m['cpu0'] * 1e3:.1f} | {m['cpu1'] * 1e3:.1f} | {cpu:.2f}× | {m['wall0'] * 1e3:.1f} | "
-        f"{m['wall1'] * 1e3:.1f} | {wall:.2f}× |"
+        f"| {name} | {m['cpu0'] * 1e3:.1f} | {m['cpu1'] * 1e3:.1f} | {this[0]:.2f}× ({this[1]:.2f}–{this[2]:.2f}) | "
+        f"{control[0]:.2f}× ({control[1]:.2f}–{control[2]:.2f}) | {m['wall0'] * 1e3:.1f} | {m['wall1'] * 1e3:.1f} |"
     )
-    return line, cpu
+    return line, this[0]
 
 
 def report(args: argparse.Namespace, rows: list[tuple[str, float]], before: str) -> str:
@@ -92,15 +110,19 @@ def report(args: argparse.Namespace, rows: list[tuple[str, float]], before: str)
             f"Written by `bench/tracer_speed.py --base {args.base} --runs {args.runs} --width {args.width} "
             f"--height {args.height}` on {describe()}. Load average before: {before}; after: {load_average()}.",
             "",
-            f"{args.width}×{args.height}, 1 sample per pixel, one thread; medians of {args.runs} interleaved runs "
-            "of the C render loop. Base: the runtime in --base; this: this checkout's. CPU: the process's CPU "
-            "time during the loop (the steadier figure on a shared machine); wall: its wall time.",
+            f"{args.width}×{args.height}, 1 sample per pixel, one thread; {args.runs} rounds of the C render loop, "
+            "each round running the base, this checkout's and the control (the base again) in turn, the order "
+            "turning through all six. Base: the runtime in --base; this: this checkout's. CPU: the process's CPU "
+            "time during the loop, medians; paired: the median of the rounds' CPU ratios, with their quartiles in "
+            "brackets. The control's ratio differs from 1 only by the noise: a base/this inside its spread is no "
+            "change.",
             "",
-            "| scene | base CPU ms | this CPU ms | base/this (CPU) | base wall ms | this wall ms | base/this (wall) |",
+            "| scene | base CPU ms | this CPU ms | base/this (paired CPU) | base/control (paired CPU) | base wall ms | "
+            "this wall ms |",
             "|---|---:|---:|---:|---:|---:|---:|",
             *(line for line, _ in rows),
             "",
-            f"Target: this at least {TARGET:.0f}× faster than the base (CPU medians) on every scene: {verdict}.",
+            f"Target: this at least {TARGET:.0f}× faster than the base (paired CPU medians) on every scene: {verdict}.",
         ]
     )
 

@@ -33,4 +33,34 @@ def test_the_report_has_a_row_per_scene_and_the_target(tmp_path: Path) -> None:
     assert text.startswith("# The render loop against main's\n\nWritten by `bench/tracer_speed.py --base ")
     rows = [line.split("|")[1].strip() for line in text.splitlines() if line.startswith("| ")]
     assert rows == ["scene", "torus"]
-    assert "Target: this at least 2× faster than the base (CPU medians) on every scene:" in text
+    assert "Target: this at least 2× faster than the base (paired CPU medians) on every scene:" in text
+
+
+def test_each_round_runs_base_this_and_a_control_of_the_base(tmp_path: Path, monkeypatch) -> None:
+    """A round runs all three sides, in an order that turns through all six; the control is the base runtime built
+    again, and the report gives base/control beside base/this, so that the noise is measured with the change."""
+    seen: list[tuple[str, int]] = []
+
+    def fake_built(scene: Path, runtime: Path):
+        class Side:
+            def close(self) -> None:
+                pass
+
+        side = Side()
+        side.runtime = runtime
+        return side, None
+
+    def fake_measure(cs, sc, size, threads):
+        seen.append((str(cs.runtime), id(cs)))
+        return 1.0, {"base": 2.0, "this": 1.0}[Path(cs.runtime).name], {}
+
+    monkeypatch.setattr(tracer_speed, "built", fake_built)
+    monkeypatch.setattr(tracer_speed, "_measure", fake_measure)
+    size = type("S", (), {"width": 8, "height": 6, "spp": 1})()
+    got = tracer_speed.time_scene(tmp_path / "x.yaml", [tmp_path / "base", tmp_path / "this"], size, 6)
+    assert got["cpu0"] == [2.0] * 6 and got["cpu1"] == [1.0] * 6 and got["cpu2"] == [2.0] * 6
+    rounds = [seen[3 + 3 * r : 6 + 3 * r] for r in range(6)]  # after the 3 warm-up runs
+    sides = {ident: k for k, (_, ident) in enumerate(seen[:3])}
+    assert sorted(tuple(sides[ident] for _, ident in rnd) for rnd in rounds) == sorted(tracer_speed.ORDERS)
+    line, ratio = tracer_speed.row("x", got)
+    assert ratio == 2.0 and "| 2.00× (2.00–2.00) | 1.00× (1.00–1.00) |" in line
