@@ -31,7 +31,7 @@ from pathlib import Path
 from view_latency import CHMUTOV12  # the drags of view_latency.py: the same shapes
 
 from implgen.measure.machine import describe as machine
-from implgen.measure.machine import write_results
+from implgen.measure.machine import write_section
 from implgen.measure.webgl import FLAGS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -200,12 +200,7 @@ def main() -> int:
     lines += ["", END]
     section = "\n".join(lines)
     print(section)
-    old = args.output.read_text(encoding="utf-8") if args.output.exists() else ""
-    if BEGIN in old and END in old:
-        text = old[: old.index(BEGIN)] + section + old[old.index(END) + len(END) :]
-    else:
-        text = old.rstrip("\n") + "\n\n" + section + "\n"
-    write_results(args.output, text)
+    write_section(args.output, BEGIN, END, section)
     return 0
 
 

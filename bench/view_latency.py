@@ -47,7 +47,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
 from implgen.measure.machine import describe as machine
-from implgen.measure.machine import write_results
+from implgen.measure.machine import write_results, write_section
 from implgen.spec.entry import load_spec
 from implgen.view.dump import spec_mapping
 from implgen.view.session import (
@@ -519,11 +519,7 @@ def glass_lines(out: dict, rounds: int, compare: Path | None, load: tuple[float,
 
 def write_glass(path: Path, lines: list[str]) -> None:
     """The glass section into the results file, in place of the last one (or at its end)."""
-    text = "\n".join(lines) + "\n"
-    old = path.read_text(encoding="utf-8") if path.exists() else ""
-    if GLASS_BEGIN in old and GLASS_END in old:
-        old = old[: old.index(GLASS_BEGIN)] + old[old.index(GLASS_END) + len(GLASS_END) + 1 :]
-    write_results(path, old.rstrip("\n") + "\n\n" + text)
+    write_section(path, GLASS_BEGIN, GLASS_END, "\n".join(lines))
 
 
 NEIGHBOUR_EQUATION = "(x+y+z+a+b+1)^15"

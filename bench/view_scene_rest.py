@@ -113,12 +113,7 @@ def main() -> int:
             print(rows[-1], file=sys.stderr, flush=True)
     section = report(rows, args, size, renderer, load_before)
     print(section)
-    old = args.output.read_text(encoding="utf-8") if args.output.exists() else ""
-    if BEGIN in old and END in old:
-        text = old[: old.index(BEGIN)] + section + old[old.index(END) + len(END) :]
-    else:
-        text = old.rstrip("\n") + "\n\n" + section + "\n"
-    machine.write_results(args.output, text)
+    machine.write_section(args.output, BEGIN, END, section)
     return 0
 
 

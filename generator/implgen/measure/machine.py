@@ -44,3 +44,14 @@ def write_results(path: Path, text: str) -> None:
     data = text.encode("utf-8")
     path.parent.mkdir(parents=True, exist_ok=True)
     atomic_write(path, lambda fh: fh.write(data))
+
+
+def write_section(path: Path, begin: str, end: str, section: str) -> None:
+    """Put `section` (from its `begin` marker to its `end` marker) into the results file in place of the one
+    there, or at its end: the file's other sections stay."""
+    old = path.read_text(encoding="utf-8") if path.exists() else ""
+    if begin in old and end in old:
+        text = old[: old.index(begin)] + section.rstrip("\n") + old[old.index(end) + len(end) :]
+    else:
+        text = (old.rstrip("\n") + "\n\n" if old.strip() else "") + section.rstrip("\n") + "\n"
+    write_results(path, text)

@@ -129,17 +129,7 @@ const ImplgenGpu = (() => {
         } else {
           g.shape = msg;
           g.programId = msg.shape_id;
-          g.progressive = g.progressive || new IgSurface.Progressive(g.renderer, {
-            onStep: (p) => {
-              g.frames += 1;
-              glCanvas.dataset.frames = g.frames;
-              if (status && view.dataset.shown === "gpu") { // the status line: what the GPU draws now
-                const r = g.renderer;
-                const done = p.moving ? "while moving" : p.row >= r.height ? "done" : `${Math.round((100 * p.row) / r.height)} %`;
-                status.textContent = `GPU ${r.width} x ${r.height}, ${done}`;
-              }
-            },
-          });
+          g.progressive = g.progressive || new IgSurface.Progressive(g.renderer, { onStep: stepped });
         }
       }
       say();
@@ -191,6 +181,7 @@ const ImplgenGpu = (() => {
       if (active()) redraw(); // the program is here: the view drawn with it
     }
 
+    /** A step of either program's progressive draw: counted, and said on the status line. */
     function stepped(p) {
       g.frames += 1;
       glCanvas.dataset.frames = g.frames;
