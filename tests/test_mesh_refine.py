@@ -125,3 +125,21 @@ def test_one_fan_each_sees_two_cones_at_a_vertex():
     assert one_fan_each(tet)
     two = np.concatenate([tet, np.where(tet == 0, 0, tet + 3)])  # a second tetrahedron sharing vertex 0
     assert closed_and_euler(two, 7)[0] and not one_fan_each(two)
+
+
+@pytest.mark.parametrize("path, size", [(CASSINI, 0.03), (BALLS, 0.01)], ids=["neck_radius", "half_gap"])
+def test_the_critical_point_gives_the_features_size(path, size):
+    """The neck's saddle (f < 0) at the origin: f reaches 0 at the neck's radius, 0.03; the gap's (f > 0): at half
+    the gap, 0.01. At 32 cells no grid line crosses the Cassini neck; the grid's samples still lead to it."""
+    from implgen.mesh.critical import critical_points
+    from implgen.mesh.crossings import grid_flags
+    from implgen.mesh.region import make_grid
+    from implgen.mesh.shapelib import ShapeLib
+
+    spec = spec_of(path)
+    lib = ShapeLib(spec, list(spec.params.values()))
+    grid, clips = make_grid(spec.box(), [], 32, str(path))
+    crit = critical_points(lib, clips, grid, grid_flags(lib, clips, grid)[1])
+    assert len(crit.points) == 1
+    assert np.abs(crit.points[0]).max() < 1e-9
+    assert crit.size[0] == pytest.approx(size, rel=0.01)

@@ -39,26 +39,24 @@ class Critical:
 def seeds(g: np.ndarray) -> np.ndarray:
     """Flat indices of the interior grid vertices where g turns along every axis and whose feature, estimated
     from g's own differences (a parabola along each axis through the vertex and its two neighbours), is less
-    than a cell across: the ones worth Newton's steps."""
-    n0 = g.shape[0]
+    than a cell across: the ones worth Newton's steps. The turns along the last axis first (contiguous, a plane
+    of x at a time for bounded memory), then the other two at those vertices only."""
     found = []
-    for s in range(1, n0 - 1, SLAB):
-        e = min(s + SLAB, n0 - 1)
-        blk = g[s - 1 : e + 1]  # planes s - 1 .. e
-        mid = blk[1:-1, 1:-1, 1:-1]
-        sides = (
-            (blk[:-2, 1:-1, 1:-1], blk[2:, 1:-1, 1:-1]),
-            (blk[1:-1, :-2, 1:-1], blk[1:-1, 2:, 1:-1]),
-            (blk[1:-1, 1:-1, :-2], blk[1:-1, 1:-1, 2:]),
-        )
-        ok = np.ones(mid.shape, dtype=bool)
-        for lo, hi in sides:
-            ok &= (mid - lo) * (hi - mid) <= 0
-        i, j, k = np.nonzero(ok)
-        if i.size:
-            keep = _estimate(mid[i, j, k], [(lo[i, j, k], hi[i, j, k]) for lo, hi in sides]) < 1.0
-            i, j, k = i[keep], j[keep], k[keep]
-        found.append(np.ravel_multi_index((i + s, j + 1, k + 1), g.shape))
+    flat_g = g.reshape(-1)
+    strides = (g.shape[1] * g.shape[2], g.shape[2], 1)
+    for s in range(1, g.shape[0] - 1, SLAB):
+        blk = g[s : min(s + SLAB, g.shape[0] - 1), 1:-1]
+        d = np.diff(blk, axis=2)
+        i, j, k = np.nonzero(d[..., :-1] * d[..., 1:] <= 0)
+        flat = np.ravel_multi_index((i + s, j + 1, k + 1), g.shape)
+        mid = flat_g[flat]
+        sides = []
+        for st in strides:
+            lo, hi = flat_g[flat - st], flat_g[flat + st]
+            sides.append((lo, hi))
+            keep = (mid - lo) * (hi - mid) <= 0
+            flat, mid, sides = flat[keep], mid[keep], [(lo_[keep], hi_[keep]) for lo_, hi_ in sides]
+        found.append(flat[_estimate(mid, sides) < 1.0])
     return np.concatenate(found + [np.zeros(0, dtype=np.int64)])
 
 

@@ -22,10 +22,13 @@ def closed_and_euler(faces: np.ndarray, nverts: int) -> tuple[bool, int]:
     return closed, used - int(first.size) + len(faces)
 
 
-def one_fan_each(faces: np.ndarray) -> bool:
-    """Whether the triangles around every vertex form one cycle. Of a closed, oriented mesh: triangle (a, b, c)
-    gives a the link edge b -> c, b the edge c -> a, c the edge a -> b; around a vertex these form cycles, one
-    per fan. Each link node (vertex, neighbour) takes the least label along its cycle; one label per vertex."""
+def one_fan_each(faces: np.ndarray, only: np.ndarray | None = None) -> bool:
+    """Whether the triangles around every vertex (of `only`, when given) form one cycle. Of a closed, oriented
+    mesh: triangle (a, b, c) gives a the link edge b -> c, b the edge c -> a, c the edge a -> b; around a vertex
+    these form cycles, one per fan. Each link node (vertex, neighbour) takes the least label along its cycle;
+    one label per vertex."""
+    if only is not None:
+        faces = faces[np.isin(faces, only).any(axis=1)]  # every triangle around those vertices
     if not len(faces):
         return True
     f = faces.astype(np.int64)
@@ -45,5 +48,7 @@ def one_fan_each(faces: np.ndarray) -> bool:
         if np.array_equal(new, label):
             break
         label = new
-    fans = np.unique(np.stack([keys // n, label], axis=1), axis=0)[:, 0]
+    fans = np.unique((keys // n) * keys.size + label) // keys.size  # a vertex once per fan
+    if only is not None:
+        fans = fans[np.isin(fans, only)]
     return bool((np.bincount(fans) <= 1).all())
