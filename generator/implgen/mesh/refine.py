@@ -31,7 +31,7 @@ from implgen.mesh.shapelib import ShapeLib
 from implgen.mesh.stitch import Block, Fine, Inconsistent, SubGrid, block_faces, coarse_faces
 
 RMAX = 32  # the finest a block goes: 1/32 of a cell
-MAX_FINE = 4_000_000  # fine cells over all blocks (about 42 bytes each at the peak: 170 MB)
+MAX_FINE = 1 << 22  # fine cells over all blocks, 4,194,304 (about 42 bytes each at the peak: 176 MB)
 SIDE = 0.9  # fine cells at most 0.9 x sqrt(2) the feature's size across (a fine grid line then passes within it)
 GROW = 3  # times a block whose faces disagree with the grid is grown and meshed again
 
