@@ -143,3 +143,11 @@ def test_the_critical_point_gives_the_features_size(path, size):
     assert len(crit.points) == 1
     assert np.abs(crit.points[0]).max() < 1e-9
     assert crit.size[0] == pytest.approx(size, rel=0.01)
+
+
+def test_a_failed_check_grows_the_blocks():
+    """The genus-2 surface at 23 cells: the first stitching fails the check (edges with one triangle, next to the
+    box's cap); the blocks grown by a cell pass it, and the mesh is refined, closed, of genus 2."""
+    manifold, euler, stats = topology(ROOT / "examples/mesh/genus2.yaml", 23)
+    assert manifold and euler == -2
+    assert stats["refine_skipped"] is None and len(stats["refined"]) == 2

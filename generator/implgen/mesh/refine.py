@@ -33,7 +33,7 @@ from implgen.mesh.stitch import Block, Fine, Inconsistent, SubGrid, block_faces,
 RMAX = 32  # the finest a block goes: 1/32 of a cell
 MAX_FINE = 1 << 22  # fine cells over all blocks, 4,194,304 (about 42 bytes each at the peak: 176 MB)
 SIDE = 0.9  # fine cells at most 0.9 x sqrt(2) the feature's size across (a fine grid line then passes within it)
-GROW = 3  # times a block whose faces disagree with the grid is grown and meshed again
+GROW = 3  # tries, besides the first and one finer, to grow blocks whose faces disagree with the grid
 
 
 def ratio_for(h: float, width: np.ndarray) -> np.ndarray:
@@ -172,7 +172,8 @@ def refine(lib: ShapeLib, clips: list[Clip], mesh: Mesh, avoid: np.ndarray) -> N
 
 
 def _attempts(lib, clips, mesh: Mesh, blocks: list[Block], n: np.ndarray) -> tuple[_Built | None, str | None]:
-    """Build, growing a block whose faces disagree, once finer where the fine grid still misses detail."""
+    """Build, growing a block whose faces disagree (every block, when the stitched mesh fails its check), once
+    finer where the fine grid still misses detail: GROW + 2 tries in all."""
     finer_tried, last = False, ""
     for _ in range(GROW + 2):
         total = sum(b.fine_cells for b in blocks)
@@ -187,7 +188,9 @@ def _attempts(lib, clips, mesh: Mesh, blocks: list[Block], n: np.ndarray) -> tup
             continue
         closed, _ = closed_and_euler(built.faces, len(built.verts))
         if not (closed and one_fan_each(built.faces, np.unique(built.faces[built.ncoarse :]))):
-            return None, "the stitched mesh failed its check (closed, one fan at every vertex)"
+            blocks = merge([grow(b, n) for b in blocks], n)  # the faces of larger blocks may lie where all is plain
+            last = "the stitched mesh failed its check (closed, one fan at every vertex)"
+            continue
         missed = [_fine_missed(lib, clips, f).count for f in built.fines]
         coarser = [i for i, m in enumerate(missed) if m and blocks[i].r < RMAX]
         if coarser and not finer_tried:
@@ -196,7 +199,7 @@ def _attempts(lib, clips, mesh: Mesh, blocks: list[Block], n: np.ndarray) -> tup
                 blocks[i] = Block(blocks[i].lo, blocks[i].hi, min(4 * blocks[i].r, RMAX))
             continue
         return built, None
-    return None, f"a block's faces still disagree with the grid after growing it {GROW} times ({last})"
+    return None, f"no consistent stitching in {GROW + 2} tries (the last: {last})"
 
 
 def _apply(lib, clips, mesh: Mesh, built: _Built) -> None:

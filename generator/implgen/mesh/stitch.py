@@ -10,7 +10,7 @@ the sheet of the cell's edges where the fine curve through the crossing (the fin
 as cells.py joins a cell's edges, an ambiguous square by f at its centre) ends. That is consistent only when
 the block's faces show what the grid there shows: each grid edge on them holds at most one fine crossing (one
 where it is active), and every fine curve inside a grid face ends, at both ends, on edges of one sheet of the
-outside cell. Where not, the block grows by a cell on every side and is meshed again (GROW times at most).
+outside cell. Where not, the block grows by a cell on every side and is meshed again (refine.GROW).
 """
 
 from __future__ import annotations
