@@ -14,6 +14,7 @@ the smallest grid of GRIDS at which each gets the topology right (closed and the
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib.util
 import io
 import statistics
@@ -32,8 +33,10 @@ from implgen.measure.machine import load_average, write_results
 from implgen.mesh.contour import contour
 from implgen.mesh.crossings import boundary_value_gradient
 from implgen.mesh.pipeline import closed_and_euler, mesh_spec
+from implgen.mesh.refine import refine
 from implgen.mesh.region import make_grid, parse_clip
 from implgen.mesh.shapelib import ShapeLib
+from implgen.mesh.singular import find_singular
 from implgen.mesh.write import mesh_bytes
 from implgen.spec.entry import load_spec
 
@@ -70,11 +73,32 @@ def boundary_distance(lib: ShapeLib, clips, verts: np.ndarray) -> np.ndarray:
     return np.abs(f) / np.maximum(np.linalg.norm(g, axis=1), 1e-300)
 
 
-def ours(lib, clips, grid, stats=None):
+def ours(lib, clips, grid, stats=None, refined=True, nodes=None):
+    """`implgen mesh`'s contour, then its local refinement (mesh/refine.py) unless `refined` is False (the grid
+    alone, as before refinement). The singular points (`nodes`, found beforehand on the nodal surfaces, untimed: a
+    phase of its own in `implgen mesh`) are set aside as the pipeline does: no refinement within two cells."""
     m = contour(lib, clips, grid)
+    t = time.perf_counter()
+    nodes = np.zeros((0, 3)) if nodes is None else nodes
+    if refined:
+        if m.missed is not None:
+            m.missed = m.missed.away_from(nodes, 2 * grid.h)
+        refine(lib, clips, m, nodes)
+    m.parts = None
     if stats is not None:
-        stats.append(m.stats)
+        stats.append({**m.stats, "seconds": {**m.stats["seconds"], "refine": time.perf_counter() - t}})
     return m.vertices, m.faces
+
+
+def grid_alone(lib, clips, grid, stats=None):
+    return ours(lib, clips, grid, stats, refined=False)
+
+
+def nodes_of(lib, grid, euler) -> np.ndarray | None:
+    """The singular points in the grid's box on a nodal surface (no known Euler characteristic), else None."""
+    if euler is not None:
+        return None
+    return find_singular(lib, grid.origin, grid.origin + grid.h * np.array(grid.n)).points
 
 
 def marching(module, params, clips, grid):
@@ -109,24 +133,30 @@ def run_surface(label, path, clip_text, euler, runs, cells, folder):
     module = python_module(spec, folder)
     user = parse_clip(clip_text) if clip_text else []
     row = {"label": label, "degree": spec.degree}
-    smallest = {"ours": None, "mc": None}
-    right_at = {"ours": [], "mc": []}
-    row["grids"] = {}  # n: (ours' Euler, MC's, ours' edges with crossings their ends do not show, missed detail)
+    smallest = {"ours": None, "grid": None, "mc": None}
+    right_at = {"ours": [], "grid": [], "mc": []}
+    row["grids"] = {}  # n: (the grid alone's Euler, MC's, its edges with crossings their ends do not show, missed)
+    row["refined"] = {}  # n: (ours' Euler, blocks refined, fine cells)
     for n in GRIDS:
         grid, clips = make_grid(spec.box(), user, n, path)
         seen = {}
-        for name, fn, merge in (("ours", ours, False), ("mc", marching, True)):
+        nodes = nodes_of(lib, grid, euler)
+        methods = (("ours", functools.partial(ours, nodes=nodes), False), ("grid", grid_alone, False))
+        for name, fn, merge in (*methods, ("mc", marching, True)):
             stats = []
-            args = (lib, clips, grid, stats) if name == "ours" else (module, spec.params, clips, grid)
+            args = (lib, clips, grid, stats) if name != "mc" else (module, spec.params, clips, grid)
             try:
                 verts, faces = fn(*args)
             except ValueError:  # marching cubes: no grid vertex inside
                 verts, faces = np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
             closed, e = topology(verts, faces, merge)
             seen[name] = e if closed else None
-            if stats:
+            if stats and name == "grid":
                 seen["hidden"] = stats[0]["hidden_crossing_edges"]
                 seen["missed"] = stats[0]["missed_detail_edges"]
+            if stats and name == "ours":
+                refined = stats[0]["refined"]
+                row["refined"][n] = (e if closed else None, len(refined), sum(b["fine_cells"] for b in refined))
             ok = closed and euler is not None and e == euler
             if ok:
                 right_at[name].append(n)
@@ -136,13 +166,16 @@ def run_surface(label, path, clip_text, euler, runs, cells, folder):
                 d = boundary_distance(lib, clips, verts)
                 row[name] = {"closed": closed, "euler": e, "max": float(d.max()), "median": float(np.median(d))}
                 row["size"] = grid.size
-        row["grids"][n] = (seen["ours"], seen["mc"], seen["hidden"], seen["missed"])
+        row["grids"][n] = (seen["grid"], seen["mc"], seen["hidden"], seen["missed"])
     grid, clips = make_grid(spec.box(), user, cells, path)
-    t_ours, t_mc, stats = [], [], []
+    t_ours, t_grid, t_mc, stats = [], [], [], []
+    nodes = nodes_of(lib, grid, euler)
     for _ in range(runs):  # interleaved
-        t_ours.append(timed(ours, lib, clips, grid, stats)[0])
+        t_ours.append(timed(ours, lib, clips, grid, stats, True, nodes)[0])
+        t_grid.append(timed(grid_alone, lib, clips, grid)[0])
         t_mc.append(timed(marching, module, spec.params, clips, grid)[0])
-    row["t_ours"], row["t_mc"] = statistics.median(t_ours), statistics.median(t_mc)
+    row["t_ours"], row["t_grid"], row["t_mc"] = (statistics.median(t) for t in (t_ours, t_grid, t_mc))
+    row["refined_at_cells"] = bool(stats[0]["refined"])
     row["phases"] = {k: statistics.median(st["seconds"][k] for st in stats) for k in stats[0]["seconds"]}
     row["smallest"] = smallest
     row["right_at"] = right_at
@@ -166,18 +199,20 @@ def yn(v: bool) -> str:
 
 def table(rows, cells: int) -> list[str]:
     out = [
-        f"| surface | degree | time ours / MC (s), N = {cells} | ratio | max distance ours / MC (of the box) "
-        "| median ours / MC | closed ours / MC | Euler ours / MC (known) | smallest right grid ours / MC "
-        "| right from (every grid after it) ours / MC |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        f"| surface | degree | time ours / grid alone / MC (s), N = {cells} | ours / MC | ours / grid alone "
+        "| max distance ours / MC (of the box) | median ours / MC | closed ours / MC | Euler ours / MC (known) "
+        "| smallest right grid ours / grid alone / MC | right from (every grid after it) ours / grid alone / MC |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         o, m, s = r["ours"], r["mc"], r["size"]
         known = "n/a" if r["known"] is None else str(r["known"])
-        small = f"{r['smallest']['ours'] or '-'} / {r['smallest']['mc'] or '-'}"
-        stays = f"{r['stays']['ours'] or '-'} / {r['stays']['mc'] or '-'}"
+        small = " / ".join(str(r["smallest"][k] or "-") for k in ("ours", "grid", "mc"))
+        stays = " / ".join(str(r["stays"][k] or "-") for k in ("ours", "grid", "mc"))
+        times = f"{r['t_ours']:.2f} / {r['t_grid']:.2f} / {r['t_mc']:.2f}"
+        ratios = f"{r['t_ours'] / r['t_mc']:.2f} | {r['t_ours'] / r['t_grid']:.2f}"
         out.append(
-            f"| {r['label']} | {r['degree']} | {r['t_ours']:.2f} / {r['t_mc']:.2f} | {r['t_ours'] / r['t_mc']:.2f} "
+            f"| {r['label']} | {r['degree']} | {times} | {ratios} "
             f"| {o['max'] / s:.1e} / {m['max'] / s:.1e} | {o['median'] / s:.1e} / {m['median'] / s:.1e} "
             f"| {yn(o['closed'])} / {yn(m['closed'])} | {o['euler']} / {m['euler']} ({known}) | {small} | {stays} |"
         )
@@ -205,9 +240,9 @@ def coarse_table(rows) -> list[str]:
     """Below the smallest right grid: what each method got, and how many grid edges held crossings that their
     two ends did not show (ours; the detail both methods miss)."""
     out = [
-        "| surface | grids where both are closed: with the same Euler characteristic | largest wrong grid below ours' "
-        "smallest right one | Euler there ours / MC (known) | edges with crossings their ends do not show there "
-        "| of them, detail the grid misses (the warning) |",
+        "| surface | grids where both are closed: with the same Euler characteristic | largest wrong grid below the "
+        "grid alone's smallest right one | Euler there grid alone / MC (known) "
+        "| edges with crossings their ends do not show there | of them, detail the grid misses (the warning) |",
         "|---|---|---|---|---|---|",
     ]
     for r in rows:
@@ -216,7 +251,7 @@ def coarse_table(rows) -> list[str]:
         g = r["grids"]
         both = [(o, m) for o, m, *_ in g.values() if o is not None and m is not None]
         agree = f"{len(both)} of {len(g)}: {sum(1 for o, m in both if o == m)}"
-        small = r["smallest"]["ours"]
+        small = r["smallest"]["grid"]
         below = [n for n in g if small is None or n < small]
         if below:
             n = max(below)
@@ -241,8 +276,8 @@ def warning_table(rows) -> list[str]:
         if r["known"] is None:
             continue
         g = r["grids"]
-        right = [n for n in g if n in r["right_at"]["ours"]]
-        wrong = [n for n in g if n not in r["right_at"]["ours"]]
+        right = [n for n in g if n in r["right_at"]["grid"]]
+        wrong = [n for n in g if n not in r["right_at"]["grid"]]
         warned_right = [n for n in right if g[n][3]]
         warned_wrong = [n for n in wrong if g[n][3]]
         silent = [n for n in wrong if not g[n][3]]
@@ -316,6 +351,7 @@ def nodal_table(folder: Path) -> list[str]:
 def targets(rows) -> list[str]:
     known = [r for r in rows if r["known"] is not None]
     every = [r["label"] for r in known if not set(r["right_at"]["mc"]) <= set(r["right_at"]["ours"])]
+    calm = [(r["label"], r["t_ours"] / r["t_grid"]) for r in rows if not r["refined_at_cells"]]
     coarser = [
         r["label"]
         for r in known
@@ -336,6 +372,10 @@ def targets(rows) -> list[str]:
         + (": met" if all(ratio >= 1000 for _, ratio in err) else ": missed where below 1000x"),
         "- time within 2x of marching cubes: "
         + ("met on every surface" if not slow else "missed on " + ", ".join(f"{name} ({x:.1f}x)" for name, x in slow)),
+        "- where nothing is refined, at most 1.5x the time of the grid alone (the search for thin features is the "
+        "cost): "
+        + ", ".join(f"{name} {x:.2f}x" for name, x in calm)
+        + (": met" if all(x <= 1.5 for _, x in calm) else ": missed where above 1.5x"),
         *thin_targets(known),
     ]
     return lines
@@ -343,17 +383,43 @@ def targets(rows) -> list[str]:
 
 def thin_targets(known) -> list[str]:
     """The warning silent on right meshes; the thin neck and the gap right at every grid from 16 cells on."""
-    warned = sum(1 for r in known for n in r["right_at"]["ours"] if r["grids"][n][3])
-    right = sum(len(r["right_at"]["ours"]) for r in known)
+    warned = sum(1 for r in known for n in r["right_at"]["grid"] if r["grids"][n][3])
+    right = sum(len(r["right_at"]["grid"]) for r in known)
     thin = [r for r in known if r["label"].startswith(("Cassini", "two balls"))]
     return [
-        f"- the warning of detail the grid misses silent on the meshes whose topology is right: spoke on {warned} "
-        f"of {right}: " + ("met" if warned == 0 else "missed"),
-        "- thin neck and near-touching shapes right at every grid from 16 cells on (it would take refining the "
-        "flagged cells, which `implgen mesh` does not do): "
-        + ", ".join(f"{r['label']} right from {r['stays']['ours'] or '-'} (MC {r['stays']['mc'] or '-'})" for r in thin)
-        + (": met" if all((r["stays"]["ours"] or 999) <= 16 for r in thin) else ": missed"),
+        f"- the warning of detail the grid misses silent on the grid's meshes whose topology is right: spoke on "
+        f"{warned} of {right}: " + ("met" if warned == 0 else "missed"),
+        "- thin neck and near-touching shapes right at every grid from 16 cells on, and from at most half the cells "
+        "marching cubes needs: "
+        + ", ".join(
+            f"{r['label']} right from {r['stays']['ours'] or '-'} (the grid alone {r['stays']['grid'] or '-'}, "
+            f"MC {r['stays']['mc'] or '-'})"
+            for r in thin
+        )
+        + (": met" if all(_thin_ok(r) for r in thin) else ": missed"),
     ]
+
+
+def _thin_ok(r) -> bool:
+    ours, mc = r["stays"]["ours"] or 999, r["stays"]["mc"] or 999
+    return ours <= 16 and 2 * ours <= mc
+
+
+def refine_table(rows) -> list[str]:
+    """Per grid, on the surfaces where anything was refined: the Euler characteristic of the grid alone, ours (its
+    blocks and fine cells), marching cubes'."""
+    out = [
+        "| surface | N | Euler grid alone / ours / MC (known) | blocks refined | fine cells |",
+        "|---|---|---|---|---|",
+    ]
+    for r in rows:
+        if r["known"] is None or not any(v[1] for v in r["refined"].values()):
+            continue
+        for n, (e, blocks, fine) in r["refined"].items():
+            g = r["grids"][n]
+            out.append(f"| {r['label']} | {n} | {_euler(g[0])} / {_euler(e)} / {_euler(g[1])} ({r['known']}) "
+                       f"| {blocks} | {fine} |")  # fmt: skip
+    return out
 
 
 def main() -> int:
@@ -385,7 +451,8 @@ def report(rows, args, tmp: Path) -> list[str]:
         f"Written by `nice .venv/bin/python bench/mesh.py --runs {args.runs} --cells {args.cells}`.",
         "",
         "Ours: `implgen mesh`'s contour (exact crossings on every grid line, one vertex per sheet, Newton onto the "
-        "surface). MC: scikit-image `marching_cubes` on the same grid, f (and the clip) sampled through the "
+        "surface) and its local refinement; the grid alone: the contour without refinement (`--no-refine`). "
+        "MC: scikit-image `marching_cubes` on the same grid, f (and the clip) sampled through the "
         "generated Python module, the sampling timed with it. Distances are |g| / |grad g| at each vertex, "
         "g = max(f, clips), as a fraction of the grid's size; ours sit at f's rounding in doubles. "
         "Closed: every edge in exactly two faces (marching cubes' vertices merged first). Smallest right grid: the "
@@ -399,7 +466,8 @@ def report(rows, args, tmp: Path) -> list[str]:
         "edge's crossing; missed -- the test of the intervals between two crossings on one grid edge (the warning of "
         "detail the grid misses); sheets -- cells' corner patterns, ambiguous faces' centres, the sheet table; qef -- "
         "each sheet's point (one C loop over the cells); projection -- Newton onto the surface (C for f alone); "
-        "faces -- quads into triangles.",
+        "faces -- quads into triangles; refine -- the search for thin features (critical points of f) and, where "
+        "any is found, the refined blocks.",
         "",
         *phase_table(rows, args.cells),
         "",
@@ -410,10 +478,16 @@ def report(rows, args, tmp: Path) -> list[str]:
 def topology_report(rows, tmp: Path) -> list[str]:
     """Below the smallest right grids, the warning, the nodal surfaces, the targets."""
     return [
-        "Why not coarser than marching cubes: both read the signs at the same grid vertices. Below the smallest "
-        "right grid, what each got and how many grid edges held two (or more) crossings with both ends on one "
-        "side -- a thin neck or handle between two grid vertices, which the exact crossings see and no sign "
-        "shows:",
+        "Local refinement (`mesh/refine.py`): where a critical point of f has a feature less than half a cell "
+        "across, or the exact crossings show an interval the grid misses, a block of cells is meshed again on a "
+        "finer grid and stitched to the rest. On the surfaces where it refined anything, grid by grid:",
+        "",
+        *refine_table(rows),
+        "",
+        "Why the grid alone is not coarser than marching cubes: both read the signs at the same grid vertices. "
+        "Below the grid alone's smallest right grid, what each got and how many grid edges held two (or more) "
+        "crossings with both ends on one side -- a thin neck or handle between two grid vertices, which the exact "
+        "crossings see and no sign shows:",
         "",
         *coarse_table(rows),
         "",

@@ -58,6 +58,9 @@ def _parser() -> ArgumentParser:
     ap.add_argument("--object", help="in a scene: the shape to mesh, by its name")
     ap.add_argument("--report", help="a JSON report: sizes, checks, singular points, timings")
     ap.add_argument("--no-singular", action="store_true", help="skip the search for singular points")
+    ap.add_argument(
+        "--no-refine", action="store_true", help="mesh the grid alone, with no finer blocks where thin detail hides"
+    )
     limit_help = "stop, writing nothing, when meshing takes longer (reading the file not counted; default: none)"
     ap.add_argument("--time-limit", metavar="SECONDS", help=limit_help)
     return ap
@@ -150,6 +153,20 @@ def _missed_text(rep: dict) -> str:
     )
 
 
+def _refined_text(stats: dict) -> str:
+    """Where the grid was refined (refine.py), or why not."""
+    done = stats.get("refined") or []
+    text = ""
+    if done:
+        text = (
+            f"; refined {len(done)} block(s) of cells where thin detail hides ({stats['refined_cells']} fine cells, "
+            f"up to 1/{max(b['ratio'] for b in done)} of a cell; the report says where)"
+        )
+    if stats.get("refine_skipped"):
+        text += f"; not refined: {stats['refine_skipped']}"
+    return text
+
+
 def main(argv: Sequence[str]) -> int:
     args = _parser().parse_args(list(argv))
     out = Path(args.output)
@@ -170,6 +187,7 @@ def main(argv: Sequence[str]) -> int:
         args.cells,
         clips,
         singular=not args.no_singular,
+        refine=not args.no_refine,
         what=args.file,
         deadline=deadline,
         seconds=limit,
@@ -195,7 +213,7 @@ def main(argv: Sequence[str]) -> int:
             f"{rep['stats']['split_distance']:.2g} apart, {rep['stats']['island_triangles_dropped']} triangles "
             "of squashed islands dropped (the report says which)"
         )
-    hidden_text = _missed_text(rep)
+    hidden_text = _refined_text(rep["stats"]) + _missed_text(rep)
     print(
         f"implgen mesh: {spec.name}: {rep['vertices']} vertices, {rep['triangles']} triangles, "
         f"{'closed' if rep['closed'] else 'NOT closed'}, Euler characteristic {rep['euler_characteristic']}; "

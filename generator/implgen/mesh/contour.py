@@ -30,6 +30,21 @@ class Mesh:
     stats: dict = field(default_factory=dict)
     cell: np.ndarray | None = None  # per vertex, the flat index of its cell's lower corner (-1: added by faces.py)
     missed: Missed | None = None  # detail the grid misses (missed.py)
+    parts: Parts | None = None  # what refine.py needs of the grid's contour; dropped once refined or not
+
+
+@dataclass
+class Parts:
+    """The contour's own pieces, kept for refine.py: vertex flags, crossings, cells and their sheets' vertices."""
+
+    inside: np.ndarray
+    cross: list[Crossings]
+    cells: _Cells
+    strides: np.ndarray
+    sheet_verts: np.ndarray  # the first cells.nverts vertices, before triangulate() adds its own
+    g: np.ndarray  # max(f, clips) at every grid vertex
+    quads: Quads
+    rowof: np.ndarray  # each grid vertex's row in `cells` (the cell of which it is the lower corner), or -1
 
 
 def _face_bits(lib, clips, grid: Grid, cell_idx: np.ndarray, config: np.ndarray) -> np.ndarray:
@@ -72,7 +87,7 @@ def _check_outer_layer(inside: np.ndarray) -> None:
         raise AssertionError("the grid's outer layer must lie outside every clip")
 
 
-def _active_cells(lib: ShapeLib, clips: list[Clip], grid: Grid, inside: np.ndarray, strides: np.ndarray) -> _Cells:
+def active_cells(lib: ShapeLib, clips: list[Clip], grid: Grid, inside: np.ndarray, strides: np.ndarray) -> _Cells:
     """Corner flags -> config; the active cells get their sheets."""
     ins = inside.view(np.uint8)
     n0, n1, n2 = grid.n
@@ -90,7 +105,7 @@ def _active_cells(lib: ShapeLib, clips: list[Clip], grid: Grid, inside: np.ndarr
     )
 
 
-def _dual_vertices(lib: ShapeLib, clips: list[Clip], grid: Grid, cross: list[Crossings], cs: _Cells, strides, clock):
+def dual_vertices(lib: ShapeLib, clips: list[Clip], grid: Grid, cross: list[Crossings], cs: _Cells, strides, clock):
     """Every sheet's crossings -> QEF point (one C loop over the cells) -> onto the surface: (vertices, which of
     them fell back to their sheet's crossing nearest the QEF point, where Newton strayed near a node or a thin
     neck: a crossing lies on the surface exactly). The QEF's end goes on the clock."""
@@ -162,10 +177,10 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     missed = missed_detail(lib, clips, grid, inside, cross)
     clock.append(time.perf_counter())
     lib.check()  # the budget, between phases (budget.py)
-    cs = _active_cells(lib, clips, grid, inside, strides)
+    cs = active_cells(lib, clips, grid, inside, strides)
     clock.append(time.perf_counter())
     lib.check()
-    verts, failed = _dual_vertices(lib, clips, grid, cross, cs, strides, clock)
+    verts, failed = dual_vertices(lib, clips, grid, cross, cs, strides, clock)
     clock.append(time.perf_counter())
     lib.check()
     quads, rowof = _quads(grid, cross, cs, inside, strides)
@@ -175,4 +190,5 @@ def contour(lib: ShapeLib, clips: list[Clip], grid: Grid) -> Mesh:
     cell = np.full(len(verts), -1, dtype=np.int64)
     cell[: cs.nverts] = np.repeat(cs.flat, cs.count)
     stats = _stats(clock, grid, cross, cs, failed, split, missed)
-    return Mesh(vertices=verts, faces=faces, grid=grid, stats=stats, cell=cell, missed=missed)
+    parts = Parts(inside, cross, cs, strides, verts[: cs.nverts], g, quads, rowof)
+    return Mesh(vertices=verts, faces=faces, grid=grid, stats=stats, cell=cell, missed=missed, parts=parts)

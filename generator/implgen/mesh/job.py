@@ -54,8 +54,8 @@ def make(job: MeshJob, deadline: float, seconds: float, cancel: threading.Event 
     """The STL's bytes and a line saying what they hold. Past `deadline` (time.monotonic(), a budget of
     `seconds`) budget.OverBudget; once `cancel` is set budget.Stopped."""
     t0 = time.monotonic()
-    result = mesh_spec(
-        job.spec, job.values, job.cells, job.clips, False, SOURCE, deadline, cancel, "cells", seconds
+    result = mesh_spec(  # no refinement: its memory (up to refine.MAX_FINE fine cells) is not in the estimate
+        job.spec, job.values, job.cells, job.clips, False, SOURCE, deadline, cancel, "cells", seconds, refine=False
     )  # fmt: skip
     verts, faces = result.mesh.vertices, result.mesh.faces
     normals = vertex_normals(result.lib, result.clips, verts)

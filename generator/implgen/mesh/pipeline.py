@@ -16,7 +16,9 @@ from implgen.errors import UserError
 from implgen.mesh.budget import MAX_CELLS, Budget, check_cells
 from implgen.mesh.contour import Mesh, contour
 from implgen.mesh.crossings import clip_values
+from implgen.mesh.manifold import closed_and_euler as closed_and_euler  # where the callers find it
 from implgen.mesh.probe import cells_to_see, probe_region
+from implgen.mesh.refine import refine as refine_mesh
 from implgen.mesh.region import Clip, make_grid, region_box
 from implgen.mesh.shapelib import ShapeLib
 from implgen.mesh.singular import Singular, find_singular
@@ -32,22 +34,6 @@ class Result:
     singular: Singular | None
     timings: dict[str, float] = field(default_factory=dict)
     at_singular: list[str] = field(default_factory=list)  # what the mesh does at each singular point
-
-
-def closed_and_euler(faces: np.ndarray, nverts: int) -> tuple[bool, int]:
-    """(every edge in exactly two faces, each way once; V - E + F over the vertices faces use). Edges are keyed
-    as one integer each (u n + v), so a sort of integers finds them: millions of faces in a second."""
-    if not len(faces):
-        return False, 0
-    n = max(int(nverts), int(faces.max()) + 1)
-    a, b = faces.reshape(-1).astype(np.int64), faces[:, [1, 2, 0]].reshape(-1).astype(np.int64)
-    directed = np.sort(a * n + b)
-    und = np.sort(np.minimum(a, b) * n + np.maximum(a, b))
-    first = np.flatnonzero(np.concatenate([[True], und[1:] != und[:-1]]))
-    counts = np.diff(np.append(first, und.size))
-    closed = bool((counts == 2).all()) and bool((directed[1:] != directed[:-1]).all())
-    used = int(np.count_nonzero(np.bincount(faces.reshape(-1), minlength=n)))
-    return closed, used - int(first.size) + len(faces)
 
 
 def signed_volume(verts: np.ndarray, faces: np.ndarray) -> float:
@@ -66,6 +52,7 @@ def mesh_spec(
     cancel: threading.Event | None = None,
     cells_name: str = "--cells",
     seconds: float | None = None,
+    refine: bool = True,
 ) -> Result:
     """Mesh the solid f < 0 (∩ the spec's box, ∩ the user's clip) of `spec` with these param values. Past
     `deadline` (a time.monotonic() value) it raises budget.OverBudget, once `cancel` is set budget.Stopped.
@@ -99,12 +86,18 @@ def mesh_spec(
             mesh.missed = mesh.missed.away_from(sing.points, 2 * grid.h)
             mesh.stats.update(mesh.missed.stats())
     t3 = time.perf_counter()
+    if refine:
+        budget.phase = "refining"
+        budget.check()
+        refine_mesh(lib, clips, mesh, result_points(sing))
+    mesh.parts = None
+    t3r = time.perf_counter()
     budget.phase = "parting touching sheets"
     through = _vertices_on(mesh.vertices, result_points(sing))
     done = _unpinch(mesh, lib, clips)
     lib.budget = None  # the caller's own uses (normals) are not timed
     t4 = time.perf_counter()
-    seconds = {"build": t1 - t0, "mesh": t2 - t1, "singular": t3 - t2, "unpinch": t4 - t3}
+    seconds = {"build": t1 - t0, "mesh": t2 - t1, "singular": t3 - t2, "refine": t3r - t3, "unpinch": t4 - t3r}
     return Result(mesh, lib, clips, sing, seconds, at_singular(result_points(sing), through, done, mesh.grid.h))
 
 
