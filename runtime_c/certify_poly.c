@@ -1,0 +1,251 @@
+/* The polynomial certificate (certify.h, docs/certify.md): a polynomial known as coefficient balls -- each true
+ * coefficient within e[k] of c[k] -- is written in the Bernstein basis of [a, b] in ball arithmetic, then cut in
+ * halves by de Casteljau's rule, left half first. A piece whose Bernstein balls all lie on one side of zero
+ * holds no root (the polynomial is a convex combination of them); a piece whose first and last balls have
+ * opposite signs and whose balls can show only one sign change, whatever the true values inside them, holds
+ * exactly one root, a simple one (Descartes' rule in the Bernstein basis). Every operation's rounding is added
+ * to the radius (errarith.h's constants), so what is proved holds for every polynomial inside the balls.
+ */
+#include "certify.h"
+#include "errarith.h"
+#include "roots.h"
+
+#include <math.h>
+
+#define CERT_MAX_DEPTH 48 /* pieces down to 2^-48 of [a, b] */
+#define CERT_BUDGET 800   /* pieces looked at per call */
+
+typedef struct {
+    double m, r;
+} ball;
+
+static inline ball b_add(ball x, ball y)
+{
+    ball z;
+    z.m = x.m + y.m;
+    z.r = (x.r + y.r + IG_ERR_U * fabs(z.m)) * IG_ERR_G;
+    return z;
+}
+
+static inline ball b_mul(ball x, ball y)
+{
+    ball z;
+    z.m = x.m * y.m;
+    z.r = (fabs(x.m) * y.r + fabs(y.m) * x.r + x.r * y.r + IG_ERR_U * fabs(z.m) + IG_ERR_ETA) * IG_ERR_G;
+    return z;
+}
+
+static inline ball b_half_sum(ball x, ball y)
+{
+    ball z;
+    z.m = 0.5 * (x.m + y.m);
+    z.r = (0.5 * (x.r + y.r) + IG_ERR_U * fabs(z.m) + IG_ERR_ETA) * IG_ERR_G;
+    return z;
+}
+
+/* -1, +1: the ball lies below or above zero; 0: it holds zero (or is not finite). */
+static inline int b_sign(ball x) { return x.m > x.r ? 1 : (x.m < -x.r ? -1 : 0); }
+
+/* The Bernstein balls of p on [a, b]: p(a + h y) = sum_i B[i] C(n, i) y^i (1 - y)^(n - i), h = b - a. */
+static void to_bernstein(const double *c, const double *e, int n, double a, double b, ball *B)
+{
+    ball q[IG_MAX_DEGREE + 1], A = {a, 0.0}, h, hp = {1.0, 0.0};
+    int i, k;
+    for (k = 0; k <= n; ++k) {
+        q[k].m = c[k];
+        q[k].r = e[k];
+    }
+    for (i = 0; i < n; ++i) /* Taylor shift to a: q(x) = p(a + x) */
+        for (k = n - 1; k >= i; --k)
+            q[k] = b_add(q[k], b_mul(A, q[k + 1]));
+    h.m = b - a;
+    h.r = IG_ERR_U * fabs(h.m);
+    for (k = 1; k <= n; ++k) { /* x = h y */
+        hp = b_mul(hp, h);
+        q[k] = b_mul(q[k], hp);
+    }
+    for (i = 0; i <= n; ++i) { /* B[i] = sum_k C(i, k) / C(n, k) q[k] */
+        ball acc = {0.0, 0.0};
+        double cik = 1.0, cnk = 1.0;
+        for (k = 0; k <= i; ++k) {
+            ball w;
+            if (k > 0) {
+                cik = cik * (double)(i - k + 1) / (double)k; /* binomials up to C(24, 12): exact in double */
+                cnk = cnk * (double)(n - k + 1) / (double)k;
+            }
+            w.m = cik / cnk;
+            w.r = IG_ERR_U * fabs(w.m) * IG_ERR_G;
+            acc = b_add(acc, b_mul(w, q[k]));
+        }
+        B[i] = acc;
+    }
+}
+
+/* de Casteljau at y = 1/2: B's left half into L, right half into R. */
+static void split(const ball *B, int n, ball *L, ball *R)
+{
+    ball t[IG_MAX_DEGREE + 1];
+    int i, k;
+    if (n < 0 || n > IG_MAX_DEGREE)
+        return;
+    for (i = 0; i <= n; ++i)
+        t[i] = B[i];
+    L[0] = B[0];
+    R[n] = B[n];
+    for (k = 1; k <= n; ++k) {
+        for (i = 0; i + k <= n; ++i)
+            t[i] = b_half_sum(t[i], t[i + 1]);
+        L[k] = t[0];
+        R[n - k] = t[n - k];
+    }
+}
+
+enum { PIECE_EMPTY = 0, PIECE_ONE = 1, PIECE_OPEN = 2, PIECE_BAD = 3 };
+
+/* What a piece's balls prove: no root, exactly one simple root, nothing yet, or a ball not finite. */
+static int classify(const ball *B, int n)
+{
+    int i, s0 = b_sign(B[0]), sn = b_sign(B[n]), last = 0, changes = 0, wild = 0, any = 0;
+    for (i = 0; i <= n; ++i)
+        if (!(fabs(B[i].m) <= 1e300) || !(B[i].r <= 1e300))
+            return PIECE_BAD;
+    for (i = 0; i <= n; ++i) {
+        int sg = b_sign(B[i]);
+        if (sg == 0) {
+            any = 1;
+            wild = 1;
+            continue;
+        }
+        if (last != 0 && sg != last)
+            ++changes;
+        else if (last != 0 && wild)
+            changes += 2; /* a zero-holding run between equal signs could hide two changes */
+        last = sg;
+        wild = 0;
+    }
+    if (!any && changes == 0)
+        return PIECE_EMPTY;
+    if (s0 != 0 && sn != 0 && s0 != sn && changes == 1)
+        return PIECE_ONE;
+    return PIECE_OPEN;
+}
+
+/* The s-interval of the piece [j 2^-m, (j + 1) 2^-m] of [a, b], rounded outward. */
+static void piece_interval(double a, double b, int m, double j, double *lo, double *hi)
+{
+    double h = b - a, w = ldexp(1.0, -m), y0 = j * w, y1 = (j + 1.0) * w;
+    double s0 = a + h * y0, s1 = a + h * y1;
+    double slack = 4.0 * IG_ERR_U * (fabs(a) + fabs(h)) + IG_ERR_ETA;
+    *lo = s0 - slack;
+    *hi = s1 + slack;
+}
+
+typedef struct {
+    ball B[IG_MAX_DEGREE + 1];
+    int depth;
+    double j;
+} piece;
+
+/* Why a piece could not be decided: its end at a or b undecided (a root within the noise of the range's end),
+ * or a root there that is not simple, or a cluster the depth cannot part. */
+static int open_reason(const piece *p, int n, int first_piece, int last_piece)
+{
+    if ((first_piece && b_sign(p->B[0]) == 0) || (last_piece && b_sign(p->B[n]) == 0))
+        return RT_CERT_NOISE;
+    return RT_CERT_TANGENT;
+}
+
+/* A piece holding one simple root cut down, half by half, to the half that holds it, until it is at most rel x
+ * |origin + its start| wide (the caller's parameter is origin + s) or its halves no longer tell. */
+static void narrow(piece *p, int n, double a, double b, double origin, double rel)
+{
+    while (p->depth < CERT_MAX_DEPTH) {
+        piece L, R;
+        double lo, hi;
+        int kl, kr;
+        piece_interval(a, b, p->depth, p->j, &lo, &hi);
+        if (hi - lo <= rel * fabs(origin + lo))
+            return;
+        split(p->B, n, L.B, R.B);
+        kl = classify(L.B, n);
+        kr = classify(R.B, n);
+        L.depth = R.depth = p->depth + 1;
+        L.j = 2.0 * p->j;
+        R.j = L.j + 1.0;
+        if (kl == PIECE_ONE && kr == PIECE_EMPTY)
+            *p = L;
+        else if (kl == PIECE_EMPTY && kr == PIECE_ONE)
+            *p = R;
+        else
+            return;
+    }
+}
+
+/* Left-first walk over the pieces of [a, b]. max_roots: stop after that many root pieces. Writes the root
+ * intervals; returns their count, or -code with lo[count] the start of the undecided piece. */
+static int walk(const double *c, const double *e, int n, double a, double b, int max_roots, double origin, double rel,
+                double *lo, double *hi)
+{
+    piece stack[CERT_MAX_DEPTH + 2], cur;
+    int sp = 0, found = 0, budget = CERT_BUDGET;
+    if (!(a <= b) || n < 0 || n > IG_MAX_DEGREE)
+        return -RT_CERT_OVERFLOW;
+    to_bernstein(c, e, n, a, b, cur.B);
+    cur.depth = 0;
+    cur.j = 0.0;
+    for (;;) {
+        int kind = classify(cur.B, n);
+        double last = ldexp(1.0, cur.depth) - 1.0;
+        if (kind == PIECE_BAD || kind == PIECE_OPEN) {
+            int code = kind == PIECE_BAD ? RT_CERT_OVERFLOW : 0;
+            if (!code && (cur.depth >= CERT_MAX_DEPTH || --budget <= 0))
+                code = cur.depth >= CERT_MAX_DEPTH ? open_reason(&cur, n, cur.j == 0.0, cur.j == last)
+                                                   : RT_CERT_BUDGET;
+            if (code) {
+                piece_interval(a, b, cur.depth, cur.j, &lo[found], &hi[found]);
+                return -code;
+            }
+            stack[sp].depth = cur.depth + 1;
+            stack[sp].j = 2.0 * cur.j + 1.0;
+            split(cur.B, n, cur.B, stack[sp].B);
+            ++sp;
+            cur.depth += 1;
+            cur.j = 2.0 * cur.j;
+            continue;
+        }
+        if (kind == PIECE_ONE) {
+            narrow(&cur, n, a, b, origin, rel);
+            piece_interval(a, b, cur.depth, cur.j, &lo[found], &hi[found]);
+            if (++found >= max_roots)
+                return found;
+        }
+        if (sp == 0)
+            return found;
+        cur = stack[--sp];
+    }
+}
+
+int rt_certify_first_root(const double *c, const double *e, int n, double a, double b, double origin, double rel,
+                          double *lo, double *hi)
+{
+    double l[2] = {a, a}, h[2] = {b, b};
+    int k = walk(c, e, n, a, b, 1, origin, rel, l, h);
+    *lo = l[0];
+    *hi = k < 0 ? l[0] : h[0];
+    return k;
+}
+
+int rt_certify_roots(const double *c, const double *e, int n, double a, double b, double origin, double rel,
+                     double *lo, double *hi, int *sign_a)
+{
+    ball B[IG_MAX_DEGREE + 1];
+    int k;
+    if (!(a <= b) || n < 0 || n > IG_MAX_DEGREE)
+        return -RT_CERT_OVERFLOW;
+    to_bernstein(c, e, n, a, b, B);
+    *sign_a = b_sign(B[0]);
+    k = walk(c, e, n, a, b, n + 1, origin, rel, lo, hi);
+    if (k >= 0 && *sign_a == 0)
+        return -RT_CERT_NOISE;
+    return k;
+}
