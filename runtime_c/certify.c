@@ -17,7 +17,7 @@
 
 #define HINT_REL 1e-9  /* the tracer's root is checked in an interval of this relative half-width */
 #define CERT_REL 1e-10 /* a hit's interval is narrowed to this relative width (where the pieces tell) */
-#define GAMMA(k) ((double)(k) * 1.0000001 * IG_ERR_U) /* gamma_k = k u / (1 - k u), rounded up */
+#define GAMMA(k) ((double)(k)*1.0000001 * IG_ERR_U) /* gamma_k = k u / (1 - k u), rounded up */
 
 static const char *const reason_names[RT_CERT_NCODES] = {
     "miss", "hit", "tangent", "singular", "noise", "tie", "overflow", "budget", "no_bound", "far", "wrong",
@@ -122,8 +122,8 @@ static int box_range(const rt_node *n, const ball_ray *br, double *t0, double *t
         ig_slab(bl, bh, br->oo[a], 1.0 / d, &ta, &tb);
         {
             double tm = ig_max(isfinite(ta) ? fabs(ta) : 0.0, isfinite(tb) ? fabs(tb) : 0.0);
-            slack = ig_max(slack, (br->eo[a] + tm * br->ed[a]) / (fabs(d) - br->ed[a]) * (1.0 + GAMMA(4)) +
-                                      GAMMA(4) * tm);
+            slack =
+                ig_max(slack, (br->eo[a] + tm * br->ed[a]) / (fabs(d) - br->ed[a]) * (1.0 + GAMMA(4)) + GAMMA(4) * tm);
         }
         if (ta > lo)
             lo = ta;
@@ -237,8 +237,8 @@ static int set_fail(obj_cert *out, int code, double at)
 /* The leaf's range, its expansion and its certificate: the exact range starts in [A, S1] and ends in [M, T]
  * (the box's faces, rounded; S1 = A and M = T where an end is exact); the first root must lie in [S1, M] with
  * no root in [A, S1], or there is none in [A, T]. */
-static int leaf_range_cert(const rt_node *n, const ball_ray *br, double A, double S1, double M, double T,
-                           double far_t, double hint, obj_cert *out)
+static int leaf_range_cert(const rt_node *n, const ball_ray *br, double A, double S1, double M, double T, double far_t,
+                           double hint, obj_cert *out)
 {
     double c[IG_MAX_DEGREE + 1], e[IG_MAX_DEGREE + 1], lo, hi;
     double ts = ig_shape_shift_point(&n->prep, br->oo, br->od, A, T);

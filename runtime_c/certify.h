@@ -56,7 +56,7 @@ int rt_certify_first_root(const double *c, const double *e, int n, double a, dou
                           double *lo, double *hi);
 /* All roots on [a, b]: up to n intervals (lo, hi: room for n + 1), each holding exactly one simple root, none
  * elsewhere on [a, b], and the certified sign of p at a in *sign_a. Returns their count, or -code as above. */
-int rt_certify_roots(const double *c, const double *e, int n, double a, double b, double origin, double rel,
-                     double *lo, double *hi, int *sign_a);
+int rt_certify_roots(const double *c, const double *e, int n, double a, double b, double origin, double rel, double *lo,
+                     double *hi, int *sign_a);
 
 #endif

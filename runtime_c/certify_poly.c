@@ -8,6 +8,7 @@
  */
 #include "certify.h"
 #include "errarith.h"
+#include "numerics.h"
 #include "roots.h"
 
 #include <math.h>
@@ -46,18 +47,62 @@ static inline ball b_half_sum(ball x, ball y)
 /* -1, +1: the ball lies below or above zero; 0: it holds zero (or is not finite). */
 static inline int b_sign(ball x) { return x.m > x.r ? 1 : (x.m < -x.r ? -1 : 0); }
 
-/* The Bernstein balls of p on [a, b]: p(a + h y) = sum_i B[i] C(n, i) y^i (1 - y)^(n - i), h = b - a. */
-static void to_bernstein(const double *c, const double *e, int n, double a, double b, ball *B)
+/* q(x) = p(a + x) in ball arithmetic: q's balls in q. */
+static void taylor_plain(const double *c, const double *e, int n, double a, ball *q)
 {
-    ball q[IG_MAX_DEGREE + 1], A = {a, 0.0}, h, hp = {1.0, 0.0};
+    ball A = {a, 0.0};
     int i, k;
     for (k = 0; k <= n; ++k) {
         q[k].m = c[k];
         q[k].r = e[k];
     }
-    for (i = 0; i < n; ++i) /* Taylor shift to a: q(x) = p(a + x) */
+    for (i = 0; i < n; ++i)
         for (k = n - 1; k >= i; --k)
             q[k] = b_add(q[k], b_mul(A, q[k + 1]));
+}
+
+/* The same compensated (the sign the plain shift cannot decide, where |a|^k |c_k| dwarfs the values: a ray
+ * polynomial written far from the object): every coefficient is carried as an unevaluated sum h + l of two
+ * doubles (error-free sums and products of numerics.h), so each step loses about u^2 of its terms' size instead
+ * of u. The step q[k] += a q[k+1]: h0 + a h1 = s + e1 + e2 exactly (TwoProd, TwoSum); the low parts
+ * l0 + a l1 + e1 + e2 are summed in double, at most four roundings of at most u times their absolute sum
+ * each. */
+static void taylor_compensated(const double *c, const double *e, int n, double a, ball *q)
+{
+    double h[IG_MAX_DEGREE + 1], l[IG_MAX_DEGREE + 1], r[IG_MAX_DEGREE + 1];
+    int i, k;
+    for (k = 0; k <= n; ++k) {
+        h[k] = c[k];
+        l[k] = 0.0;
+        /* TwoProd splits its factors: exact only below 2^996 */
+        r[k] = fabs(c[k]) < 1e250 && fabs(a) < 1e250 ? e[k] : INFINITY;
+    }
+    for (i = 0; i < n; ++i)
+        for (k = n - 1; k >= i; --k) {
+            double p, pe, s, se, al = a * l[k + 1], lo, mag;
+            ig_two_prod(a, h[k + 1], &p, &pe);
+            ig_two_sum(h[k], p, &s, &se);
+            lo = ((l[k] + al) + se) + pe;
+            mag = fabs(l[k]) + fabs(al) + fabs(se) + fabs(pe);
+            r[k] = (r[k] + fabs(a) * r[k + 1] + 5.0 * IG_ERR_U * mag + 4.0 * IG_ERR_ETA) * IG_ERR_G;
+            ig_two_sum(s, lo, &h[k], &l[k]); /* renormalised: exact */
+        }
+    for (k = 0; k <= n; ++k) {
+        q[k].m = h[k] + l[k];
+        q[k].r = (r[k] + fabs(q[k].m - h[k] - l[k]) + IG_ERR_U * fabs(q[k].m)) * IG_ERR_G;
+    }
+}
+
+/* The Bernstein balls of p on [a, b]: p(a + h y) = sum_i B[i] C(n, i) y^i (1 - y)^(n - i), h = b - a. The Taylor
+ * shift plain, or compensated. */
+static void to_bernstein(const double *c, const double *e, int n, double a, double b, int compensated, ball *B)
+{
+    ball q[IG_MAX_DEGREE + 1], h, hp = {1.0, 0.0};
+    int i, k;
+    if (compensated)
+        taylor_compensated(c, e, n, a, q);
+    else
+        taylor_plain(c, e, n, a, q);
     h.m = b - a;
     h.r = IG_ERR_U * fabs(h.m);
     for (k = 1; k <= n; ++k) { /* x = h y */
@@ -184,13 +229,13 @@ static void narrow(piece *p, int n, double a, double b, double origin, double re
 /* Left-first walk over the pieces of [a, b]. max_roots: stop after that many root pieces. Writes the root
  * intervals; returns their count, or -code with lo[count] the start of the undecided piece. */
 static int walk(const double *c, const double *e, int n, double a, double b, int max_roots, double origin, double rel,
-                double *lo, double *hi)
+                int compensated, double *lo, double *hi)
 {
     piece stack[CERT_MAX_DEPTH + 2], cur;
     int sp = 0, found = 0, budget = CERT_BUDGET;
     if (!(a <= b) || n < 0 || n > IG_MAX_DEGREE)
         return -RT_CERT_OVERFLOW;
-    to_bernstein(c, e, n, a, b, cur.B);
+    to_bernstein(c, e, n, a, b, compensated, cur.B);
     cur.depth = 0;
     cur.j = 0.0;
     for (;;) {
@@ -199,8 +244,7 @@ static int walk(const double *c, const double *e, int n, double a, double b, int
         if (kind == PIECE_BAD || kind == PIECE_OPEN) {
             int code = kind == PIECE_BAD ? RT_CERT_OVERFLOW : 0;
             if (!code && (cur.depth >= CERT_MAX_DEPTH || --budget <= 0))
-                code = cur.depth >= CERT_MAX_DEPTH ? open_reason(&cur, n, cur.j == 0.0, cur.j == last)
-                                                   : RT_CERT_BUDGET;
+                code = cur.depth >= CERT_MAX_DEPTH ? open_reason(&cur, n, cur.j == 0.0, cur.j == last) : RT_CERT_BUDGET;
             if (code) {
                 piece_interval(a, b, cur.depth, cur.j, &lo[found], &hi[found]);
                 return -code;
@@ -229,22 +273,26 @@ int rt_certify_first_root(const double *c, const double *e, int n, double a, dou
                           double *lo, double *hi)
 {
     double l[2] = {a, a}, h[2] = {b, b};
-    int k = walk(c, e, n, a, b, 1, origin, rel, l, h);
+    int k = walk(c, e, n, a, b, 1, origin, rel, 0, l, h);
+    if (k < 0 && k != -RT_CERT_OVERFLOW) /* the plain shift could not decide: again, compensated */
+        k = walk(c, e, n, a, b, 1, origin, rel, 1, l, h);
     *lo = l[0];
     *hi = k < 0 ? l[0] : h[0];
     return k;
 }
 
-int rt_certify_roots(const double *c, const double *e, int n, double a, double b, double origin, double rel,
-                     double *lo, double *hi, int *sign_a)
+int rt_certify_roots(const double *c, const double *e, int n, double a, double b, double origin, double rel, double *lo,
+                     double *hi, int *sign_a)
 {
     ball B[IG_MAX_DEGREE + 1];
     int k;
     if (!(a <= b) || n < 0 || n > IG_MAX_DEGREE)
         return -RT_CERT_OVERFLOW;
-    to_bernstein(c, e, n, a, b, B);
+    to_bernstein(c, e, n, a, b, 1, B);
     *sign_a = b_sign(B[0]);
-    k = walk(c, e, n, a, b, n + 1, origin, rel, lo, hi);
+    k = walk(c, e, n, a, b, n + 1, origin, rel, 0, lo, hi);
+    if (k < 0 && k != -RT_CERT_OVERFLOW)
+        k = walk(c, e, n, a, b, n + 1, origin, rel, 1, lo, hi);
     if (k >= 0 && *sign_a == 0)
         return -RT_CERT_NOISE;
     return k;

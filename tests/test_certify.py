@@ -16,6 +16,9 @@ import sympy as sp
 from PIL import Image
 
 from implgen.cli import main as cli_main
+from implgen.measure.cases.extreme import far_torus_rays
+from implgen.measure.cases.polys import hard_set
+from implgen.measure.cases.reference import reference
 from implgen.measure.certcheck import check_pixels, sample_pixels
 from implgen.scene.build import build_scene
 from implgen.scene.load import load_scene, parse_scene
@@ -224,3 +227,55 @@ def test_bad_certify_options_are_one_line_and_exit_2(tmp_path, capsys, monkeypat
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and word in err
     assert list(tmp_path.iterdir()) == []
+
+
+# ------------------------------------------------------------------------------------- far rays and hard cases
+
+
+def certify_roots(lib, c, a, b):
+    """rt_certify_roots on the double polynomial c (exact: no error balls) over [a, b]: the count or -code, and
+    the intervals."""
+    f = lib.rt_certify_roots
+    f.restype = ctypes.c_int
+    f.argtypes = [_pd, _pd, ctypes.c_int, ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double]
+    f.argtypes += [_pd, _pd, ctypes.POINTER(ctypes.c_int)]
+    lo, hi, sign = (ctypes.c_double * 26)(), (ctypes.c_double * 26)(), ctypes.c_int()
+    k = f(darr(c), darr([0.0] * len(c)), len(c) - 1, a, b, 0.0, 1e-12, lo, hi, ctypes.byref(sign))
+    return k, list(zip(lo[: max(k, 0)], hi[: max(k, 0)]))
+
+
+def agrees(k, got, want) -> bool:
+    """A certified answer lists exactly the reference's real roots on the interval, each simple, in order."""
+    return k == len(want) and all(r.mult == 1 and lo <= r.value <= hi for (lo, hi), r in zip(got, want))
+
+
+@pytest.mark.parametrize("dist", [1e3, 1e4])
+def test_far_torus_rays_without_the_shift_are_certified_by_the_compensated_shift(lib, dist):
+    """Torus ray polynomials written at the far origin (no shift): at 1e4 the plain Taylor shift's noise (~u
+    |a|^4 |c_4|, about 1) hides every sign, so every one of these was undecided before the compensated shift;
+    now each is certified, and every certified answer is exactly the double polynomial's real roots."""
+    c, lo, hi = far_torus_rays(60, np.random.default_rng(2), dist)
+    ref = reference(c)
+    certified = 0
+    for i in range(len(c)):
+        k, got = certify_roots(lib, c[i], lo[i], hi[i])
+        if k >= 0:
+            certified += 1
+            assert agrees(k, got, [r for r in ref[i] if lo[i] <= r.value <= hi[i]]), (i, k, got)
+    assert certified == len(c)
+
+
+def test_the_hard_set_is_certified_only_where_exactly_right(lib):
+    """The solver report's hard polynomials (near-double and quadruple roots once rounded to doubles, clusters,
+    spread roots, roots at an end, a tiny minimum) on a finite window: every certified answer is exact."""
+    c, lo, hi = hard_set(64, np.random.default_rng(4), n=12)
+    ref = reference(c)
+    certified = 0
+    for i in range(len(c)):
+        a, b = max(lo[i], -8.0), min(hi[i], 8.0)
+        want = [r for r in ref[i] if a <= r.value <= b]
+        k, got = certify_roots(lib, c[i], a, b)
+        if k >= 0:
+            certified += 1
+            assert agrees(k, got, want), (i, k, got, [(r.value, r.mult) for r in want])
+    assert certified >= len(c) // 3
