@@ -15,8 +15,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define HINT_REL 1e-9  /* the tracer's root is checked in an interval of this relative half-width */
-#define CERT_REL 1e-10 /* a hit's interval is narrowed to this relative width (where the pieces tell) */
+#define HINT_REL 1e-9 /* the tracer's root is checked in an interval of this relative half-width */
+#define CERT_REL 1e-7 /* a hit's interval is narrowed to this relative width (where the pieces tell) */
 #define GAMMA(k) ((double)(k)*1.0000001 * IG_ERR_U) /* gamma_k = k u / (1 - k u), rounded up */
 
 static const char *const reason_names[RT_CERT_NCODES] = {

@@ -94,36 +94,31 @@ static void taylor_compensated(const double *c, const double *e, int n, double a
 }
 
 /* The Bernstein balls of p on [a, b]: p(a + h y) = sum_i B[i] C(n, i) y^i (1 - y)^(n - i), h = b - a. The Taylor
- * shift plain, or compensated. */
+ * shift plain, or compensated; worked in place in B. */
 static void to_bernstein(const double *c, const double *e, int n, double a, double b, int compensated, ball *B)
 {
-    ball q[IG_MAX_DEGREE + 1], h, hp = {1.0, 0.0};
+    ball h, hp = {1.0, 0.0};
+    double cnk = 1.0;
     int i, k;
     if (compensated)
-        taylor_compensated(c, e, n, a, q);
+        taylor_compensated(c, e, n, a, B);
     else
-        taylor_plain(c, e, n, a, q);
+        taylor_plain(c, e, n, a, B);
     h.m = b - a;
     h.r = IG_ERR_U * fabs(h.m);
-    for (k = 1; k <= n; ++k) { /* x = h y */
+    /* x = h y, then B[i] = sum_k C(i, k) q[k] / C(n, k): q[k] divided by C(n, k) (an exact integer below 2^53),
+     * and the sums with C(i, k) as Pascal's triangle builds them, by additions only */
+    for (k = 1; k <= n; ++k) {
+        ball q;
         hp = b_mul(hp, h);
-        q[k] = b_mul(q[k], hp);
+        q = b_mul(B[k], hp);
+        cnk = cnk * (double)(n - k + 1) / (double)k; /* C(n, k) from C(n, k - 1): exact */
+        B[k].m = q.m / cnk;
+        B[k].r = (q.r / cnk + IG_ERR_U * fabs(B[k].m) + IG_ERR_ETA) * IG_ERR_G;
     }
-    for (i = 0; i <= n; ++i) { /* B[i] = sum_k C(i, k) / C(n, k) q[k] */
-        ball acc = {0.0, 0.0};
-        double cik = 1.0, cnk = 1.0;
-        for (k = 0; k <= i; ++k) {
-            ball w;
-            if (k > 0) {
-                cik = cik * (double)(i - k + 1) / (double)k; /* binomials up to C(24, 12): exact in double */
-                cnk = cnk * (double)(n - k + 1) / (double)k;
-            }
-            w.m = cik / cnk;
-            w.r = IG_ERR_U * fabs(w.m) * IG_ERR_G;
-            acc = b_add(acc, b_mul(w, q[k]));
-        }
-        B[i] = acc;
-    }
+    for (i = 1; i <= n; ++i)
+        for (k = n; k >= i; --k)
+            B[k] = b_add(B[k], B[k - 1]);
 }
 
 /* de Casteljau at y = 1/2: B's left half into L, right half into R. */
@@ -269,11 +264,40 @@ static int walk(const double *c, const double *e, int n, double a, double b, int
     }
 }
 
+/* A line c0 + c1 s with |C1| > e1: its one root -C0 / C1 lies between the quotients of the balls' corners (each
+ * rounded outward). 1 and the interval when that lies inside (a, b), 0 when it misses [a, b], -1: undecided. */
+static int line_root(const double *c, const double *e, double a, double b, double *lo, double *hi)
+{
+    double q[4], l = INFINITY, h = -INFINITY;
+    int i;
+    if (!(fabs(c[1]) > e[1]) || !(fabs(c[0]) + e[0] <= 1e300) || !(fabs(c[1]) <= 1e300))
+        return -1;
+    q[0] = -(c[0] - e[0]) / (c[1] - e[1]);
+    q[1] = -(c[0] - e[0]) / (c[1] + e[1]);
+    q[2] = -(c[0] + e[0]) / (c[1] - e[1]);
+    q[3] = -(c[0] + e[0]) / (c[1] + e[1]);
+    for (i = 0; i < 4; ++i) {
+        l = q[i] < l ? q[i] : l;
+        h = q[i] > h ? q[i] : h;
+    }
+    l -= 4.0 * IG_ERR_U * fabs(l) + IG_ERR_ETA;
+    h += 4.0 * IG_ERR_U * fabs(h) + IG_ERR_ETA;
+    if (l > a && h < b) {
+        *lo = l;
+        *hi = h;
+        return 1;
+    }
+    return (h < a || l > b) ? 0 : -1;
+}
+
 int rt_certify_first_root(const double *c, const double *e, int n, double a, double b, double origin, double rel,
                           double *lo, double *hi)
 {
     double l[2] = {a, a}, h[2] = {b, b};
-    int k = walk(c, e, n, a, b, 1, origin, rel, 0, l, h);
+    int k = n == 1 ? line_root(c, e, a, b, lo, hi) : -1;
+    if (k >= 0)
+        return k;
+    k = walk(c, e, n, a, b, 1, origin, rel, 0, l, h);
     if (k < 0 && k != -RT_CERT_OVERFLOW) /* the plain shift could not decide: again, compensated */
         k = walk(c, e, n, a, b, 1, origin, rel, 1, l, h);
     *lo = l[0];
