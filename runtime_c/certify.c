@@ -298,7 +298,7 @@ static int leaf_cert(const rt_node *n, const rt_ray *ray, double cap, double hin
 }
 
 /* Object k's answer for t in (0, cap]. */
-static void object_cert(const rt_scene *s, int k, const rt_ray *ray, double cap, obj_cert *out)
+static void object_cert(const rt_scene *s, int k, const rt_ray *ray, double cap, double hint, obj_cert *out)
 {
     const rt_node *n = &s->nodes[s->objects[k]];
     double t0 = 0.0, t1 = cap;
@@ -313,48 +313,63 @@ static void object_cert(const rt_scene *s, int k, const rt_ray *ray, double cap,
         out->hi = INFINITY;
         return;
     }
-    {
-        rt_pending h;
-        double hint = rt_object_hit(s, k, ray, 0.0, INFINITY, 0, &h) ? h.t : INFINITY;
-        (void)leaf_cert(n, ray, cap, hint, out);
+    (void)leaf_cert(n, ray, cap, hint, out);
+}
+
+/* The answers so far: the first hit W (the smallest interval start, lo1 .. hi1), the second smallest start, the
+ * earliest failure. */
+typedef struct {
+    double cap, lo1, hi1, lo2, fail_at;
+    int best, fail, fail_code;
+} ray_answers;
+
+static void take(ray_answers *q, int i, const obj_cert *c)
+{
+    if (c->code == RT_CERT_HIT) {
+        if (c->lo < q->lo1) {
+            q->lo2 = q->lo1;
+            q->lo1 = c->lo;
+            q->hi1 = c->hi;
+            q->best = i;
+        } else if (c->lo < q->lo2) {
+            q->lo2 = c->lo;
+        }
+        if (c->hi < q->cap)
+            q->cap = c->hi;
+    } else if (c->code != RT_CERT_MISS && c->lo < q->fail_at) {
+        q->fail_at = c->lo;
+        q->fail = i;
+        q->fail_code = c->code;
     }
 }
 
 /* The certified first hit over all objects: code, and the object in *object. The first hit W (the smallest
  * interval start) is certified when every other hit starts after W's interval ends and no object's certificate
- * failed before that end. Each object is asked only up to the smallest interval end so far (cap). */
-static int scene_cert(const rt_scene *s, const rt_ray *ray, int *object)
+ * failed before that end. The object the tracer shows (shown, at t_shown; -1: none) goes first, its certificate
+ * starting at the tracer's root; every other object is then asked only up to the smallest interval end so far. */
+static int scene_cert(const rt_scene *s, const rt_ray *ray, int shown, double t_shown, int *object)
 {
-    double cap = INFINITY, lo1 = INFINITY, hi1 = INFINITY, lo2 = INFINITY, fail_at = INFINITY;
-    int i, best = -1, fail = -1, fail_code = RT_CERT_MISS;
+    ray_answers q = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY, -1, -1, RT_CERT_MISS};
+    obj_cert c;
+    int i;
+    if (shown >= 0) {
+        object_cert(s, shown, ray, INFINITY, t_shown, &c);
+        take(&q, shown, &c);
+    }
     for (i = 0; i < s->nobjects; ++i) {
-        obj_cert c;
-        object_cert(s, i, ray, cap, &c);
-        if (c.code == RT_CERT_HIT) {
-            if (c.lo < lo1) {
-                lo2 = lo1;
-                lo1 = c.lo;
-                hi1 = c.hi;
-                best = i;
-            } else if (c.lo < lo2) {
-                lo2 = c.lo;
-            }
-            if (c.hi < cap)
-                cap = c.hi;
-        } else if (c.code != RT_CERT_MISS && c.lo < fail_at) {
-            fail_at = c.lo;
-            fail = i;
-            fail_code = c.code;
-        }
+        if (i == shown)
+            continue;
+        object_cert(s, i, ray, q.cap, INFINITY, &c);
+        take(&q, i, &c);
     }
-    if (fail >= 0 && !(fail_at > hi1)) {
-        *object = fail;
-        return fail_code;
+    if (q.fail >= 0 && !(q.fail_at > q.hi1)) {
+        *object = q.fail;
+        return q.fail_code;
     }
-    *object = best;
-    if (best >= 0 && !(lo2 > hi1))
+    *object = q.best;
+    if (q.best >= 0 && !(q.lo2 > q.hi1))
         return RT_CERT_TIE;
-    return best >= 0 ? RT_CERT_HIT : RT_CERT_MISS;
+    return q.best >= 0 ? RT_CERT_HIT : RT_CERT_MISS;
 }
 
 int rt_certify_ray(const rt_scene *s, const double o[3], const double d[3], int *object)
@@ -366,13 +381,11 @@ int rt_certify_ray(const rt_scene *s, const double o[3], const double d[3], int 
     if (!s->committed)
         return RT_CERT_NOBOUND;
     rt_ray_init(&ray, o, d, s->far, s->unit_rays);
-    code = scene_cert(s, &ray, object);
     shown = rt_scene_closest(s, o, d, 0.0, INFINITY, RT_CLOSEST, -1, &ph) ? ph.object : -1;
-    if (code == RT_CERT_HIT || code == RT_CERT_MISS) {
-        if (shown != *object) {
-            *object = shown >= 0 ? shown : *object;
-            return RT_CERT_WRONG;
-        }
+    code = scene_cert(s, &ray, shown, shown >= 0 ? ph.t : INFINITY, object);
+    if ((code == RT_CERT_HIT || code == RT_CERT_MISS) && shown != *object) {
+        *object = shown >= 0 ? shown : *object;
+        return RT_CERT_WRONG;
     }
     return code;
 }
