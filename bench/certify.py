@@ -1,13 +1,16 @@
 """Certified pixels (docs/certify.md): certified answers against the exact judge, the pixels not certified per
 degree, and what `--certify` costs against the plain render.
 
-    .venv/bin/python bench/certify.py [--pixels 2000] [--runs 5] [--scenes a,b] [-o bench/results/certify.md]
+    .venv/bin/python bench/certify.py [--pixels 2000] [--disputed 3000] [--runs 5] [--scenes a,b]
+        [-o bench/results/certify.md]
         [--base-python /work/main/.venv/bin/python]
 
 Scenes: the POV-Ray comparison's (bench/scenes/*.yaml) and the examples (examples/scenes/*.yaml). For each:
   1. judge: --pixels pixels drawn at random at the scene's own size, each centre ray certified (rt_certify_ray) and
      every certified answer decided exactly (implgen.measure.certcheck, implgen.roots.exactray); scenes with CSG
      objects are not judged (the exact judge knows leaves only; their CSG pixels are never certified anyway);
+     1b. the pixels POV-Ray disputes (bench/povray_compare.py's disagreement pictures; at most --disputed a
+     scene, drawn at random), judged the same way;
   2. per degree: the whole certify map at the scene's own size, 1 sample; per degree of the object a pixel's code
      is about, its pixels and those not certified;
   3. cost: --runs times, one render context each, the plain render (rt_render_run) then the certify pass
@@ -54,6 +57,27 @@ def judge(sc, cs, pixels: int) -> dict:
         return {"judged": None}
     got = check_pixels(sc, cs, sc.width, sc.height, sample_pixels(sc.width, sc.height, pixels, seed=1))
     return {"judged": got.judged, "wrong": len(got.wrong), "sampled": pixels, "counts": got.counts}
+
+
+def disputed(name: str, sc, cs, most: int) -> dict | None:
+    """Step 1b: the pixels bench/povray_compare.py found disputed with POV-Ray (its disagreement picture's red and
+    blue, dilated by a pixel: a superset), all of them or a random `most` of them, judged as in step 1."""
+    from PIL import Image
+
+    png = ROOT / "bench" / "results" / "povray" / f"{name}_disagreement.png"
+    if not png.exists():
+        return None
+    with Image.open(png) as im:
+        rgb = np.asarray(im.convert("RGB")).astype(int)
+    if rgb.shape[:2] != (sc.height, sc.width):
+        return None
+    flagged = (rgb[..., 0] == 255) | (rgb[..., 2] == 255)
+    ys, xs = np.nonzero(flagged)
+    pix = np.stack([xs, ys], axis=1)
+    if len(pix) > most:
+        pix = pix[np.random.default_rng(2).choice(len(pix), size=most, replace=False)]
+    got = check_pixels(sc, cs, sc.width, sc.height, pix)
+    return {"flagged": int(flagged.sum()), "checked": len(pix), "judged": got.judged, "wrong": len(got.wrong)}
 
 
 def per_degree(sc, cs) -> dict[int, list[int]]:
@@ -112,7 +136,7 @@ def run_scene(path: Path, opt) -> dict:
     cs = CScene(sc, build_scene(sc))
     try:
         t0 = time.perf_counter()
-        out = {"judge": judge(sc, cs, opt.pixels)}
+        out = {"judge": judge(sc, cs, opt.pixels), "disputed": disputed(path.stem, sc, cs, opt.disputed)}
         out["judge_seconds"] = time.perf_counter() - t0
         out["degree"] = per_degree(sc, cs)
         out["cost"] = cost(sc, cs, opt.runs)
@@ -128,7 +152,7 @@ def report(results: dict, base_rows, load_before: str, load_after: str, opt) -> 
         "# Certified pixels: exact agreement, pixels not certified, cost",
         "",
         f"Machine: {describe()}. Load average before: {load_before}; after: {load_after}.",
-        f"Command: `.venv/bin/python bench/certify.py --pixels {opt.pixels} --runs {opt.runs}"
+        f"Command: `.venv/bin/python bench/certify.py --pixels {opt.pixels} --disputed {opt.disputed} --runs {opt.runs}"
         + (f" --base-python {opt.base_python}`." if opt.base_python else "`."),
         "",
         "## Certified answers against the exact judge",
@@ -142,8 +166,19 @@ def report(results: dict, base_rows, load_before: str, load_after: str, opt) -> 
             lines.append(f"| {name} | - | not judged (CSG objects) | - |")
         else:
             lines.append(f"| {name} | {j['sampled']} | {j['judged']} | {j['wrong']} |")
+    lines += _disputed_table(results)
     lines += _degree_table(results) + _cost_table(results) + _base_table(base_rows)
     return "\n".join(lines) + "\n"
+
+
+def _disputed_table(results: dict) -> list[str]:
+    lines = ["", "## Pixels POV-Ray disputes (bench/results/povray's disagreement pictures, dilated by 1 px)", ""]
+    lines += ["| scene | flagged | checked | certified, judged | judged wrong |", "|---|---|---|---|---|"]
+    for name, r in results.items():
+        d = r.get("disputed")
+        if d is not None:
+            lines.append(f"| {name} | {d['flagged']} | {d['checked']} | {d['judged']} | {d['wrong']} |")
+    return lines
 
 
 def _degree_table(results: dict) -> list[str]:
@@ -186,6 +221,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--pixels", type=int, default=2000)
     ap.add_argument("--runs", type=int, default=5)
+    ap.add_argument("--disputed", type=int, default=3000, help="at most this many disputed pixels a scene")
     ap.add_argument("--scenes", default="", help="comma-separated scene names (default: all)")
     ap.add_argument("--base-python", help="the Python of a base checkout's venv, to time its plain render")
     ap.add_argument("-o", "--output", type=Path, default=ROOT / "bench" / "results" / "certify.md")

@@ -15,8 +15,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define HINT_REL 1e-9 /* the tracer's root is checked in an interval of this relative half-width */
-#define CERT_REL 1e-7 /* a hit's interval is narrowed to this relative width (where the pieces tell) */
+#define HINT_REL 1e-9  /* the tracer's root is checked in an interval of this relative half-width */
+#define HINT_WIDE 1e-3 /* ... and, expanded about that root, in one of this relative half-width */
+#define CERT_REL 1e-7  /* a hit's interval is narrowed to this relative width (where the pieces tell) */
 #define GAMMA(k) ((double)(k)*1.0000001 * IG_ERR_U) /* gamma_k = k u / (1 - k u), rounded up */
 
 static const char *const reason_names[RT_CERT_NCODES] = {
@@ -226,6 +227,24 @@ static int hinted_root(const double *c, const double *e, int deg, double ts, dou
     return 1;
 }
 
+/* The same with f expanded again about the tracer's root: where the expansion about ts sees f near its root only
+ * through the noise of terms far larger than f there (a surface of high degree seen through its box's centre),
+ * the expansion about the root does not. No root on [ta, hint - W] from the first expansion, then the first root
+ * of [hint - W, hint + W] from the second, W = HINT_WIDE |hint| (cut to [ta, tb]). */
+static int reexpanded_root(const rt_node *n, const ball_ray *br, const double *c, const double *e, double ts, double ta,
+                           double tb, double hint, double *lo, double *hi)
+{
+    double c2[IG_MAX_DEGREE + 1], e2[IG_MAX_DEGREE + 1], W = HINT_WIDE * fabs(hint), a, b, l, h;
+    int deg = n->shape->degree;
+    if (!(hint > ta && hint < tb) || shifted_coeffs(n, br, hint, c2, e2) <= 0)
+        return -1;
+    a = ig_max(ta, hint - W);
+    b = hint + W < tb ? hint + W : tb;
+    if (a > ta && first_root_t(c, e, deg, ts, ta, a, &l, &h) != 0)
+        return -1;
+    return first_root_t(c2, e2, deg, hint, a, b, lo, hi) == 1 ? 1 : -1;
+}
+
 static int set_fail(obj_cert *out, int code, double at)
 {
     out->code = code;
@@ -249,6 +268,8 @@ static int leaf_range_cert(const rt_node *n, const ball_ray *br, double A, doubl
         return set_fail(out, RT_CERT_NOISE, A); /* a root near where the range starts */
     got = hinted_root(c, e, deg, ts, S1, M, hint, &lo, &hi);
     if (got < 0)
+        got = reexpanded_root(n, br, c, e, ts, S1, M, hint, &lo, &hi);
+    if (got < 0)
         got = first_root_t(c, e, deg, ts, S1, M, &lo, &hi);
     if (got < 0) {
         k = -got;
@@ -257,6 +278,10 @@ static int leaf_range_cert(const rt_node *n, const ball_ray *br, double A, doubl
         return set_fail(out, k, lo);
     }
     if (got == 1) {
+        /* the interval, rounded outward, may reach past S1 .. M by a rounding: before t = 0, or into the band where
+         * the exact range may already have ended, the root is not known to be in range */
+        if (lo <= 0.0 || (hi > M && M < T))
+            return set_fail(out, RT_CERT_NOISE, lo);
         if (hi >= far_t * (1.0 - 1e-12))
             return set_fail(out, RT_CERT_FAR, lo);
         out->code = RT_CERT_HIT;
