@@ -170,21 +170,54 @@ static int classify(const ball *B, int n)
     return PIECE_OPEN;
 }
 
-/* The s-interval of the piece [j 2^-m, (j + 1) 2^-m] of [a, b], rounded outward. */
-static void piece_interval(double a, double b, int m, double j, double *lo, double *hi)
-{
-    double h = b - a, w = ldexp(1.0, -m), y0 = j * w, y1 = (j + 1.0) * w;
-    double s0 = a + h * y0, s1 = a + h * y1;
-    double slack = 4.0 * IG_ERR_U * (fabs(a) + fabs(h)) + IG_ERR_ETA;
-    *lo = s0 - slack;
-    *hi = s1 + slack;
-}
+/* The polynomial a walk works on: its coefficient balls, and whether its Taylor shifts are compensated. */
+typedef struct {
+    const double *c, *e;
+    int n, compensated;
+} poly;
 
+/* A piece: the Bernstein balls of exactly [lo, hi] (both doubles); fresh: computed from the coefficients, not
+ * by de Casteljau (whose radii only grow as pieces shrink). */
 typedef struct {
     ball B[IG_MAX_DEGREE + 1];
-    int depth;
-    double j;
+    double lo, hi;
+    int depth, fresh;
 } piece;
+
+static void form(const poly *P, piece *p)
+{
+    to_bernstein(P->c, P->e, P->n, p->lo, p->hi, P->compensated, p->B);
+    p->fresh = 1;
+}
+
+/* p cut in two: its left half stays in p, its right half goes to R. At the exact midpoint when that is a double
+ * (de Casteljau at y = 1/2), else at the double nearest it (both halves' forms from the coefficients). 0, with
+ * p unchanged, when no double lies strictly between the ends. */
+static int halve(const poly *P, piece *p, piece *R)
+{
+    double s, e, m;
+    ig_two_sum(p->lo, p->hi, &s, &e);
+    m = 0.5 * s;
+    if (e == 0.0 && 2.0 * m == s && m > p->lo && m < p->hi) {
+        split(p->B, P->n, p->B, R->B);
+        R->lo = m;
+        R->hi = p->hi;
+        p->hi = m;
+        R->depth = ++p->depth;
+        p->fresh = R->fresh = 0;
+        return 1;
+    }
+    m = 0.5 * p->lo + 0.5 * p->hi;
+    if (!(m > p->lo && m < p->hi))
+        return 0;
+    R->lo = m;
+    R->hi = p->hi;
+    p->hi = m;
+    R->depth = ++p->depth;
+    form(P, p);
+    form(P, R);
+    return 1;
+}
 
 /* Why a piece could not be decided: its end at a or b undecided (a root within the noise of the range's end),
  * or a root there that is not simple, or a cluster the depth cannot part. */
@@ -197,21 +230,15 @@ static int open_reason(const piece *p, int n, int first_piece, int last_piece)
 
 /* A piece holding one simple root cut down, half by half, to the half that holds it, until it is at most rel x
  * |origin + its start| wide (the caller's parameter is origin + s) or its halves no longer tell. */
-static void narrow(piece *p, int n, double a, double b, double origin, double rel)
+static void narrow(const poly *P, piece *p, double origin, double rel)
 {
-    while (p->depth < CERT_MAX_DEPTH) {
-        piece L, R;
-        double lo, hi;
+    while (p->depth < CERT_MAX_DEPTH && p->hi - p->lo > rel * fabs(origin + p->lo)) {
+        piece L = *p, R;
         int kl, kr;
-        piece_interval(a, b, p->depth, p->j, &lo, &hi);
-        if (hi - lo <= rel * fabs(origin + lo))
+        if (!halve(P, &L, &R))
             return;
-        split(p->B, n, L.B, R.B);
-        kl = classify(L.B, n);
-        kr = classify(R.B, n);
-        L.depth = R.depth = p->depth + 1;
-        L.j = 2.0 * p->j;
-        R.j = L.j + 1.0;
+        kl = classify(L.B, P->n);
+        kr = classify(R.B, P->n);
         if (kl == PIECE_ONE && kr == PIECE_EMPTY)
             *p = L;
         else if (kl == PIECE_EMPTY && kr == PIECE_ONE)
@@ -221,40 +248,48 @@ static void narrow(piece *p, int n, double a, double b, double origin, double re
     }
 }
 
+/* What a piece proves; an open piece deep enough whose form came by de Casteljau is formed afresh first. */
+static int piece_kind(const poly *P, piece *p)
+{
+    int kind = classify(p->B, P->n);
+    if (kind == PIECE_OPEN && !p->fresh && p->depth % 4 == 0) {
+        form(P, p);
+        kind = classify(p->B, P->n);
+    }
+    return kind;
+}
+
 /* Left-first walk over the pieces of [a, b]. max_roots: stop after that many root pieces. Writes the root
- * intervals; returns their count, or -code with lo[count] the start of the undecided piece. */
-static int walk(const double *c, const double *e, int n, double a, double b, int max_roots, double origin, double rel,
-                int compensated, double *lo, double *hi)
+ * intervals (each exactly a piece: no rounding); returns their count, or -code with lo[count] .. hi[count] the
+ * undecided piece. */
+static int walk(const poly *P, double a, double b, int max_roots, double origin, double rel, double *lo, double *hi)
 {
     piece stack[CERT_MAX_DEPTH + 2], cur;
     int sp = 0, found = 0, budget = CERT_BUDGET;
-    if (!(a <= b) || n < 0 || n > IG_MAX_DEGREE)
+    if (!(a <= b) || P->n < 0 || P->n > IG_MAX_DEGREE)
         return -RT_CERT_OVERFLOW;
-    to_bernstein(c, e, n, a, b, compensated, cur.B);
+    cur.lo = a;
+    cur.hi = b;
     cur.depth = 0;
-    cur.j = 0.0;
+    form(P, &cur);
     for (;;) {
-        int kind = classify(cur.B, n);
-        double last = ldexp(1.0, cur.depth) - 1.0;
+        int kind = piece_kind(P, &cur);
         if (kind == PIECE_BAD || kind == PIECE_OPEN) {
             int code = kind == PIECE_BAD ? RT_CERT_OVERFLOW : 0;
-            if (!code && (cur.depth >= CERT_MAX_DEPTH || --budget <= 0))
-                code = cur.depth >= CERT_MAX_DEPTH ? open_reason(&cur, n, cur.j == 0.0, cur.j == last) : RT_CERT_BUDGET;
+            if (!code && (cur.depth >= CERT_MAX_DEPTH || --budget <= 0 || !halve(P, &cur, &stack[sp])))
+                code = budget <= 0 ? RT_CERT_BUDGET : open_reason(&cur, P->n, cur.lo == a, cur.hi == b);
             if (code) {
-                piece_interval(a, b, cur.depth, cur.j, &lo[found], &hi[found]);
+                lo[found] = cur.lo;
+                hi[found] = cur.hi;
                 return -code;
             }
-            stack[sp].depth = cur.depth + 1;
-            stack[sp].j = 2.0 * cur.j + 1.0;
-            split(cur.B, n, cur.B, stack[sp].B);
             ++sp;
-            cur.depth += 1;
-            cur.j = 2.0 * cur.j;
             continue;
         }
         if (kind == PIECE_ONE) {
-            narrow(&cur, n, a, b, origin, rel);
-            piece_interval(a, b, cur.depth, cur.j, &lo[found], &hi[found]);
+            narrow(P, &cur, origin, rel);
+            lo[found] = cur.lo;
+            hi[found] = cur.hi;
             if (++found >= max_roots)
                 return found;
         }
@@ -294,12 +329,15 @@ int rt_certify_first_root(const double *c, const double *e, int n, double a, dou
                           double *lo, double *hi)
 {
     double l[2] = {a, a}, h[2] = {b, b};
+    poly P = {c, e, n, 0};
     int k = n == 1 ? line_root(c, e, a, b, lo, hi) : -1;
     if (k >= 0)
         return k;
-    k = walk(c, e, n, a, b, 1, origin, rel, 0, l, h);
-    if (k < 0 && k != -RT_CERT_OVERFLOW) /* the plain shift could not decide: again, compensated */
-        k = walk(c, e, n, a, b, 1, origin, rel, 1, l, h);
+    k = walk(&P, a, b, 1, origin, rel, l, h);
+    if (k < 0 && k != -RT_CERT_OVERFLOW) { /* the plain shift could not decide: again, compensated */
+        P.compensated = 1;
+        k = walk(&P, a, b, 1, origin, rel, l, h);
+    }
     *lo = l[0];
     *hi = k < 0 ? l[0] : h[0];
     return k;
@@ -309,14 +347,17 @@ int rt_certify_roots(const double *c, const double *e, int n, double a, double b
                      double *hi, int *sign_a)
 {
     ball B[IG_MAX_DEGREE + 1];
+    poly P = {c, e, n, 0};
     int k;
     if (!(a <= b) || n < 0 || n > IG_MAX_DEGREE)
         return -RT_CERT_OVERFLOW;
     to_bernstein(c, e, n, a, b, 1, B);
     *sign_a = b_sign(B[0]);
-    k = walk(c, e, n, a, b, n + 1, origin, rel, 0, lo, hi);
-    if (k < 0 && k != -RT_CERT_OVERFLOW)
-        k = walk(c, e, n, a, b, n + 1, origin, rel, 1, lo, hi);
+    k = walk(&P, a, b, n + 1, origin, rel, lo, hi);
+    if (k < 0 && k != -RT_CERT_OVERFLOW) {
+        P.compensated = 1;
+        k = walk(&P, a, b, n + 1, origin, rel, lo, hi);
+    }
     if (k >= 0 && *sign_a == 0)
         return -RT_CERT_NOISE;
     return k;
