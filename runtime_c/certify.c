@@ -260,7 +260,9 @@ static int leaf_range_cert(const rt_node *n, const ball_ray *br, double A, doubl
                            double hint, obj_cert *out)
 {
     double c[IG_MAX_DEGREE + 1], e[IG_MAX_DEGREE + 1], lo, hi;
-    double ts = ig_shape_shift_point(&n->prep, br->oo, br->od, A, T);
+    /* expanded about the tracer's root when there is one in range (f is smallest there, and so is its noise),
+     * else about shape.c's shift point */
+    double ts = hint > A && hint < T ? hint : ig_shape_shift_point(&n->prep, br->oo, br->od, A, T);
     int deg = n->shape->degree, got, k = shifted_coeffs(n, br, ts, c, e);
     if (k <= 0)
         return set_fail(out, k == 0 ? RT_CERT_NOBOUND : RT_CERT_OVERFLOW, A);

@@ -248,11 +248,24 @@ static void narrow(const poly *P, piece *p, double origin, double rel)
     }
 }
 
-/* What a piece proves; an open piece deep enough whose form came by de Casteljau is formed afresh first. */
+/* Do the balls' radii matter: some radius above 1e-3 of the largest centre? */
+static int noisy(const ball *B, int n)
+{
+    double m = 0.0, r = 0.0;
+    int i;
+    for (i = 0; i <= n; ++i) {
+        m = ig_max(m, fabs(B[i].m));
+        r = ig_max(r, B[i].r);
+    }
+    return r > 1e-3 * m;
+}
+
+/* What a piece proves; an open piece deep enough whose form came by de Casteljau, with radii that matter, is
+ * formed afresh first. */
 static int piece_kind(const poly *P, piece *p)
 {
     int kind = classify(p->B, P->n);
-    if (kind == PIECE_OPEN && !p->fresh && p->depth % 4 == 0) {
+    if (kind == PIECE_OPEN && !p->fresh && p->depth % 4 == 0 && noisy(p->B, P->n)) {
         form(P, p);
         kind = classify(p->B, P->n);
     }
