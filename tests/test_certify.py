@@ -280,3 +280,13 @@ def test_the_hard_set_is_certified_only_where_exactly_right(lib):
             certified += 1
             assert agrees(k, got, want), (i, k, got, [(r.value, r.mult) for r in want])
     assert certified >= len(c) // 3
+
+
+def test_a_degree_20_surface_seen_through_its_box_centre_is_certified():
+    """The spiky degree-20 surface: expanded about its box's centre, f's terms near the hit are a million times f,
+    and pieces cut by de Casteljau alone keep that noise; pieces formed afresh (and the expansion about the
+    tracer's root) certify the hit. This ray was `tangent` (not certified) before."""
+    sc = load_scene(ROOT / "bench" / "scenes" / "spiky20.yaml")
+    cs = CScene(sc, build_scene(sc))
+    got = check_pixels(sc, cs, sc.width, sc.height, [(342, 207), (335, 214), (342, 214)])
+    assert got.counts == {HIT: 3} and got.wrong == []
