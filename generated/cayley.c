@@ -5,6 +5,7 @@
  *   arithmetic operations: coeffs 36, value 10, gradient 9
  */
 #include "cayley.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -29,6 +30,109 @@ void cayley_coeffs(const double o[3], const double d[3], const double *params, d
     c[1] = dz*w0 + 2*dz*w1 + ox*w2 + oy*w3 + oz*w4;
     c[2] = dz*w4 + oz*w5 + dx*dx + dy*dy + dz*dz;
     c[3] = dz*w5;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int cayley_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                      const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double v0 = 2.0 * o[2];
+    const double e0 = ig_err_mul(2.0, 0.0, o[2], eo[2], v0);
+    const double w0 = v0;
+    const double w0_e = e0;
+    const double v1 = o[0] * o[1];
+    const double e1 = ig_err_mul(o[0], eo[0], o[1], eo[1], v1);
+    const double w1 = v1;
+    const double w1_e = e1;
+    const double v2 = 2.0 * d[0];
+    const double e2 = ig_err_mul(2.0, 0.0, d[0], ed[0], v2);
+    const double w2 = v2;
+    const double w2_e = e2;
+    const double v3 = 2.0 * d[1];
+    const double e3 = ig_err_mul(2.0, 0.0, d[1], ed[1], v3);
+    const double w3 = v3;
+    const double w3_e = e3;
+    const double v4 = o[0] * w3;
+    const double e4 = ig_err_mul(o[0], eo[0], w3, w3_e, v4);
+    const double v5 = o[1] * w2;
+    const double e5 = ig_err_mul(o[1], eo[1], w2, w2_e, v5);
+    const double v6 = v4 + v5;
+    const double e6 = ig_err_add(v4, e4, v5, e5, v6);
+    const double w4 = v6;
+    const double w4_e = e6;
+    const double v7 = d[1] * w2;
+    const double e7 = ig_err_mul(d[1], ed[1], w2, w2_e, v7);
+    const double w5 = v7;
+    const double w5_e = e7;
+    const double v8 = -1.0;
+    const double e8 = 0.0;
+    const double v9 = o[0] * o[0];
+    const double e9 = ig_err_mul(o[0], eo[0], o[0], eo[0], v9);
+    const double v10 = v8 + v9;
+    const double e10 = ig_err_add(v8, e8, v9, e9, v10);
+    const double v11 = o[1] * o[1];
+    const double e11 = ig_err_mul(o[1], eo[1], o[1], eo[1], v11);
+    const double v12 = v10 + v11;
+    const double e12 = ig_err_add(v10, e10, v11, e11, v12);
+    const double v13 = o[2] * o[2];
+    const double e13 = ig_err_mul(o[2], eo[2], o[2], eo[2], v13);
+    const double v14 = v12 + v13;
+    const double e14 = ig_err_add(v12, e12, v13, e13, v14);
+    const double v15 = w0 * w1;
+    const double e15 = ig_err_mul(w0, w0_e, w1, w1_e, v15);
+    const double v16 = v14 + v15;
+    const double e16 = ig_err_add(v14, e14, v15, e15, v16);
+    c[0] = v16;
+    e[0] = e16;
+    const double v17 = d[2] * w0;
+    const double e17 = ig_err_mul(d[2], ed[2], w0, w0_e, v17);
+    const double v18 = o[0] * w2;
+    const double e18 = ig_err_mul(o[0], eo[0], w2, w2_e, v18);
+    const double v19 = v17 + v18;
+    const double e19 = ig_err_add(v17, e17, v18, e18, v19);
+    const double v20 = o[1] * w3;
+    const double e20 = ig_err_mul(o[1], eo[1], w3, w3_e, v20);
+    const double v21 = v19 + v20;
+    const double e21 = ig_err_add(v19, e19, v20, e20, v21);
+    const double v22 = o[2] * w4;
+    const double e22 = ig_err_mul(o[2], eo[2], w4, w4_e, v22);
+    const double v23 = v21 + v22;
+    const double e23 = ig_err_add(v21, e21, v22, e22, v23);
+    const double v24 = 2.0 * d[2];
+    const double e24 = ig_err_mul(2.0, 0.0, d[2], ed[2], v24);
+    const double v25 = v24 * w1;
+    const double e25 = ig_err_mul(v24, e24, w1, w1_e, v25);
+    const double v26 = v23 + v25;
+    const double e26 = ig_err_add(v23, e23, v25, e25, v26);
+    c[1] = v26;
+    e[1] = e26;
+    const double v27 = d[0] * d[0];
+    const double e27 = ig_err_mul(d[0], ed[0], d[0], ed[0], v27);
+    const double v28 = d[1] * d[1];
+    const double e28 = ig_err_mul(d[1], ed[1], d[1], ed[1], v28);
+    const double v29 = v27 + v28;
+    const double e29 = ig_err_add(v27, e27, v28, e28, v29);
+    const double v30 = d[2] * d[2];
+    const double e30 = ig_err_mul(d[2], ed[2], d[2], ed[2], v30);
+    const double v31 = v29 + v30;
+    const double e31 = ig_err_add(v29, e29, v30, e30, v31);
+    const double v32 = d[2] * w4;
+    const double e32 = ig_err_mul(d[2], ed[2], w4, w4_e, v32);
+    const double v33 = v31 + v32;
+    const double e33 = ig_err_add(v31, e31, v32, e32, v33);
+    const double v34 = o[2] * w5;
+    const double e34 = ig_err_mul(o[2], eo[2], w5, w5_e, v34);
+    const double v35 = v33 + v34;
+    const double e35 = ig_err_add(v33, e33, v34, e34, v35);
+    c[2] = v35;
+    e[2] = e35;
+    const double v36 = d[2] * w5;
+    const double e36 = ig_err_mul(d[2], ed[2], w5, w5_e, v36);
+    c[3] = v36;
+    e[3] = e36;
+    return 1;
 }
 
 double cayley_value(const double p[3], const double *params)
@@ -73,7 +177,7 @@ int cayley_bounds(const double *params, double box[6])
 
 const ig_shape cayley_shape = {
     "cayley", CAYLEY_DEGREE, CAYLEY_NPARAMS,
-    cayley_coeffs, cayley_value, cayley_gradient, cayley_bounds
+    cayley_coeffs, cayley_value, cayley_gradient, cayley_bounds, cayley_coeffs_err
 };
 
 int cayley_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -5,6 +5,7 @@
  *   arithmetic operations: coeffs 58, value 15, gradient 15
  */
 #include "clebsch.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -25,6 +26,147 @@ void clebsch_coeffs(const double o[3], const double d[3], const double *params, 
     c[1] = 3*dx*(ox*ox) + 3*dy*(oy*oy) + 3*dz*(oz*oz) - 3*w1*w0*w0;
     c[2] = 3*ox*(dx*dx) + 3*oy*(dy*dy) + 3*oz*(dz*dz) - 3*w0*w1*w1;
     c[3] = dx*dx*dx + dy*dy*dy + dz*dz*dz - (w1*w1*w1);
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int clebsch_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                       const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double v0 = 1.0 + o[0];
+    const double e0 = ig_err_add(1.0, 0.0, o[0], eo[0], v0);
+    const double v1 = v0 + o[1];
+    const double e1 = ig_err_add(v0, e0, o[1], eo[1], v1);
+    const double v2 = v1 + o[2];
+    const double e2 = ig_err_add(v1, e1, o[2], eo[2], v2);
+    const double w0 = v2;
+    const double w0_e = e2;
+    const double v3 = d[0] + d[1];
+    const double e3 = ig_err_add(d[0], ed[0], d[1], ed[1], v3);
+    const double v4 = v3 + d[2];
+    const double e4 = ig_err_add(v3, e3, d[2], ed[2], v4);
+    const double w1 = v4;
+    const double w1_e = e4;
+    const double v5 = o[0] * o[0];
+    const double e5 = ig_err_mul(o[0], eo[0], o[0], eo[0], v5);
+    const double v6 = o[0] * v5;
+    const double e6 = ig_err_mul(o[0], eo[0], v5, e5, v6);
+    const double v7 = 1.0 + v6;
+    const double e7 = ig_err_add(1.0, 0.0, v6, e6, v7);
+    const double v8 = o[1] * o[1];
+    const double e8 = ig_err_mul(o[1], eo[1], o[1], eo[1], v8);
+    const double v9 = o[1] * v8;
+    const double e9 = ig_err_mul(o[1], eo[1], v8, e8, v9);
+    const double v10 = v7 + v9;
+    const double e10 = ig_err_add(v7, e7, v9, e9, v10);
+    const double v11 = o[2] * o[2];
+    const double e11 = ig_err_mul(o[2], eo[2], o[2], eo[2], v11);
+    const double v12 = o[2] * v11;
+    const double e12 = ig_err_mul(o[2], eo[2], v11, e11, v12);
+    const double v13 = v10 + v12;
+    const double e13 = ig_err_add(v10, e10, v12, e12, v13);
+    const double v14 = w0 * w0;
+    const double e14 = ig_err_mul(w0, w0_e, w0, w0_e, v14);
+    const double v15 = w0 * v14;
+    const double e15 = ig_err_mul(w0, w0_e, v14, e14, v15);
+    const double v16 = v13 - v15;
+    const double e16 = ig_err_add(v13, e13, v15, e15, v16);
+    c[0] = v16;
+    e[0] = e16;
+    const double v17 = 3.0 * w1;
+    const double e17 = ig_err_mul(3.0, 0.0, w1, w1_e, v17);
+    const double v18 = w0 * w0;
+    const double e18 = ig_err_mul(w0, w0_e, w0, w0_e, v18);
+    const double v19 = v17 * v18;
+    const double e19 = ig_err_mul(v17, e17, v18, e18, v19);
+    const double v20 = -v19;
+    const double e20 = e19;
+    const double v21 = 3.0 * d[0];
+    const double e21 = ig_err_mul(3.0, 0.0, d[0], ed[0], v21);
+    const double v22 = o[0] * o[0];
+    const double e22 = ig_err_mul(o[0], eo[0], o[0], eo[0], v22);
+    const double v23 = v21 * v22;
+    const double e23 = ig_err_mul(v21, e21, v22, e22, v23);
+    const double v24 = v20 + v23;
+    const double e24 = ig_err_add(v20, e20, v23, e23, v24);
+    const double v25 = 3.0 * d[1];
+    const double e25 = ig_err_mul(3.0, 0.0, d[1], ed[1], v25);
+    const double v26 = o[1] * o[1];
+    const double e26 = ig_err_mul(o[1], eo[1], o[1], eo[1], v26);
+    const double v27 = v25 * v26;
+    const double e27 = ig_err_mul(v25, e25, v26, e26, v27);
+    const double v28 = v24 + v27;
+    const double e28 = ig_err_add(v24, e24, v27, e27, v28);
+    const double v29 = 3.0 * d[2];
+    const double e29 = ig_err_mul(3.0, 0.0, d[2], ed[2], v29);
+    const double v30 = o[2] * o[2];
+    const double e30 = ig_err_mul(o[2], eo[2], o[2], eo[2], v30);
+    const double v31 = v29 * v30;
+    const double e31 = ig_err_mul(v29, e29, v30, e30, v31);
+    const double v32 = v28 + v31;
+    const double e32 = ig_err_add(v28, e28, v31, e31, v32);
+    c[1] = v32;
+    e[1] = e32;
+    const double v33 = 3.0 * w0;
+    const double e33 = ig_err_mul(3.0, 0.0, w0, w0_e, v33);
+    const double v34 = w1 * w1;
+    const double e34 = ig_err_mul(w1, w1_e, w1, w1_e, v34);
+    const double v35 = v33 * v34;
+    const double e35 = ig_err_mul(v33, e33, v34, e34, v35);
+    const double v36 = -v35;
+    const double e36 = e35;
+    const double v37 = 3.0 * o[0];
+    const double e37 = ig_err_mul(3.0, 0.0, o[0], eo[0], v37);
+    const double v38 = d[0] * d[0];
+    const double e38 = ig_err_mul(d[0], ed[0], d[0], ed[0], v38);
+    const double v39 = v37 * v38;
+    const double e39 = ig_err_mul(v37, e37, v38, e38, v39);
+    const double v40 = v36 + v39;
+    const double e40 = ig_err_add(v36, e36, v39, e39, v40);
+    const double v41 = 3.0 * o[1];
+    const double e41 = ig_err_mul(3.0, 0.0, o[1], eo[1], v41);
+    const double v42 = d[1] * d[1];
+    const double e42 = ig_err_mul(d[1], ed[1], d[1], ed[1], v42);
+    const double v43 = v41 * v42;
+    const double e43 = ig_err_mul(v41, e41, v42, e42, v43);
+    const double v44 = v40 + v43;
+    const double e44 = ig_err_add(v40, e40, v43, e43, v44);
+    const double v45 = 3.0 * o[2];
+    const double e45 = ig_err_mul(3.0, 0.0, o[2], eo[2], v45);
+    const double v46 = d[2] * d[2];
+    const double e46 = ig_err_mul(d[2], ed[2], d[2], ed[2], v46);
+    const double v47 = v45 * v46;
+    const double e47 = ig_err_mul(v45, e45, v46, e46, v47);
+    const double v48 = v44 + v47;
+    const double e48 = ig_err_add(v44, e44, v47, e47, v48);
+    c[2] = v48;
+    e[2] = e48;
+    const double v49 = d[0] * d[0];
+    const double e49 = ig_err_mul(d[0], ed[0], d[0], ed[0], v49);
+    const double v50 = d[0] * v49;
+    const double e50 = ig_err_mul(d[0], ed[0], v49, e49, v50);
+    const double v51 = d[1] * d[1];
+    const double e51 = ig_err_mul(d[1], ed[1], d[1], ed[1], v51);
+    const double v52 = d[1] * v51;
+    const double e52 = ig_err_mul(d[1], ed[1], v51, e51, v52);
+    const double v53 = v50 + v52;
+    const double e53 = ig_err_add(v50, e50, v52, e52, v53);
+    const double v54 = d[2] * d[2];
+    const double e54 = ig_err_mul(d[2], ed[2], d[2], ed[2], v54);
+    const double v55 = d[2] * v54;
+    const double e55 = ig_err_mul(d[2], ed[2], v54, e54, v55);
+    const double v56 = v53 + v55;
+    const double e56 = ig_err_add(v53, e53, v55, e55, v56);
+    const double v57 = w1 * w1;
+    const double e57 = ig_err_mul(w1, w1_e, w1, w1_e, v57);
+    const double v58 = w1 * v57;
+    const double e58 = ig_err_mul(w1, w1_e, v57, e57, v58);
+    const double v59 = v56 - v58;
+    const double e59 = ig_err_add(v56, e56, v58, e58, v59);
+    c[3] = v59;
+    e[3] = e59;
+    return 1;
 }
 
 double clebsch_value(const double p[3], const double *params)
@@ -67,7 +209,7 @@ int clebsch_bounds(const double *params, double box[6])
 
 const ig_shape clebsch_shape = {
     "clebsch", CLEBSCH_DEGREE, CLEBSCH_NPARAMS,
-    clebsch_coeffs, clebsch_value, clebsch_gradient, clebsch_bounds
+    clebsch_coeffs, clebsch_value, clebsch_gradient, clebsch_bounds, clebsch_coeffs_err
 };
 
 int clebsch_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -5,6 +5,7 @@
  *   arithmetic operations: coeffs 18, value 5, gradient 4
  */
 #include "cone.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -22,6 +23,59 @@ void cone_coeffs(const double o[3], const double d[3], const double *params, dou
     c[0] = ox*ox + oy*oy - (oz*oz);
     c[1] = 2*dx*ox + 2*dy*oy - 2*dz*oz;
     c[2] = dx*dx + dy*dy - (dz*dz);
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int cone_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                    const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double v0 = o[0] * o[0];
+    const double e0 = ig_err_mul(o[0], eo[0], o[0], eo[0], v0);
+    const double v1 = o[1] * o[1];
+    const double e1 = ig_err_mul(o[1], eo[1], o[1], eo[1], v1);
+    const double v2 = v0 + v1;
+    const double e2 = ig_err_add(v0, e0, v1, e1, v2);
+    const double v3 = o[2] * o[2];
+    const double e3 = ig_err_mul(o[2], eo[2], o[2], eo[2], v3);
+    const double v4 = v2 - v3;
+    const double e4 = ig_err_add(v2, e2, v3, e3, v4);
+    c[0] = v4;
+    e[0] = e4;
+    const double v5 = 2.0 * d[2];
+    const double e5 = ig_err_mul(2.0, 0.0, d[2], ed[2], v5);
+    const double v6 = v5 * o[2];
+    const double e6 = ig_err_mul(v5, e5, o[2], eo[2], v6);
+    const double v7 = -v6;
+    const double e7 = e6;
+    const double v8 = 2.0 * d[0];
+    const double e8 = ig_err_mul(2.0, 0.0, d[0], ed[0], v8);
+    const double v9 = v8 * o[0];
+    const double e9 = ig_err_mul(v8, e8, o[0], eo[0], v9);
+    const double v10 = v7 + v9;
+    const double e10 = ig_err_add(v7, e7, v9, e9, v10);
+    const double v11 = 2.0 * d[1];
+    const double e11 = ig_err_mul(2.0, 0.0, d[1], ed[1], v11);
+    const double v12 = v11 * o[1];
+    const double e12 = ig_err_mul(v11, e11, o[1], eo[1], v12);
+    const double v13 = v10 + v12;
+    const double e13 = ig_err_add(v10, e10, v12, e12, v13);
+    c[1] = v13;
+    e[1] = e13;
+    const double v14 = d[0] * d[0];
+    const double e14 = ig_err_mul(d[0], ed[0], d[0], ed[0], v14);
+    const double v15 = d[1] * d[1];
+    const double e15 = ig_err_mul(d[1], ed[1], d[1], ed[1], v15);
+    const double v16 = v14 + v15;
+    const double e16 = ig_err_add(v14, e14, v15, e15, v16);
+    const double v17 = d[2] * d[2];
+    const double e17 = ig_err_mul(d[2], ed[2], d[2], ed[2], v17);
+    const double v18 = v16 - v17;
+    const double e18 = ig_err_add(v16, e16, v17, e17, v18);
+    c[2] = v18;
+    e[2] = e18;
+    return 1;
 }
 
 double cone_value(const double p[3], const double *params)
@@ -56,7 +110,7 @@ int cone_bounds(const double *params, double box[6])
 
 const ig_shape cone_shape = {
     "cone", CONE_DEGREE, CONE_NPARAMS,
-    cone_coeffs, cone_value, cone_gradient, cone_bounds
+    cone_coeffs, cone_value, cone_gradient, cone_bounds, cone_coeffs_err
 };
 
 int cone_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -6,6 +6,7 @@
  *   arithmetic operations: coeffs 14, value 6, gradient 2
  */
 #include "cylinder.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -23,6 +24,52 @@ void cylinder_coeffs(const double o[3], const double d[3], const double *params,
     c[0] = w0 + ox*ox + oz*oz;
     c[1] = 2*dx*ox + 2*dz*oz;
     c[2] = dx*dx + dz*dz;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int cylinder_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                        const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double k_r = params[0];
+    const double v0 = k_r * k_r;
+    const double e0 = ig_err_mul(k_r, 0.0, k_r, 0.0, v0);
+    const double v1 = -v0;
+    const double e1 = e0;
+    const double w0 = v1;
+    const double w0_e = e1;
+    const double v2 = o[0] * o[0];
+    const double e2 = ig_err_mul(o[0], eo[0], o[0], eo[0], v2);
+    const double v3 = w0 + v2;
+    const double e3 = ig_err_add(w0, w0_e, v2, e2, v3);
+    const double v4 = o[2] * o[2];
+    const double e4 = ig_err_mul(o[2], eo[2], o[2], eo[2], v4);
+    const double v5 = v3 + v4;
+    const double e5 = ig_err_add(v3, e3, v4, e4, v5);
+    c[0] = v5;
+    e[0] = e5;
+    const double v6 = 2.0 * d[0];
+    const double e6 = ig_err_mul(2.0, 0.0, d[0], ed[0], v6);
+    const double v7 = v6 * o[0];
+    const double e7 = ig_err_mul(v6, e6, o[0], eo[0], v7);
+    const double v8 = 2.0 * d[2];
+    const double e8 = ig_err_mul(2.0, 0.0, d[2], ed[2], v8);
+    const double v9 = v8 * o[2];
+    const double e9 = ig_err_mul(v8, e8, o[2], eo[2], v9);
+    const double v10 = v7 + v9;
+    const double e10 = ig_err_add(v7, e7, v9, e9, v10);
+    c[1] = v10;
+    e[1] = e10;
+    const double v11 = d[0] * d[0];
+    const double e11 = ig_err_mul(d[0], ed[0], d[0], ed[0], v11);
+    const double v12 = d[2] * d[2];
+    const double e12 = ig_err_mul(d[2], ed[2], d[2], ed[2], v12);
+    const double v13 = v11 + v12;
+    const double e13 = ig_err_add(v11, e11, v12, e12, v13);
+    c[2] = v13;
+    e[2] = e13;
+    return 1;
 }
 
 double cylinder_value(const double p[3], const double *params)
@@ -64,7 +111,7 @@ int cylinder_bounds(const double *params, double box[6])
 
 const ig_shape cylinder_shape = {
     "cylinder", CYLINDER_DEGREE, CYLINDER_NPARAMS,
-    cylinder_coeffs, cylinder_value, cylinder_gradient, cylinder_bounds
+    cylinder_coeffs, cylinder_value, cylinder_gradient, cylinder_bounds, cylinder_coeffs_err
 };
 
 int cylinder_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -5,6 +5,7 @@
  *   arithmetic operations: coeffs 29, value 8, gradient 6
  */
 #include "dingdong.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -25,6 +26,87 @@ void dingdong_coeffs(const double o[3], const double d[3], const double *params,
     c[1] = 2*dx*ox + 2*dy*oy - 2*dz*oz + 3*dz*w0;
     c[2] = 3*oz*w1 - w1 + dx*dx + dy*dy;
     c[3] = dz*dz*dz;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int dingdong_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                        const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double v0 = o[2] * o[2];
+    const double e0 = ig_err_mul(o[2], eo[2], o[2], eo[2], v0);
+    const double w0 = v0;
+    const double w0_e = e0;
+    const double v1 = d[2] * d[2];
+    const double e1 = ig_err_mul(d[2], ed[2], d[2], ed[2], v1);
+    const double w1 = v1;
+    const double w1_e = e1;
+    const double v2 = o[0] * o[0];
+    const double e2 = ig_err_mul(o[0], eo[0], o[0], eo[0], v2);
+    const double v3 = o[1] * o[1];
+    const double e3 = ig_err_mul(o[1], eo[1], o[1], eo[1], v3);
+    const double v4 = v2 + v3;
+    const double e4 = ig_err_add(v2, e2, v3, e3, v4);
+    const double v5 = o[2] * o[2];
+    const double e5 = ig_err_mul(o[2], eo[2], o[2], eo[2], v5);
+    const double v6 = o[2] * v5;
+    const double e6 = ig_err_mul(o[2], eo[2], v5, e5, v6);
+    const double v7 = v4 + v6;
+    const double e7 = ig_err_add(v4, e4, v6, e6, v7);
+    const double v8 = v7 - w0;
+    const double e8 = ig_err_add(v7, e7, w0, w0_e, v8);
+    c[0] = v8;
+    e[0] = e8;
+    const double v9 = 2.0 * d[2];
+    const double e9 = ig_err_mul(2.0, 0.0, d[2], ed[2], v9);
+    const double v10 = v9 * o[2];
+    const double e10 = ig_err_mul(v9, e9, o[2], eo[2], v10);
+    const double v11 = -v10;
+    const double e11 = e10;
+    const double v12 = 2.0 * d[0];
+    const double e12 = ig_err_mul(2.0, 0.0, d[0], ed[0], v12);
+    const double v13 = v12 * o[0];
+    const double e13 = ig_err_mul(v12, e12, o[0], eo[0], v13);
+    const double v14 = v11 + v13;
+    const double e14 = ig_err_add(v11, e11, v13, e13, v14);
+    const double v15 = 2.0 * d[1];
+    const double e15 = ig_err_mul(2.0, 0.0, d[1], ed[1], v15);
+    const double v16 = v15 * o[1];
+    const double e16 = ig_err_mul(v15, e15, o[1], eo[1], v16);
+    const double v17 = v14 + v16;
+    const double e17 = ig_err_add(v14, e14, v16, e16, v17);
+    const double v18 = 3.0 * d[2];
+    const double e18 = ig_err_mul(3.0, 0.0, d[2], ed[2], v18);
+    const double v19 = v18 * w0;
+    const double e19 = ig_err_mul(v18, e18, w0, w0_e, v19);
+    const double v20 = v17 + v19;
+    const double e20 = ig_err_add(v17, e17, v19, e19, v20);
+    c[1] = v20;
+    e[1] = e20;
+    const double v21 = d[0] * d[0];
+    const double e21 = ig_err_mul(d[0], ed[0], d[0], ed[0], v21);
+    const double v22 = d[1] * d[1];
+    const double e22 = ig_err_mul(d[1], ed[1], d[1], ed[1], v22);
+    const double v23 = v21 + v22;
+    const double e23 = ig_err_add(v21, e21, v22, e22, v23);
+    const double v24 = v23 - w1;
+    const double e24 = ig_err_add(v23, e23, w1, w1_e, v24);
+    const double v25 = 3.0 * o[2];
+    const double e25 = ig_err_mul(3.0, 0.0, o[2], eo[2], v25);
+    const double v26 = v25 * w1;
+    const double e26 = ig_err_mul(v25, e25, w1, w1_e, v26);
+    const double v27 = v24 + v26;
+    const double e27 = ig_err_add(v24, e24, v26, e26, v27);
+    c[2] = v27;
+    e[2] = e27;
+    const double v28 = d[2] * d[2];
+    const double e28 = ig_err_mul(d[2], ed[2], d[2], ed[2], v28);
+    const double v29 = d[2] * v28;
+    const double e29 = ig_err_mul(d[2], ed[2], v28, e28, v29);
+    c[3] = v29;
+    e[3] = e29;
+    return 1;
 }
 
 double dingdong_value(const double p[3], const double *params)
@@ -66,7 +148,7 @@ int dingdong_bounds(const double *params, double box[6])
 
 const ig_shape dingdong_shape = {
     "dingdong", DINGDONG_DEGREE, DINGDONG_NPARAMS,
-    dingdong_coeffs, dingdong_value, dingdong_gradient, dingdong_bounds
+    dingdong_coeffs, dingdong_value, dingdong_gradient, dingdong_bounds, dingdong_coeffs_err
 };
 
 int dingdong_intersect(const double o[3], const double d[3], double tmin, double tmax,

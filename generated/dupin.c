@@ -6,6 +6,7 @@
  *   arithmetic operations: coeffs 56, value 24, gradient 30
  */
 #include "dupin.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -43,6 +44,172 @@ void dupin_coeffs(const double o[3], const double d[3], const double *params, do
     c[2] = -w12*w8 - w13*w7 + 2*w14*w4 + w10*w10;
     c[3] = 2*w10*w14;
     c[4] = w14*w14;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int dupin_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                     const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double k_a = params[0];
+    const double k_c = params[1];
+    const double k_d = params[2];
+    const double v0 = o[1] * o[1];
+    const double e0 = ig_err_mul(o[1], eo[1], o[1], eo[1], v0);
+    const double w0 = v0;
+    const double w0_e = e0;
+    const double v1 = k_a * k_a;
+    const double e1 = ig_err_mul(k_a, 0.0, k_a, 0.0, v1);
+    const double w1 = v1;
+    const double w1_e = e1;
+    const double v2 = k_c * k_c;
+    const double e2 = ig_err_mul(k_c, 0.0, k_c, 0.0, v2);
+    const double w2 = v2;
+    const double w2_e = e2;
+    const double v3 = w1 - w2;
+    const double e3 = ig_err_add(w1, w1_e, w2, w2_e, v3);
+    const double v4 = k_d * k_d;
+    const double e4 = ig_err_mul(k_d, 0.0, k_d, 0.0, v4);
+    const double v5 = v3 - v4;
+    const double e5 = ig_err_add(v3, e3, v4, e4, v5);
+    const double w3 = v5;
+    const double w3_e = e5;
+    const double v6 = w0 + w3;
+    const double e6 = ig_err_add(w0, w0_e, w3, w3_e, v6);
+    const double v7 = o[0] * o[0];
+    const double e7 = ig_err_mul(o[0], eo[0], o[0], eo[0], v7);
+    const double v8 = v6 + v7;
+    const double e8 = ig_err_add(v6, e6, v7, e7, v8);
+    const double v9 = o[2] * o[2];
+    const double e9 = ig_err_mul(o[2], eo[2], o[2], eo[2], v9);
+    const double v10 = v8 + v9;
+    const double e10 = ig_err_add(v8, e8, v9, e9, v10);
+    const double w4 = v10;
+    const double w4_e = e10;
+    const double v11 = k_c * k_d;
+    const double e11 = ig_err_mul(k_c, 0.0, k_d, 0.0, v11);
+    const double v12 = -v11;
+    const double e12 = e11;
+    const double w5 = v12;
+    const double w5_e = e12;
+    const double v13 = k_a * o[0];
+    const double e13 = ig_err_mul(k_a, 0.0, o[0], eo[0], v13);
+    const double v14 = w5 + v13;
+    const double e14 = ig_err_add(w5, w5_e, v13, e13, v14);
+    const double w6 = v14;
+    const double w6_e = e14;
+    const double v15 = 4.0 * w1;
+    const double e15 = ig_err_mul(4.0, 0.0, w1, w1_e, v15);
+    const double w7 = v15;
+    const double w7_e = e15;
+    const double v16 = 4.0 * w2;
+    const double e16 = ig_err_mul(4.0, 0.0, w2, w2_e, v16);
+    const double v17 = w7 - v16;
+    const double e17 = ig_err_add(w7, w7_e, v16, e16, v17);
+    const double w8 = v17;
+    const double w8_e = e17;
+    const double v18 = 2.0 * d[1];
+    const double e18 = ig_err_mul(2.0, 0.0, d[1], ed[1], v18);
+    const double v19 = v18 * o[1];
+    const double e19 = ig_err_mul(v18, e18, o[1], eo[1], v19);
+    const double w9 = v19;
+    const double w9_e = e19;
+    const double v20 = 2.0 * d[0];
+    const double e20 = ig_err_mul(2.0, 0.0, d[0], ed[0], v20);
+    const double v21 = v20 * o[0];
+    const double e21 = ig_err_mul(v20, e20, o[0], eo[0], v21);
+    const double v22 = w9 + v21;
+    const double e22 = ig_err_add(w9, w9_e, v21, e21, v22);
+    const double v23 = 2.0 * d[2];
+    const double e23 = ig_err_mul(2.0, 0.0, d[2], ed[2], v23);
+    const double v24 = v23 * o[2];
+    const double e24 = ig_err_mul(v23, e23, o[2], eo[2], v24);
+    const double v25 = v22 + v24;
+    const double e25 = ig_err_add(v22, e22, v24, e24, v25);
+    const double w10 = v25;
+    const double w10_e = e25;
+    const double v26 = 8.0 * k_a;
+    const double e26 = ig_err_mul(8.0, 0.0, k_a, 0.0, v26);
+    const double w11 = v26;
+    const double w11_e = e26;
+    const double v27 = d[1] * d[1];
+    const double e27 = ig_err_mul(d[1], ed[1], d[1], ed[1], v27);
+    const double w12 = v27;
+    const double w12_e = e27;
+    const double v28 = d[0] * d[0];
+    const double e28 = ig_err_mul(d[0], ed[0], d[0], ed[0], v28);
+    const double w13 = v28;
+    const double w13_e = e28;
+    const double v29 = w12 + w13;
+    const double e29 = ig_err_add(w12, w12_e, w13, w13_e, v29);
+    const double v30 = d[2] * d[2];
+    const double e30 = ig_err_mul(d[2], ed[2], d[2], ed[2], v30);
+    const double v31 = v29 + v30;
+    const double e31 = ig_err_add(v29, e29, v30, e30, v31);
+    const double w14 = v31;
+    const double w14_e = e31;
+    const double v32 = w4 * w4;
+    const double e32 = ig_err_mul(w4, w4_e, w4, w4_e, v32);
+    const double v33 = w6 * w6;
+    const double e33 = ig_err_mul(w6, w6_e, w6, w6_e, v33);
+    const double v34 = 4.0 * v33;
+    const double e34 = ig_err_mul(4.0, 0.0, v33, e33, v34);
+    const double v35 = v32 - v34;
+    const double e35 = ig_err_add(v32, e32, v34, e34, v35);
+    const double v36 = w0 * w8;
+    const double e36 = ig_err_mul(w0, w0_e, w8, w8_e, v36);
+    const double v37 = v35 - v36;
+    const double e37 = ig_err_add(v35, e35, v36, e36, v37);
+    c[0] = v37;
+    e[0] = e37;
+    const double v38 = w8 * w9;
+    const double e38 = ig_err_mul(w8, w8_e, w9, w9_e, v38);
+    const double v39 = -v38;
+    const double e39 = e38;
+    const double v40 = 2.0 * w10;
+    const double e40 = ig_err_mul(2.0, 0.0, w10, w10_e, v40);
+    const double v41 = v40 * w4;
+    const double e41 = ig_err_mul(v40, e40, w4, w4_e, v41);
+    const double v42 = v39 + v41;
+    const double e42 = ig_err_add(v39, e39, v41, e41, v42);
+    const double v43 = d[0] * w11;
+    const double e43 = ig_err_mul(d[0], ed[0], w11, w11_e, v43);
+    const double v44 = v43 * w6;
+    const double e44 = ig_err_mul(v43, e43, w6, w6_e, v44);
+    const double v45 = v42 - v44;
+    const double e45 = ig_err_add(v42, e42, v44, e44, v45);
+    c[1] = v45;
+    e[1] = e45;
+    const double v46 = w10 * w10;
+    const double e46 = ig_err_mul(w10, w10_e, w10, w10_e, v46);
+    const double v47 = w12 * w8;
+    const double e47 = ig_err_mul(w12, w12_e, w8, w8_e, v47);
+    const double v48 = v46 - v47;
+    const double e48 = ig_err_add(v46, e46, v47, e47, v48);
+    const double v49 = w13 * w7;
+    const double e49 = ig_err_mul(w13, w13_e, w7, w7_e, v49);
+    const double v50 = v48 - v49;
+    const double e50 = ig_err_add(v48, e48, v49, e49, v50);
+    const double v51 = 2.0 * w14;
+    const double e51 = ig_err_mul(2.0, 0.0, w14, w14_e, v51);
+    const double v52 = v51 * w4;
+    const double e52 = ig_err_mul(v51, e51, w4, w4_e, v52);
+    const double v53 = v50 + v52;
+    const double e53 = ig_err_add(v50, e50, v52, e52, v53);
+    c[2] = v53;
+    e[2] = e53;
+    const double v54 = 2.0 * w10;
+    const double e54 = ig_err_mul(2.0, 0.0, w10, w10_e, v54);
+    const double v55 = v54 * w14;
+    const double e55 = ig_err_mul(v54, e54, w14, w14_e, v55);
+    c[3] = v55;
+    e[3] = e55;
+    const double v56 = w14 * w14;
+    const double e56 = ig_err_mul(w14, w14_e, w14, w14_e, v56);
+    c[4] = v56;
+    e[4] = e56;
+    return 1;
 }
 
 double dupin_value(const double p[3], const double *params)
@@ -113,7 +280,7 @@ int dupin_bounds(const double *params, double box[6])
 
 const ig_shape dupin_shape = {
     "dupin", DUPIN_DEGREE, DUPIN_NPARAMS,
-    dupin_coeffs, dupin_value, dupin_gradient, dupin_bounds
+    dupin_coeffs, dupin_value, dupin_gradient, dupin_bounds, dupin_coeffs_err
 };
 
 int dupin_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -6,6 +6,7 @@
  *   arithmetic operations: coeffs 83, value 16, gradient 26
  */
 #include "goursat.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -51,6 +52,240 @@ void goursat_coeffs(const double o[3], const double d[3], const double *params, 
     c[2] = k_a*(w10*w5 + w4*w4) + k_b*w10 + 6*w0*w7 + 6*w1*w8 + 6*w2*w9;
     c[3] = 4*dx*ox*q0 + 4*dy*oy*q2 + 4*dz*oz*q4 + 2*w10*w6;
     c[4] = k_a*(w10*w10) + q1 + q3 + q5;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int goursat_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                       const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double k_a = params[0];
+    const double k_b = params[1];
+    const double k_c = params[2];
+    const double v0 = d[0] * d[0];
+    const double e0 = ig_err_mul(d[0], ed[0], d[0], ed[0], v0);
+    const double q0 = v0;
+    const double q0_e = e0;
+    const double v1 = q0 * q0;
+    const double e1 = ig_err_mul(q0, q0_e, q0, q0_e, v1);
+    const double q1 = v1;
+    const double q1_e = e1;
+    const double v2 = d[1] * d[1];
+    const double e2 = ig_err_mul(d[1], ed[1], d[1], ed[1], v2);
+    const double q2 = v2;
+    const double q2_e = e2;
+    const double v3 = q2 * q2;
+    const double e3 = ig_err_mul(q2, q2_e, q2, q2_e, v3);
+    const double q3 = v3;
+    const double q3_e = e3;
+    const double v4 = d[2] * d[2];
+    const double e4 = ig_err_mul(d[2], ed[2], d[2], ed[2], v4);
+    const double q4 = v4;
+    const double q4_e = e4;
+    const double v5 = q4 * q4;
+    const double e5 = ig_err_mul(q4, q4_e, q4, q4_e, v5);
+    const double q5 = v5;
+    const double q5_e = e5;
+    const double v6 = o[0] * o[0];
+    const double e6 = ig_err_mul(o[0], eo[0], o[0], eo[0], v6);
+    const double q6 = v6;
+    const double q6_e = e6;
+    const double v7 = q6 * q6;
+    const double e7 = ig_err_mul(q6, q6_e, q6, q6_e, v7);
+    const double q7 = v7;
+    const double q7_e = e7;
+    const double v8 = o[1] * o[1];
+    const double e8 = ig_err_mul(o[1], eo[1], o[1], eo[1], v8);
+    const double q8 = v8;
+    const double q8_e = e8;
+    const double v9 = q8 * q8;
+    const double e9 = ig_err_mul(q8, q8_e, q8, q8_e, v9);
+    const double q9 = v9;
+    const double q9_e = e9;
+    const double v10 = o[2] * o[2];
+    const double e10 = ig_err_mul(o[2], eo[2], o[2], eo[2], v10);
+    const double q10 = v10;
+    const double q10_e = e10;
+    const double v11 = q10 * q10;
+    const double e11 = ig_err_mul(q10, q10_e, q10, q10_e, v11);
+    const double q11 = v11;
+    const double q11_e = e11;
+    const double w0 = q6;
+    const double w0_e = q6_e;
+    const double w1 = q8;
+    const double w1_e = q8_e;
+    const double w2 = q10;
+    const double w2_e = q10_e;
+    const double v12 = w0 + w1;
+    const double e12 = ig_err_add(w0, w0_e, w1, w1_e, v12);
+    const double v13 = v12 + w2;
+    const double e13 = ig_err_add(v12, e12, w2, w2_e, v13);
+    const double w3 = v13;
+    const double w3_e = e13;
+    const double v14 = 2.0 * d[0];
+    const double e14 = ig_err_mul(2.0, 0.0, d[0], ed[0], v14);
+    const double v15 = v14 * o[0];
+    const double e15 = ig_err_mul(v14, e14, o[0], eo[0], v15);
+    const double v16 = 2.0 * d[1];
+    const double e16 = ig_err_mul(2.0, 0.0, d[1], ed[1], v16);
+    const double v17 = v16 * o[1];
+    const double e17 = ig_err_mul(v16, e16, o[1], eo[1], v17);
+    const double v18 = v15 + v17;
+    const double e18 = ig_err_add(v15, e15, v17, e17, v18);
+    const double v19 = 2.0 * d[2];
+    const double e19 = ig_err_mul(2.0, 0.0, d[2], ed[2], v19);
+    const double v20 = v19 * o[2];
+    const double e20 = ig_err_mul(v19, e19, o[2], eo[2], v20);
+    const double v21 = v18 + v20;
+    const double e21 = ig_err_add(v18, e18, v20, e20, v21);
+    const double w4 = v21;
+    const double w4_e = e21;
+    const double v22 = 2.0 * w3;
+    const double e22 = ig_err_mul(2.0, 0.0, w3, w3_e, v22);
+    const double w5 = v22;
+    const double w5_e = e22;
+    const double v23 = k_a * w4;
+    const double e23 = ig_err_mul(k_a, 0.0, w4, w4_e, v23);
+    const double w6 = v23;
+    const double w6_e = e23;
+    const double w7 = q0;
+    const double w7_e = q0_e;
+    const double w8 = q2;
+    const double w8_e = q2_e;
+    const double w9 = q4;
+    const double w9_e = q4_e;
+    const double v24 = w7 + w8;
+    const double e24 = ig_err_add(w7, w7_e, w8, w8_e, v24);
+    const double v25 = v24 + w9;
+    const double e25 = ig_err_add(v24, e24, w9, w9_e, v25);
+    const double w10 = v25;
+    const double w10_e = e25;
+    const double v26 = k_c + q11;
+    const double e26 = ig_err_add(k_c, 0.0, q11, q11_e, v26);
+    const double v27 = v26 + q7;
+    const double e27 = ig_err_add(v26, e26, q7, q7_e, v27);
+    const double v28 = v27 + q9;
+    const double e28 = ig_err_add(v27, e27, q9, q9_e, v28);
+    const double v29 = w3 * w3;
+    const double e29 = ig_err_mul(w3, w3_e, w3, w3_e, v29);
+    const double v30 = k_a * v29;
+    const double e30 = ig_err_mul(k_a, 0.0, v29, e29, v30);
+    const double v31 = v28 + v30;
+    const double e31 = ig_err_add(v28, e28, v30, e30, v31);
+    const double v32 = k_b * w3;
+    const double e32 = ig_err_mul(k_b, 0.0, w3, w3_e, v32);
+    const double v33 = v31 + v32;
+    const double e33 = ig_err_add(v31, e31, v32, e32, v33);
+    c[0] = v33;
+    e[0] = e33;
+    const double v34 = k_b * w4;
+    const double e34 = ig_err_mul(k_b, 0.0, w4, w4_e, v34);
+    const double v35 = w5 * w6;
+    const double e35 = ig_err_mul(w5, w5_e, w6, w6_e, v35);
+    const double v36 = v34 + v35;
+    const double e36 = ig_err_add(v34, e34, v35, e35, v36);
+    const double v37 = 4.0 * d[0];
+    const double e37 = ig_err_mul(4.0, 0.0, d[0], ed[0], v37);
+    const double v38 = v37 * o[0];
+    const double e38 = ig_err_mul(v37, e37, o[0], eo[0], v38);
+    const double v39 = v38 * q6;
+    const double e39 = ig_err_mul(v38, e38, q6, q6_e, v39);
+    const double v40 = v36 + v39;
+    const double e40 = ig_err_add(v36, e36, v39, e39, v40);
+    const double v41 = 4.0 * d[1];
+    const double e41 = ig_err_mul(4.0, 0.0, d[1], ed[1], v41);
+    const double v42 = v41 * o[1];
+    const double e42 = ig_err_mul(v41, e41, o[1], eo[1], v42);
+    const double v43 = v42 * q8;
+    const double e43 = ig_err_mul(v42, e42, q8, q8_e, v43);
+    const double v44 = v40 + v43;
+    const double e44 = ig_err_add(v40, e40, v43, e43, v44);
+    const double v45 = 4.0 * d[2];
+    const double e45 = ig_err_mul(4.0, 0.0, d[2], ed[2], v45);
+    const double v46 = v45 * o[2];
+    const double e46 = ig_err_mul(v45, e45, o[2], eo[2], v46);
+    const double v47 = v46 * q10;
+    const double e47 = ig_err_mul(v46, e46, q10, q10_e, v47);
+    const double v48 = v44 + v47;
+    const double e48 = ig_err_add(v44, e44, v47, e47, v48);
+    c[1] = v48;
+    e[1] = e48;
+    const double v49 = w4 * w4;
+    const double e49 = ig_err_mul(w4, w4_e, w4, w4_e, v49);
+    const double v50 = w10 * w5;
+    const double e50 = ig_err_mul(w10, w10_e, w5, w5_e, v50);
+    const double v51 = v49 + v50;
+    const double e51 = ig_err_add(v49, e49, v50, e50, v51);
+    const double v52 = k_a * v51;
+    const double e52 = ig_err_mul(k_a, 0.0, v51, e51, v52);
+    const double v53 = k_b * w10;
+    const double e53 = ig_err_mul(k_b, 0.0, w10, w10_e, v53);
+    const double v54 = v52 + v53;
+    const double e54 = ig_err_add(v52, e52, v53, e53, v54);
+    const double v55 = 6.0 * w0;
+    const double e55 = ig_err_mul(6.0, 0.0, w0, w0_e, v55);
+    const double v56 = v55 * w7;
+    const double e56 = ig_err_mul(v55, e55, w7, w7_e, v56);
+    const double v57 = v54 + v56;
+    const double e57 = ig_err_add(v54, e54, v56, e56, v57);
+    const double v58 = 6.0 * w1;
+    const double e58 = ig_err_mul(6.0, 0.0, w1, w1_e, v58);
+    const double v59 = v58 * w8;
+    const double e59 = ig_err_mul(v58, e58, w8, w8_e, v59);
+    const double v60 = v57 + v59;
+    const double e60 = ig_err_add(v57, e57, v59, e59, v60);
+    const double v61 = 6.0 * w2;
+    const double e61 = ig_err_mul(6.0, 0.0, w2, w2_e, v61);
+    const double v62 = v61 * w9;
+    const double e62 = ig_err_mul(v61, e61, w9, w9_e, v62);
+    const double v63 = v60 + v62;
+    const double e63 = ig_err_add(v60, e60, v62, e62, v63);
+    c[2] = v63;
+    e[2] = e63;
+    const double v64 = 2.0 * w10;
+    const double e64 = ig_err_mul(2.0, 0.0, w10, w10_e, v64);
+    const double v65 = v64 * w6;
+    const double e65 = ig_err_mul(v64, e64, w6, w6_e, v65);
+    const double v66 = 4.0 * d[0];
+    const double e66 = ig_err_mul(4.0, 0.0, d[0], ed[0], v66);
+    const double v67 = v66 * o[0];
+    const double e67 = ig_err_mul(v66, e66, o[0], eo[0], v67);
+    const double v68 = v67 * q0;
+    const double e68 = ig_err_mul(v67, e67, q0, q0_e, v68);
+    const double v69 = v65 + v68;
+    const double e69 = ig_err_add(v65, e65, v68, e68, v69);
+    const double v70 = 4.0 * d[1];
+    const double e70 = ig_err_mul(4.0, 0.0, d[1], ed[1], v70);
+    const double v71 = v70 * o[1];
+    const double e71 = ig_err_mul(v70, e70, o[1], eo[1], v71);
+    const double v72 = v71 * q2;
+    const double e72 = ig_err_mul(v71, e71, q2, q2_e, v72);
+    const double v73 = v69 + v72;
+    const double e73 = ig_err_add(v69, e69, v72, e72, v73);
+    const double v74 = 4.0 * d[2];
+    const double e74 = ig_err_mul(4.0, 0.0, d[2], ed[2], v74);
+    const double v75 = v74 * o[2];
+    const double e75 = ig_err_mul(v74, e74, o[2], eo[2], v75);
+    const double v76 = v75 * q4;
+    const double e76 = ig_err_mul(v75, e75, q4, q4_e, v76);
+    const double v77 = v73 + v76;
+    const double e77 = ig_err_add(v73, e73, v76, e76, v77);
+    c[3] = v77;
+    e[3] = e77;
+    const double v78 = q1 + q3;
+    const double e78 = ig_err_add(q1, q1_e, q3, q3_e, v78);
+    const double v79 = v78 + q5;
+    const double e79 = ig_err_add(v78, e78, q5, q5_e, v79);
+    const double v80 = w10 * w10;
+    const double e80 = ig_err_mul(w10, w10_e, w10, w10_e, v80);
+    const double v81 = k_a * v80;
+    const double e81 = ig_err_mul(k_a, 0.0, v80, e80, v81);
+    const double v82 = v79 + v81;
+    const double e82 = ig_err_add(v79, e79, v81, e81, v82);
+    c[4] = v82;
+    e[4] = e82;
+    return 1;
 }
 
 double goursat_value(const double p[3], const double *params)
@@ -108,7 +343,7 @@ int goursat_bounds(const double *params, double box[6])
 
 const ig_shape goursat_shape = {
     "goursat", GOURSAT_DEGREE, GOURSAT_NPARAMS,
-    goursat_coeffs, goursat_value, goursat_gradient, goursat_bounds
+    goursat_coeffs, goursat_value, goursat_gradient, goursat_bounds, goursat_coeffs_err
 };
 
 int goursat_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -14,6 +14,9 @@
 
 /* c[0..HEART_DEGREE] of f(o + t d), lowest power first; d need not be unit length. */
 void heart_coeffs(const double o[3], const double d[3], const double *params, double *c);
+/* the same with a rigorous bound e[k] on each c[k]'s error, for o and d known within eo and ed (docs/certify.md) */
+int heart_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                     const double *params, double *c, double *e);
 /* f(p) */
 double heart_value(const double p[3], const double *params);
 /* grad f(p), not normalised */

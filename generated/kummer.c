@@ -6,6 +6,7 @@
  *   arithmetic operations: coeffs 83, value 24, gradient 40
  */
 #include "kummer.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -56,6 +57,256 @@ void kummer_coeffs(const double o[3], const double d[3], const double *params, d
     c[2] = w11*w26 + w14*w28 + w17*w27 + w5*(w18*w24 + w19*w19);
     c[3] = w14*w29 + 2*w20*w24 + w26*w28;
     c[4] = w26*w29 + w5*(w24*w24);
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int kummer_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                      const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double k_mu = params[0];
+    const double v0 = o[0] * o[0];
+    const double e0 = ig_err_mul(o[0], eo[0], o[0], eo[0], v0);
+    const double w0 = v0;
+    const double w0_e = e0;
+    const double v1 = o[1] * o[1];
+    const double e1 = ig_err_mul(o[1], eo[1], o[1], eo[1], v1);
+    const double w1 = v1;
+    const double w1_e = e1;
+    const double v2 = k_mu * k_mu;
+    const double e2 = ig_err_mul(k_mu, 0.0, k_mu, 0.0, v2);
+    const double w2 = v2;
+    const double w2_e = e2;
+    const double v3 = -w2;
+    const double e3 = w2_e;
+    const double w3 = v3;
+    const double w3_e = e3;
+    const double v4 = w0 + w1;
+    const double e4 = ig_err_add(w0, w0_e, w1, w1_e, v4);
+    const double v5 = v4 + w3;
+    const double e5 = ig_err_add(v4, e4, w3, w3_e, v5);
+    const double v6 = o[2] * o[2];
+    const double e6 = ig_err_mul(o[2], eo[2], o[2], eo[2], v6);
+    const double v7 = v5 + v6;
+    const double e7 = ig_err_add(v5, e5, v6, e6, v7);
+    const double w4 = v7;
+    const double w4_e = e7;
+    const double v8 = 3.0 - w2;
+    const double e8 = ig_err_add(3.0, 0.0, w2, w2_e, v8);
+    const double w5 = v8;
+    const double w5_e = e8;
+    const double v9 = 1.0 - o[2];
+    const double e9 = ig_err_add(1.0, 0.0, o[2], eo[2], v9);
+    const double w6 = v9;
+    const double w6_e = e9;
+    const double v10 = w6 * w6;
+    const double e10 = ig_err_mul(w6, w6_e, w6, w6_e, v10);
+    const double v11 = 2.0 * w0;
+    const double e11 = ig_err_mul(2.0, 0.0, w0, w0_e, v11);
+    const double v12 = v10 - v11;
+    const double e12 = ig_err_add(v10, e10, v11, e11, v12);
+    const double w7 = v12;
+    const double w7_e = e12;
+    const double v13 = -1.0;
+    const double e13 = 0.0;
+    const double v14 = 3.0 * w2;
+    const double e14 = ig_err_mul(3.0, 0.0, w2, w2_e, v14);
+    const double v15 = v13 + v14;
+    const double e15 = ig_err_add(v13, e13, v14, e14, v15);
+    const double w8 = v15;
+    const double w8_e = e15;
+    const double v16 = -w8;
+    const double e16 = w8_e;
+    const double w9 = v16;
+    const double w9_e = e16;
+    const double v17 = 1.0 + o[2];
+    const double e17 = ig_err_add(1.0, 0.0, o[2], eo[2], v17);
+    const double w10 = v17;
+    const double w10_e = e17;
+    const double v18 = w10 * w10;
+    const double e18 = ig_err_mul(w10, w10_e, w10, w10_e, v18);
+    const double v19 = 2.0 * w1;
+    const double e19 = ig_err_mul(2.0, 0.0, w1, w1_e, v19);
+    const double v20 = v18 - v19;
+    const double e20 = ig_err_add(v18, e18, v19, e19, v20);
+    const double v21 = w9 * v20;
+    const double e21 = ig_err_mul(w9, w9_e, v20, e20, v21);
+    const double w11 = v21;
+    const double w11_e = e21;
+    const double v22 = 2.0 * d[2];
+    const double e22 = ig_err_mul(2.0, 0.0, d[2], ed[2], v22);
+    const double w12 = v22;
+    const double w12_e = e22;
+    const double v23 = d[0] * o[0];
+    const double e23 = ig_err_mul(d[0], ed[0], o[0], eo[0], v23);
+    const double w13 = v23;
+    const double w13_e = e23;
+    const double v24 = 4.0 * w13;
+    const double e24 = ig_err_mul(4.0, 0.0, w13, w13_e, v24);
+    const double v25 = -v24;
+    const double e25 = e24;
+    const double v26 = w12 * w6;
+    const double e26 = ig_err_mul(w12, w12_e, w6, w6_e, v26);
+    const double v27 = v25 - v26;
+    const double e27 = ig_err_add(v25, e25, v26, e26, v27);
+    const double w14 = v27;
+    const double w14_e = e27;
+    const double v28 = d[1] * o[1];
+    const double e28 = ig_err_mul(d[1], ed[1], o[1], eo[1], v28);
+    const double w15 = v28;
+    const double w15_e = e28;
+    const double v29 = 4.0 * w15;
+    const double e29 = ig_err_mul(4.0, 0.0, w15, w15_e, v29);
+    const double v30 = -v29;
+    const double e30 = e29;
+    const double v31 = 2.0 * d[2];
+    const double e31 = ig_err_mul(2.0, 0.0, d[2], ed[2], v31);
+    const double v32 = v31 * w10;
+    const double e32 = ig_err_mul(v31, e31, w10, w10_e, v32);
+    const double v33 = v30 + v32;
+    const double e33 = ig_err_add(v30, e30, v32, e32, v33);
+    const double w16 = v33;
+    const double w16_e = e33;
+    const double v34 = w7 * w9;
+    const double e34 = ig_err_mul(w7, w7_e, w9, w9_e, v34);
+    const double w17 = v34;
+    const double w17_e = e34;
+    const double v35 = 2.0 * w4;
+    const double e35 = ig_err_mul(2.0, 0.0, w4, w4_e, v35);
+    const double w18 = v35;
+    const double w18_e = e35;
+    const double v36 = 2.0 * w13;
+    const double e36 = ig_err_mul(2.0, 0.0, w13, w13_e, v36);
+    const double v37 = 2.0 * w15;
+    const double e37 = ig_err_mul(2.0, 0.0, w15, w15_e, v37);
+    const double v38 = v36 + v37;
+    const double e38 = ig_err_add(v36, e36, v37, e37, v38);
+    const double v39 = o[2] * w12;
+    const double e39 = ig_err_mul(o[2], eo[2], w12, w12_e, v39);
+    const double v40 = v38 + v39;
+    const double e40 = ig_err_add(v38, e38, v39, e39, v40);
+    const double w19 = v40;
+    const double w19_e = e40;
+    const double v41 = w19 * w5;
+    const double e41 = ig_err_mul(w19, w19_e, w5, w5_e, v41);
+    const double w20 = v41;
+    const double w20_e = e41;
+    const double v42 = d[0] * d[0];
+    const double e42 = ig_err_mul(d[0], ed[0], d[0], ed[0], v42);
+    const double w21 = v42;
+    const double w21_e = e42;
+    const double v43 = d[1] * d[1];
+    const double e43 = ig_err_mul(d[1], ed[1], d[1], ed[1], v43);
+    const double w22 = v43;
+    const double w22_e = e43;
+    const double v44 = d[2] * d[2];
+    const double e44 = ig_err_mul(d[2], ed[2], d[2], ed[2], v44);
+    const double w23 = v44;
+    const double w23_e = e44;
+    const double v45 = w21 + w22;
+    const double e45 = ig_err_add(w21, w21_e, w22, w22_e, v45);
+    const double v46 = v45 + w23;
+    const double e46 = ig_err_add(v45, e45, w23, w23_e, v46);
+    const double w24 = v46;
+    const double w24_e = e46;
+    const double v47 = -w23;
+    const double e47 = w23_e;
+    const double w25 = v47;
+    const double w25_e = e47;
+    const double v48 = -w25;
+    const double e48 = w25_e;
+    const double v49 = 2.0 * w21;
+    const double e49 = ig_err_mul(2.0, 0.0, w21, w21_e, v49);
+    const double v50 = v48 - v49;
+    const double e50 = ig_err_add(v48, e48, v49, e49, v50);
+    const double w26 = v50;
+    const double w26_e = e50;
+    const double v51 = -w25;
+    const double e51 = w25_e;
+    const double v52 = 2.0 * w22;
+    const double e52 = ig_err_mul(2.0, 0.0, w22, w22_e, v52);
+    const double v53 = v51 - v52;
+    const double e53 = ig_err_add(v51, e51, v52, e52, v53);
+    const double w27 = v53;
+    const double w27_e = e53;
+    const double v54 = w16 * w9;
+    const double e54 = ig_err_mul(w16, w16_e, w9, w9_e, v54);
+    const double w28 = v54;
+    const double w28_e = e54;
+    const double v55 = w27 * w9;
+    const double e55 = ig_err_mul(w27, w27_e, w9, w9_e, v55);
+    const double w29 = v55;
+    const double w29_e = e55;
+    const double v56 = w11 * w7;
+    const double e56 = ig_err_mul(w11, w11_e, w7, w7_e, v56);
+    const double v57 = w4 * w4;
+    const double e57 = ig_err_mul(w4, w4_e, w4, w4_e, v57);
+    const double v58 = w5 * v57;
+    const double e58 = ig_err_mul(w5, w5_e, v57, e57, v58);
+    const double v59 = v56 + v58;
+    const double e59 = ig_err_add(v56, e56, v58, e58, v59);
+    c[0] = v59;
+    e[0] = e59;
+    const double v60 = w11 * w14;
+    const double e60 = ig_err_mul(w11, w11_e, w14, w14_e, v60);
+    const double v61 = w16 * w17;
+    const double e61 = ig_err_mul(w16, w16_e, w17, w17_e, v61);
+    const double v62 = v60 + v61;
+    const double e62 = ig_err_add(v60, e60, v61, e61, v62);
+    const double v63 = w18 * w20;
+    const double e63 = ig_err_mul(w18, w18_e, w20, w20_e, v63);
+    const double v64 = v62 + v63;
+    const double e64 = ig_err_add(v62, e62, v63, e63, v64);
+    c[1] = v64;
+    e[1] = e64;
+    const double v65 = w11 * w26;
+    const double e65 = ig_err_mul(w11, w11_e, w26, w26_e, v65);
+    const double v66 = w14 * w28;
+    const double e66 = ig_err_mul(w14, w14_e, w28, w28_e, v66);
+    const double v67 = v65 + v66;
+    const double e67 = ig_err_add(v65, e65, v66, e66, v67);
+    const double v68 = w17 * w27;
+    const double e68 = ig_err_mul(w17, w17_e, w27, w27_e, v68);
+    const double v69 = v67 + v68;
+    const double e69 = ig_err_add(v67, e67, v68, e68, v69);
+    const double v70 = w19 * w19;
+    const double e70 = ig_err_mul(w19, w19_e, w19, w19_e, v70);
+    const double v71 = w18 * w24;
+    const double e71 = ig_err_mul(w18, w18_e, w24, w24_e, v71);
+    const double v72 = v70 + v71;
+    const double e72 = ig_err_add(v70, e70, v71, e71, v72);
+    const double v73 = w5 * v72;
+    const double e73 = ig_err_mul(w5, w5_e, v72, e72, v73);
+    const double v74 = v69 + v73;
+    const double e74 = ig_err_add(v69, e69, v73, e73, v74);
+    c[2] = v74;
+    e[2] = e74;
+    const double v75 = w14 * w29;
+    const double e75 = ig_err_mul(w14, w14_e, w29, w29_e, v75);
+    const double v76 = w26 * w28;
+    const double e76 = ig_err_mul(w26, w26_e, w28, w28_e, v76);
+    const double v77 = v75 + v76;
+    const double e77 = ig_err_add(v75, e75, v76, e76, v77);
+    const double v78 = 2.0 * w20;
+    const double e78 = ig_err_mul(2.0, 0.0, w20, w20_e, v78);
+    const double v79 = v78 * w24;
+    const double e79 = ig_err_mul(v78, e78, w24, w24_e, v79);
+    const double v80 = v77 + v79;
+    const double e80 = ig_err_add(v77, e77, v79, e79, v80);
+    c[3] = v80;
+    e[3] = e80;
+    const double v81 = w26 * w29;
+    const double e81 = ig_err_mul(w26, w26_e, w29, w29_e, v81);
+    const double v82 = w24 * w24;
+    const double e82 = ig_err_mul(w24, w24_e, w24, w24_e, v82);
+    const double v83 = w5 * v82;
+    const double e83 = ig_err_mul(w5, w5_e, v82, e82, v83);
+    const double v84 = v81 + v83;
+    const double e84 = ig_err_add(v81, e81, v83, e83, v84);
+    c[4] = v84;
+    e[4] = e84;
+    return 1;
 }
 
 double kummer_value(const double p[3], const double *params)
@@ -120,7 +371,7 @@ int kummer_bounds(const double *params, double box[6])
 
 const ig_shape kummer_shape = {
     "kummer", KUMMER_DEGREE, KUMMER_NPARAMS,
-    kummer_coeffs, kummer_value, kummer_gradient, kummer_bounds
+    kummer_coeffs, kummer_value, kummer_gradient, kummer_bounds, kummer_coeffs_err
 };
 
 int kummer_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -5,6 +5,7 @@
  *   arithmetic operations: coeffs 30, value 7, gradient 7
  */
 #include "monkey_saddle.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -27,6 +28,93 @@ void monkey_saddle_coeffs(const double o[3], const double d[3], const double *pa
     c[1] = dx*w0 - 3*dx*ox*ox + dz + ox*w1;
     c[2] = dx*w1 + w2*w3 - w2*dx*dx;
     c[3] = 3*dx*w3 - (dx*dx*dx);
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int monkey_saddle_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                             const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double v0 = o[1] * o[1];
+    const double e0 = ig_err_mul(o[1], eo[1], o[1], eo[1], v0);
+    const double v1 = 3.0 * v0;
+    const double e1 = ig_err_mul(3.0, 0.0, v0, e0, v1);
+    const double w0 = v1;
+    const double w0_e = e1;
+    const double v2 = 6.0 * d[1];
+    const double e2 = ig_err_mul(6.0, 0.0, d[1], ed[1], v2);
+    const double v3 = v2 * o[1];
+    const double e3 = ig_err_mul(v2, e2, o[1], eo[1], v3);
+    const double w1 = v3;
+    const double w1_e = e3;
+    const double v4 = 3.0 * o[0];
+    const double e4 = ig_err_mul(3.0, 0.0, o[0], eo[0], v4);
+    const double w2 = v4;
+    const double w2_e = e4;
+    const double v5 = d[1] * d[1];
+    const double e5 = ig_err_mul(d[1], ed[1], d[1], ed[1], v5);
+    const double w3 = v5;
+    const double w3_e = e5;
+    const double v6 = o[0] * o[0];
+    const double e6 = ig_err_mul(o[0], eo[0], o[0], eo[0], v6);
+    const double v7 = o[0] * v6;
+    const double e7 = ig_err_mul(o[0], eo[0], v6, e6, v7);
+    const double v8 = o[2] - v7;
+    const double e8 = ig_err_add(o[2], eo[2], v7, e7, v8);
+    const double v9 = o[0] * w0;
+    const double e9 = ig_err_mul(o[0], eo[0], w0, w0_e, v9);
+    const double v10 = v8 + v9;
+    const double e10 = ig_err_add(v8, e8, v9, e9, v10);
+    c[0] = v10;
+    e[0] = e10;
+    const double v11 = d[0] * w0;
+    const double e11 = ig_err_mul(d[0], ed[0], w0, w0_e, v11);
+    const double v12 = d[2] + v11;
+    const double e12 = ig_err_add(d[2], ed[2], v11, e11, v12);
+    const double v13 = o[0] * w1;
+    const double e13 = ig_err_mul(o[0], eo[0], w1, w1_e, v13);
+    const double v14 = v12 + v13;
+    const double e14 = ig_err_add(v12, e12, v13, e13, v14);
+    const double v15 = 3.0 * d[0];
+    const double e15 = ig_err_mul(3.0, 0.0, d[0], ed[0], v15);
+    const double v16 = o[0] * o[0];
+    const double e16 = ig_err_mul(o[0], eo[0], o[0], eo[0], v16);
+    const double v17 = v15 * v16;
+    const double e17 = ig_err_mul(v15, e15, v16, e16, v17);
+    const double v18 = v14 - v17;
+    const double e18 = ig_err_add(v14, e14, v17, e17, v18);
+    c[1] = v18;
+    e[1] = e18;
+    const double v19 = d[0] * w1;
+    const double e19 = ig_err_mul(d[0], ed[0], w1, w1_e, v19);
+    const double v20 = w2 * w3;
+    const double e20 = ig_err_mul(w2, w2_e, w3, w3_e, v20);
+    const double v21 = v19 + v20;
+    const double e21 = ig_err_add(v19, e19, v20, e20, v21);
+    const double v22 = d[0] * d[0];
+    const double e22 = ig_err_mul(d[0], ed[0], d[0], ed[0], v22);
+    const double v23 = w2 * v22;
+    const double e23 = ig_err_mul(w2, w2_e, v22, e22, v23);
+    const double v24 = v21 - v23;
+    const double e24 = ig_err_add(v21, e21, v23, e23, v24);
+    c[2] = v24;
+    e[2] = e24;
+    const double v25 = d[0] * d[0];
+    const double e25 = ig_err_mul(d[0], ed[0], d[0], ed[0], v25);
+    const double v26 = d[0] * v25;
+    const double e26 = ig_err_mul(d[0], ed[0], v25, e25, v26);
+    const double v27 = -v26;
+    const double e27 = e26;
+    const double v28 = 3.0 * d[0];
+    const double e28 = ig_err_mul(3.0, 0.0, d[0], ed[0], v28);
+    const double v29 = v28 * w3;
+    const double e29 = ig_err_mul(v28, e28, w3, w3_e, v29);
+    const double v30 = v27 + v29;
+    const double e30 = ig_err_add(v27, e27, v29, e29, v30);
+    c[3] = v30;
+    e[3] = e30;
+    return 1;
 }
 
 double monkey_saddle_value(const double p[3], const double *params)
@@ -67,7 +155,7 @@ int monkey_saddle_bounds(const double *params, double box[6])
 
 const ig_shape monkey_saddle_shape = {
     "monkey_saddle", MONKEY_SADDLE_DEGREE, MONKEY_SADDLE_NPARAMS,
-    monkey_saddle_coeffs, monkey_saddle_value, monkey_saddle_gradient, monkey_saddle_bounds
+    monkey_saddle_coeffs, monkey_saddle_value, monkey_saddle_gradient, monkey_saddle_bounds, monkey_saddle_coeffs_err
 };
 
 int monkey_saddle_intersect(const double o[3], const double d[3], double tmin, double tmax,

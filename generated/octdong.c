@@ -6,6 +6,7 @@
  *   arithmetic operations: coeffs 36, value 10, gradient 9
  */
 #include "octdong.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -34,6 +35,116 @@ void octdong_coeffs(const double o[3], const double d[3], const double *params, 
     c[2] = 6*w0*w3 + w2*(-w3 + dx*dx + dy*dy);
     c[3] = 4*dz*oz*q0;
     c[4] = q1;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int octdong_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                       const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double k_a = params[0];
+    const double v0 = d[2] * d[2];
+    const double e0 = ig_err_mul(d[2], ed[2], d[2], ed[2], v0);
+    const double q0 = v0;
+    const double q0_e = e0;
+    const double v1 = q0 * q0;
+    const double e1 = ig_err_mul(q0, q0_e, q0, q0_e, v1);
+    const double q1 = v1;
+    const double q1_e = e1;
+    const double v2 = o[2] * o[2];
+    const double e2 = ig_err_mul(o[2], eo[2], o[2], eo[2], v2);
+    const double q2 = v2;
+    const double q2_e = e2;
+    const double v3 = q2 * q2;
+    const double e3 = ig_err_mul(q2, q2_e, q2, q2_e, v3);
+    const double q3 = v3;
+    const double q3_e = e3;
+    const double w0 = q2;
+    const double w0_e = q2_e;
+    const double v4 = k_a * k_a;
+    const double e4 = ig_err_mul(k_a, 0.0, k_a, 0.0, v4);
+    const double w1 = v4;
+    const double w1_e = e4;
+    const double v5 = 4.0 * w1;
+    const double e5 = ig_err_mul(4.0, 0.0, w1, w1_e, v5);
+    const double w2 = v5;
+    const double w2_e = e5;
+    const double w3 = q0;
+    const double w3_e = q0_e;
+    const double v6 = o[0] * o[0];
+    const double e6 = ig_err_mul(o[0], eo[0], o[0], eo[0], v6);
+    const double v7 = o[1] * o[1];
+    const double e7 = ig_err_mul(o[1], eo[1], o[1], eo[1], v7);
+    const double v8 = v6 + v7;
+    const double e8 = ig_err_add(v6, e6, v7, e7, v8);
+    const double v9 = v8 - w0;
+    const double e9 = ig_err_add(v8, e8, w0, w0_e, v9);
+    const double v10 = w2 * v9;
+    const double e10 = ig_err_mul(w2, w2_e, v9, e9, v10);
+    const double v11 = q3 + v10;
+    const double e11 = ig_err_add(q3, q3_e, v10, e10, v11);
+    c[0] = v11;
+    e[0] = e11;
+    const double v12 = 2.0 * d[2];
+    const double e12 = ig_err_mul(2.0, 0.0, d[2], ed[2], v12);
+    const double v13 = v12 * o[2];
+    const double e13 = ig_err_mul(v12, e12, o[2], eo[2], v13);
+    const double v14 = -v13;
+    const double e14 = e13;
+    const double v15 = 2.0 * d[0];
+    const double e15 = ig_err_mul(2.0, 0.0, d[0], ed[0], v15);
+    const double v16 = v15 * o[0];
+    const double e16 = ig_err_mul(v15, e15, o[0], eo[0], v16);
+    const double v17 = v14 + v16;
+    const double e17 = ig_err_add(v14, e14, v16, e16, v17);
+    const double v18 = 2.0 * d[1];
+    const double e18 = ig_err_mul(2.0, 0.0, d[1], ed[1], v18);
+    const double v19 = v18 * o[1];
+    const double e19 = ig_err_mul(v18, e18, o[1], eo[1], v19);
+    const double v20 = v17 + v19;
+    const double e20 = ig_err_add(v17, e17, v19, e19, v20);
+    const double v21 = w2 * v20;
+    const double e21 = ig_err_mul(w2, w2_e, v20, e20, v21);
+    const double v22 = 4.0 * d[2];
+    const double e22 = ig_err_mul(4.0, 0.0, d[2], ed[2], v22);
+    const double v23 = v22 * o[2];
+    const double e23 = ig_err_mul(v22, e22, o[2], eo[2], v23);
+    const double v24 = v23 * q2;
+    const double e24 = ig_err_mul(v23, e23, q2, q2_e, v24);
+    const double v25 = v21 + v24;
+    const double e25 = ig_err_add(v21, e21, v24, e24, v25);
+    c[1] = v25;
+    e[1] = e25;
+    const double v26 = d[0] * d[0];
+    const double e26 = ig_err_mul(d[0], ed[0], d[0], ed[0], v26);
+    const double v27 = d[1] * d[1];
+    const double e27 = ig_err_mul(d[1], ed[1], d[1], ed[1], v27);
+    const double v28 = v26 + v27;
+    const double e28 = ig_err_add(v26, e26, v27, e27, v28);
+    const double v29 = v28 - w3;
+    const double e29 = ig_err_add(v28, e28, w3, w3_e, v29);
+    const double v30 = w2 * v29;
+    const double e30 = ig_err_mul(w2, w2_e, v29, e29, v30);
+    const double v31 = 6.0 * w0;
+    const double e31 = ig_err_mul(6.0, 0.0, w0, w0_e, v31);
+    const double v32 = v31 * w3;
+    const double e32 = ig_err_mul(v31, e31, w3, w3_e, v32);
+    const double v33 = v30 + v32;
+    const double e33 = ig_err_add(v30, e30, v32, e32, v33);
+    c[2] = v33;
+    e[2] = e33;
+    const double v34 = 4.0 * d[2];
+    const double e34 = ig_err_mul(4.0, 0.0, d[2], ed[2], v34);
+    const double v35 = v34 * o[2];
+    const double e35 = ig_err_mul(v34, e34, o[2], eo[2], v35);
+    const double v36 = v35 * q0;
+    const double e36 = ig_err_mul(v35, e35, q0, q0_e, v36);
+    c[3] = v36;
+    e[3] = e36;
+    c[4] = q1;
+    e[4] = q1_e;
+    return 1;
 }
 
 double octdong_value(const double p[3], const double *params)
@@ -86,7 +197,7 @@ int octdong_bounds(const double *params, double box[6])
 
 const ig_shape octdong_shape = {
     "octdong", OCTDONG_DEGREE, OCTDONG_NPARAMS,
-    octdong_coeffs, octdong_value, octdong_gradient, octdong_bounds
+    octdong_coeffs, octdong_value, octdong_gradient, octdong_bounds, octdong_coeffs_err
 };
 
 int octdong_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -5,6 +5,7 @@
  *   arithmetic operations: coeffs 34, value 8, gradient 7
  */
 #include "piriform.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -32,6 +33,113 @@ void piriform_coeffs(const double o[3], const double d[3], const double *params,
     c[2] = -3*ox*w2 + 6*w1*w2 + dy*dy + dz*dz;
     c[3] = 4*ox*w3 - w3;
     c[4] = q1;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int piriform_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                        const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double v0 = d[0] * d[0];
+    const double e0 = ig_err_mul(d[0], ed[0], d[0], ed[0], v0);
+    const double q0 = v0;
+    const double q0_e = e0;
+    const double v1 = q0 * q0;
+    const double e1 = ig_err_mul(q0, q0_e, q0, q0_e, v1);
+    const double q1 = v1;
+    const double q1_e = e1;
+    const double v2 = o[0] * o[0];
+    const double e2 = ig_err_mul(o[0], eo[0], o[0], eo[0], v2);
+    const double q2 = v2;
+    const double q2_e = e2;
+    const double v3 = q2 * q2;
+    const double e3 = ig_err_mul(q2, q2_e, q2, q2_e, v3);
+    const double q3 = v3;
+    const double q3_e = e3;
+    const double v4 = o[0] * q2;
+    const double e4 = ig_err_mul(o[0], eo[0], q2, q2_e, v4);
+    const double w0 = v4;
+    const double w0_e = e4;
+    const double w1 = q2;
+    const double w1_e = q2_e;
+    const double w2 = q0;
+    const double w2_e = q0_e;
+    const double v5 = d[0] * q0;
+    const double e5 = ig_err_mul(d[0], ed[0], q0, q0_e, v5);
+    const double w3 = v5;
+    const double w3_e = e5;
+    const double v6 = o[1] * o[1];
+    const double e6 = ig_err_mul(o[1], eo[1], o[1], eo[1], v6);
+    const double v7 = q3 + v6;
+    const double e7 = ig_err_add(q3, q3_e, v6, e6, v7);
+    const double v8 = o[2] * o[2];
+    const double e8 = ig_err_mul(o[2], eo[2], o[2], eo[2], v8);
+    const double v9 = v7 + v8;
+    const double e9 = ig_err_add(v7, e7, v8, e8, v9);
+    const double v10 = v9 - w0;
+    const double e10 = ig_err_add(v9, e9, w0, w0_e, v10);
+    c[0] = v10;
+    e[0] = e10;
+    const double v11 = 3.0 * d[0];
+    const double e11 = ig_err_mul(3.0, 0.0, d[0], ed[0], v11);
+    const double v12 = v11 * w1;
+    const double e12 = ig_err_mul(v11, e11, w1, w1_e, v12);
+    const double v13 = -v12;
+    const double e13 = e12;
+    const double v14 = 2.0 * d[1];
+    const double e14 = ig_err_mul(2.0, 0.0, d[1], ed[1], v14);
+    const double v15 = v14 * o[1];
+    const double e15 = ig_err_mul(v14, e14, o[1], eo[1], v15);
+    const double v16 = v13 + v15;
+    const double e16 = ig_err_add(v13, e13, v15, e15, v16);
+    const double v17 = 2.0 * d[2];
+    const double e17 = ig_err_mul(2.0, 0.0, d[2], ed[2], v17);
+    const double v18 = v17 * o[2];
+    const double e18 = ig_err_mul(v17, e17, o[2], eo[2], v18);
+    const double v19 = v16 + v18;
+    const double e19 = ig_err_add(v16, e16, v18, e18, v19);
+    const double v20 = 4.0 * d[0];
+    const double e20 = ig_err_mul(4.0, 0.0, d[0], ed[0], v20);
+    const double v21 = v20 * w0;
+    const double e21 = ig_err_mul(v20, e20, w0, w0_e, v21);
+    const double v22 = v19 + v21;
+    const double e22 = ig_err_add(v19, e19, v21, e21, v22);
+    c[1] = v22;
+    e[1] = e22;
+    const double v23 = d[1] * d[1];
+    const double e23 = ig_err_mul(d[1], ed[1], d[1], ed[1], v23);
+    const double v24 = d[2] * d[2];
+    const double e24 = ig_err_mul(d[2], ed[2], d[2], ed[2], v24);
+    const double v25 = v23 + v24;
+    const double e25 = ig_err_add(v23, e23, v24, e24, v25);
+    const double v26 = 3.0 * o[0];
+    const double e26 = ig_err_mul(3.0, 0.0, o[0], eo[0], v26);
+    const double v27 = v26 * w2;
+    const double e27 = ig_err_mul(v26, e26, w2, w2_e, v27);
+    const double v28 = v25 - v27;
+    const double e28 = ig_err_add(v25, e25, v27, e27, v28);
+    const double v29 = 6.0 * w1;
+    const double e29 = ig_err_mul(6.0, 0.0, w1, w1_e, v29);
+    const double v30 = v29 * w2;
+    const double e30 = ig_err_mul(v29, e29, w2, w2_e, v30);
+    const double v31 = v28 + v30;
+    const double e31 = ig_err_add(v28, e28, v30, e30, v31);
+    c[2] = v31;
+    e[2] = e31;
+    const double v32 = -w3;
+    const double e32 = w3_e;
+    const double v33 = 4.0 * o[0];
+    const double e33 = ig_err_mul(4.0, 0.0, o[0], eo[0], v33);
+    const double v34 = v33 * w3;
+    const double e34 = ig_err_mul(v33, e33, w3, w3_e, v34);
+    const double v35 = v32 + v34;
+    const double e35 = ig_err_add(v32, e32, v34, e34, v35);
+    c[3] = v35;
+    e[3] = e35;
+    c[4] = q1;
+    e[4] = q1_e;
+    return 1;
 }
 
 double piriform_value(const double p[3], const double *params)
@@ -76,7 +184,7 @@ int piriform_bounds(const double *params, double box[6])
 
 const ig_shape piriform_shape = {
     "piriform", PIRIFORM_DEGREE, PIRIFORM_NPARAMS,
-    piriform_coeffs, piriform_value, piriform_gradient, piriform_bounds
+    piriform_coeffs, piriform_value, piriform_gradient, piriform_bounds, piriform_coeffs_err
 };
 
 int piriform_intersect(const double o[3], const double d[3], double tmin, double tmax,

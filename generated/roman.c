@@ -5,6 +5,7 @@
  *   arithmetic operations: coeffs 84, value 11, gradient 21
  */
 #include "roman.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -45,6 +46,235 @@ void roman_coeffs(const double o[3], const double d[3], const double *params, do
     c[2] = dz*w6 - oz*w16 + w0*w14 + w0*w15 + w1*w13 + w1*w15 + w10*w17 + w13*w2 + w14*w2 + w17*w8 + 4*w4*w5;
     c[3] = -dz*w16 + w13*w19 + w13*w20 + w14*w18 + w14*w20 + w15*w18 + w15*w19;
     c[4] = w13*w14 + w13*w15 + w14*w15;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int roman_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                     const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double v0 = o[0] * o[0];
+    const double e0 = ig_err_mul(o[0], eo[0], o[0], eo[0], v0);
+    const double w0 = v0;
+    const double w0_e = e0;
+    const double v1 = o[1] * o[1];
+    const double e1 = ig_err_mul(o[1], eo[1], o[1], eo[1], v1);
+    const double w1 = v1;
+    const double w1_e = e1;
+    const double v2 = o[2] * o[2];
+    const double e2 = ig_err_mul(o[2], eo[2], o[2], eo[2], v2);
+    const double w2 = v2;
+    const double w2_e = e2;
+    const double v3 = o[0] * o[1];
+    const double e3 = ig_err_mul(o[0], eo[0], o[1], eo[1], v3);
+    const double w3 = v3;
+    const double w3_e = e3;
+    const double v4 = d[0] * o[1];
+    const double e4 = ig_err_mul(d[0], ed[0], o[1], eo[1], v4);
+    const double w4 = v4;
+    const double w4_e = e4;
+    const double v5 = d[1] * o[0];
+    const double e5 = ig_err_mul(d[1], ed[1], o[0], eo[0], v5);
+    const double w5 = v5;
+    const double w5_e = e5;
+    const double v6 = -w4;
+    const double e6 = w4_e;
+    const double v7 = v6 - w5;
+    const double e7 = ig_err_add(v6, e6, w5, w5_e, v7);
+    const double w6 = v7;
+    const double w6_e = e7;
+    const double v8 = 2.0 * w1;
+    const double e8 = ig_err_mul(2.0, 0.0, w1, w1_e, v8);
+    const double w7 = v8;
+    const double w7_e = e8;
+    const double v9 = d[0] * o[0];
+    const double e9 = ig_err_mul(d[0], ed[0], o[0], eo[0], v9);
+    const double w8 = v9;
+    const double w8_e = e9;
+    const double v10 = 2.0 * w2;
+    const double e10 = ig_err_mul(2.0, 0.0, w2, w2_e, v10);
+    const double w9 = v10;
+    const double w9_e = e10;
+    const double v11 = d[1] * o[1];
+    const double e11 = ig_err_mul(d[1], ed[1], o[1], eo[1], v11);
+    const double w10 = v11;
+    const double w10_e = e11;
+    const double v12 = 2.0 * w0;
+    const double e12 = ig_err_mul(2.0, 0.0, w0, w0_e, v12);
+    const double w11 = v12;
+    const double w11_e = e12;
+    const double v13 = d[2] * o[2];
+    const double e13 = ig_err_mul(d[2], ed[2], o[2], eo[2], v13);
+    const double w12 = v13;
+    const double w12_e = e13;
+    const double v14 = d[0] * d[0];
+    const double e14 = ig_err_mul(d[0], ed[0], d[0], ed[0], v14);
+    const double w13 = v14;
+    const double w13_e = e14;
+    const double v15 = d[1] * d[1];
+    const double e15 = ig_err_mul(d[1], ed[1], d[1], ed[1], v15);
+    const double w14 = v15;
+    const double w14_e = e15;
+    const double v16 = d[2] * d[2];
+    const double e16 = ig_err_mul(d[2], ed[2], d[2], ed[2], v16);
+    const double w15 = v16;
+    const double w15_e = e16;
+    const double v17 = d[0] * d[1];
+    const double e17 = ig_err_mul(d[0], ed[0], d[1], ed[1], v17);
+    const double w16 = v17;
+    const double w16_e = e17;
+    const double v18 = 4.0 * w12;
+    const double e18 = ig_err_mul(4.0, 0.0, w12, w12_e, v18);
+    const double w17 = v18;
+    const double w17_e = e18;
+    const double v19 = 2.0 * w8;
+    const double e19 = ig_err_mul(2.0, 0.0, w8, w8_e, v19);
+    const double w18 = v19;
+    const double w18_e = e19;
+    const double v20 = 2.0 * w10;
+    const double e20 = ig_err_mul(2.0, 0.0, w10, w10_e, v20);
+    const double w19 = v20;
+    const double w19_e = e20;
+    const double v21 = 2.0 * w12;
+    const double e21 = ig_err_mul(2.0, 0.0, w12, w12_e, v21);
+    const double w20 = v21;
+    const double w20_e = e21;
+    const double v22 = w0 * w1;
+    const double e22 = ig_err_mul(w0, w0_e, w1, w1_e, v22);
+    const double v23 = w0 * w2;
+    const double e23 = ig_err_mul(w0, w0_e, w2, w2_e, v23);
+    const double v24 = v22 + v23;
+    const double e24 = ig_err_add(v22, e22, v23, e23, v24);
+    const double v25 = w1 * w2;
+    const double e25 = ig_err_mul(w1, w1_e, w2, w2_e, v25);
+    const double v26 = v24 + v25;
+    const double e26 = ig_err_add(v24, e24, v25, e25, v26);
+    const double v27 = o[2] * w3;
+    const double e27 = ig_err_mul(o[2], eo[2], w3, w3_e, v27);
+    const double v28 = v26 - v27;
+    const double e28 = ig_err_add(v26, e26, v27, e27, v28);
+    c[0] = v28;
+    e[0] = e28;
+    const double v29 = o[2] * w6;
+    const double e29 = ig_err_mul(o[2], eo[2], w6, w6_e, v29);
+    const double v30 = w10 * w11;
+    const double e30 = ig_err_mul(w10, w10_e, w11, w11_e, v30);
+    const double v31 = v29 + v30;
+    const double e31 = ig_err_add(v29, e29, v30, e30, v31);
+    const double v32 = w10 * w9;
+    const double e32 = ig_err_mul(w10, w10_e, w9, w9_e, v32);
+    const double v33 = v31 + v32;
+    const double e33 = ig_err_add(v31, e31, v32, e32, v33);
+    const double v34 = w11 * w12;
+    const double e34 = ig_err_mul(w11, w11_e, w12, w12_e, v34);
+    const double v35 = v33 + v34;
+    const double e35 = ig_err_add(v33, e33, v34, e34, v35);
+    const double v36 = w12 * w7;
+    const double e36 = ig_err_mul(w12, w12_e, w7, w7_e, v36);
+    const double v37 = v35 + v36;
+    const double e37 = ig_err_add(v35, e35, v36, e36, v37);
+    const double v38 = w7 * w8;
+    const double e38 = ig_err_mul(w7, w7_e, w8, w8_e, v38);
+    const double v39 = v37 + v38;
+    const double e39 = ig_err_add(v37, e37, v38, e38, v39);
+    const double v40 = w8 * w9;
+    const double e40 = ig_err_mul(w8, w8_e, w9, w9_e, v40);
+    const double v41 = v39 + v40;
+    const double e41 = ig_err_add(v39, e39, v40, e40, v41);
+    const double v42 = d[2] * w3;
+    const double e42 = ig_err_mul(d[2], ed[2], w3, w3_e, v42);
+    const double v43 = v41 - v42;
+    const double e43 = ig_err_add(v41, e41, v42, e42, v43);
+    c[1] = v43;
+    e[1] = e43;
+    const double v44 = d[2] * w6;
+    const double e44 = ig_err_mul(d[2], ed[2], w6, w6_e, v44);
+    const double v45 = w0 * w14;
+    const double e45 = ig_err_mul(w0, w0_e, w14, w14_e, v45);
+    const double v46 = v44 + v45;
+    const double e46 = ig_err_add(v44, e44, v45, e45, v46);
+    const double v47 = w0 * w15;
+    const double e47 = ig_err_mul(w0, w0_e, w15, w15_e, v47);
+    const double v48 = v46 + v47;
+    const double e48 = ig_err_add(v46, e46, v47, e47, v48);
+    const double v49 = w1 * w13;
+    const double e49 = ig_err_mul(w1, w1_e, w13, w13_e, v49);
+    const double v50 = v48 + v49;
+    const double e50 = ig_err_add(v48, e48, v49, e49, v50);
+    const double v51 = w1 * w15;
+    const double e51 = ig_err_mul(w1, w1_e, w15, w15_e, v51);
+    const double v52 = v50 + v51;
+    const double e52 = ig_err_add(v50, e50, v51, e51, v52);
+    const double v53 = w10 * w17;
+    const double e53 = ig_err_mul(w10, w10_e, w17, w17_e, v53);
+    const double v54 = v52 + v53;
+    const double e54 = ig_err_add(v52, e52, v53, e53, v54);
+    const double v55 = w13 * w2;
+    const double e55 = ig_err_mul(w13, w13_e, w2, w2_e, v55);
+    const double v56 = v54 + v55;
+    const double e56 = ig_err_add(v54, e54, v55, e55, v56);
+    const double v57 = w14 * w2;
+    const double e57 = ig_err_mul(w14, w14_e, w2, w2_e, v57);
+    const double v58 = v56 + v57;
+    const double e58 = ig_err_add(v56, e56, v57, e57, v58);
+    const double v59 = w17 * w8;
+    const double e59 = ig_err_mul(w17, w17_e, w8, w8_e, v59);
+    const double v60 = v58 + v59;
+    const double e60 = ig_err_add(v58, e58, v59, e59, v60);
+    const double v61 = o[2] * w16;
+    const double e61 = ig_err_mul(o[2], eo[2], w16, w16_e, v61);
+    const double v62 = v60 - v61;
+    const double e62 = ig_err_add(v60, e60, v61, e61, v62);
+    const double v63 = 4.0 * w4;
+    const double e63 = ig_err_mul(4.0, 0.0, w4, w4_e, v63);
+    const double v64 = v63 * w5;
+    const double e64 = ig_err_mul(v63, e63, w5, w5_e, v64);
+    const double v65 = v62 + v64;
+    const double e65 = ig_err_add(v62, e62, v64, e64, v65);
+    c[2] = v65;
+    e[2] = e65;
+    const double v66 = w13 * w19;
+    const double e66 = ig_err_mul(w13, w13_e, w19, w19_e, v66);
+    const double v67 = w13 * w20;
+    const double e67 = ig_err_mul(w13, w13_e, w20, w20_e, v67);
+    const double v68 = v66 + v67;
+    const double e68 = ig_err_add(v66, e66, v67, e67, v68);
+    const double v69 = w14 * w18;
+    const double e69 = ig_err_mul(w14, w14_e, w18, w18_e, v69);
+    const double v70 = v68 + v69;
+    const double e70 = ig_err_add(v68, e68, v69, e69, v70);
+    const double v71 = w14 * w20;
+    const double e71 = ig_err_mul(w14, w14_e, w20, w20_e, v71);
+    const double v72 = v70 + v71;
+    const double e72 = ig_err_add(v70, e70, v71, e71, v72);
+    const double v73 = w15 * w18;
+    const double e73 = ig_err_mul(w15, w15_e, w18, w18_e, v73);
+    const double v74 = v72 + v73;
+    const double e74 = ig_err_add(v72, e72, v73, e73, v74);
+    const double v75 = w15 * w19;
+    const double e75 = ig_err_mul(w15, w15_e, w19, w19_e, v75);
+    const double v76 = v74 + v75;
+    const double e76 = ig_err_add(v74, e74, v75, e75, v76);
+    const double v77 = d[2] * w16;
+    const double e77 = ig_err_mul(d[2], ed[2], w16, w16_e, v77);
+    const double v78 = v76 - v77;
+    const double e78 = ig_err_add(v76, e76, v77, e77, v78);
+    c[3] = v78;
+    e[3] = e78;
+    const double v79 = w13 * w14;
+    const double e79 = ig_err_mul(w13, w13_e, w14, w14_e, v79);
+    const double v80 = w13 * w15;
+    const double e80 = ig_err_mul(w13, w13_e, w15, w15_e, v80);
+    const double v81 = v79 + v80;
+    const double e81 = ig_err_add(v79, e79, v80, e80, v81);
+    const double v82 = w14 * w15;
+    const double e82 = ig_err_mul(w14, w14_e, w15, w15_e, v82);
+    const double v83 = v81 + v82;
+    const double e83 = ig_err_add(v81, e81, v82, e82, v83);
+    c[4] = v83;
+    e[4] = e83;
+    return 1;
 }
 
 double roman_value(const double p[3], const double *params)
@@ -95,7 +325,7 @@ int roman_bounds(const double *params, double box[6])
 
 const ig_shape roman_shape = {
     "roman", ROMAN_DEGREE, ROMAN_NPARAMS,
-    roman_coeffs, roman_value, roman_gradient, roman_bounds
+    roman_coeffs, roman_value, roman_gradient, roman_bounds, roman_coeffs_err
 };
 
 int roman_intersect(const double o[3], const double d[3], double tmin, double tmax,

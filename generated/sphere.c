@@ -6,6 +6,7 @@
  *   arithmetic operations: coeffs 21, value 8, gradient 3
  */
 #include "sphere.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -25,6 +26,66 @@ void sphere_coeffs(const double o[3], const double d[3], const double *params, d
     c[0] = w0 + ox*ox + oy*oy + oz*oz;
     c[1] = 2*dx*ox + 2*dy*oy + 2*dz*oz;
     c[2] = dx*dx + dy*dy + dz*dz;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int sphere_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                      const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double k_r = params[0];
+    const double v0 = k_r * k_r;
+    const double e0 = ig_err_mul(k_r, 0.0, k_r, 0.0, v0);
+    const double v1 = -v0;
+    const double e1 = e0;
+    const double w0 = v1;
+    const double w0_e = e1;
+    const double v2 = o[0] * o[0];
+    const double e2 = ig_err_mul(o[0], eo[0], o[0], eo[0], v2);
+    const double v3 = w0 + v2;
+    const double e3 = ig_err_add(w0, w0_e, v2, e2, v3);
+    const double v4 = o[1] * o[1];
+    const double e4 = ig_err_mul(o[1], eo[1], o[1], eo[1], v4);
+    const double v5 = v3 + v4;
+    const double e5 = ig_err_add(v3, e3, v4, e4, v5);
+    const double v6 = o[2] * o[2];
+    const double e6 = ig_err_mul(o[2], eo[2], o[2], eo[2], v6);
+    const double v7 = v5 + v6;
+    const double e7 = ig_err_add(v5, e5, v6, e6, v7);
+    c[0] = v7;
+    e[0] = e7;
+    const double v8 = 2.0 * d[0];
+    const double e8 = ig_err_mul(2.0, 0.0, d[0], ed[0], v8);
+    const double v9 = v8 * o[0];
+    const double e9 = ig_err_mul(v8, e8, o[0], eo[0], v9);
+    const double v10 = 2.0 * d[1];
+    const double e10 = ig_err_mul(2.0, 0.0, d[1], ed[1], v10);
+    const double v11 = v10 * o[1];
+    const double e11 = ig_err_mul(v10, e10, o[1], eo[1], v11);
+    const double v12 = v9 + v11;
+    const double e12 = ig_err_add(v9, e9, v11, e11, v12);
+    const double v13 = 2.0 * d[2];
+    const double e13 = ig_err_mul(2.0, 0.0, d[2], ed[2], v13);
+    const double v14 = v13 * o[2];
+    const double e14 = ig_err_mul(v13, e13, o[2], eo[2], v14);
+    const double v15 = v12 + v14;
+    const double e15 = ig_err_add(v12, e12, v14, e14, v15);
+    c[1] = v15;
+    e[1] = e15;
+    const double v16 = d[0] * d[0];
+    const double e16 = ig_err_mul(d[0], ed[0], d[0], ed[0], v16);
+    const double v17 = d[1] * d[1];
+    const double e17 = ig_err_mul(d[1], ed[1], d[1], ed[1], v17);
+    const double v18 = v16 + v17;
+    const double e18 = ig_err_add(v16, e16, v17, e17, v18);
+    const double v19 = d[2] * d[2];
+    const double e19 = ig_err_mul(d[2], ed[2], d[2], ed[2], v19);
+    const double v20 = v18 + v19;
+    const double e20 = ig_err_add(v18, e18, v19, e19, v20);
+    c[2] = v20;
+    e[2] = e20;
+    return 1;
 }
 
 double sphere_value(const double p[3], const double *params)
@@ -68,7 +129,7 @@ int sphere_bounds(const double *params, double box[6])
 
 const ig_shape sphere_shape = {
     "sphere", SPHERE_DEGREE, SPHERE_NPARAMS,
-    sphere_coeffs, sphere_value, sphere_gradient, sphere_bounds
+    sphere_coeffs, sphere_value, sphere_gradient, sphere_bounds, sphere_coeffs_err
 };
 
 int sphere_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -5,6 +5,7 @@
  *   arithmetic operations: coeffs 69, value 16, gradient 15
  */
 #include "tanglecube.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -42,6 +43,203 @@ void tanglecube_coeffs(const double o[3], const double d[3], const double *param
     c[2] = 6*w0*w3 + 6*w1*w4 + 6*w2*w5 - 5*w3 - 5*w4 - 5*w5;
     c[3] = 4*dx*ox*q0 + 4*dy*oy*q2 + 4*dz*oz*q4;
     c[4] = q1 + q3 + q5;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int tanglecube_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                          const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double v0 = d[0] * d[0];
+    const double e0 = ig_err_mul(d[0], ed[0], d[0], ed[0], v0);
+    const double q0 = v0;
+    const double q0_e = e0;
+    const double v1 = q0 * q0;
+    const double e1 = ig_err_mul(q0, q0_e, q0, q0_e, v1);
+    const double q1 = v1;
+    const double q1_e = e1;
+    const double v2 = d[1] * d[1];
+    const double e2 = ig_err_mul(d[1], ed[1], d[1], ed[1], v2);
+    const double q2 = v2;
+    const double q2_e = e2;
+    const double v3 = q2 * q2;
+    const double e3 = ig_err_mul(q2, q2_e, q2, q2_e, v3);
+    const double q3 = v3;
+    const double q3_e = e3;
+    const double v4 = d[2] * d[2];
+    const double e4 = ig_err_mul(d[2], ed[2], d[2], ed[2], v4);
+    const double q4 = v4;
+    const double q4_e = e4;
+    const double v5 = q4 * q4;
+    const double e5 = ig_err_mul(q4, q4_e, q4, q4_e, v5);
+    const double q5 = v5;
+    const double q5_e = e5;
+    const double v6 = o[0] * o[0];
+    const double e6 = ig_err_mul(o[0], eo[0], o[0], eo[0], v6);
+    const double q6 = v6;
+    const double q6_e = e6;
+    const double v7 = q6 * q6;
+    const double e7 = ig_err_mul(q6, q6_e, q6, q6_e, v7);
+    const double q7 = v7;
+    const double q7_e = e7;
+    const double v8 = o[1] * o[1];
+    const double e8 = ig_err_mul(o[1], eo[1], o[1], eo[1], v8);
+    const double q8 = v8;
+    const double q8_e = e8;
+    const double v9 = q8 * q8;
+    const double e9 = ig_err_mul(q8, q8_e, q8, q8_e, v9);
+    const double q9 = v9;
+    const double q9_e = e9;
+    const double v10 = o[2] * o[2];
+    const double e10 = ig_err_mul(o[2], eo[2], o[2], eo[2], v10);
+    const double q10 = v10;
+    const double q10_e = e10;
+    const double v11 = q10 * q10;
+    const double e11 = ig_err_mul(q10, q10_e, q10, q10_e, v11);
+    const double q11 = v11;
+    const double q11_e = e11;
+    const double w0 = q6;
+    const double w0_e = q6_e;
+    const double w1 = q8;
+    const double w1_e = q8_e;
+    const double w2 = q10;
+    const double w2_e = q10_e;
+    const double w3 = q0;
+    const double w3_e = q0_e;
+    const double w4 = q2;
+    const double w4_e = q2_e;
+    const double w5 = q4;
+    const double w5_e = q4_e;
+    const double v12 = 11.8;
+    const double e12 = ig_err_const(11.8);
+    const double v13 = v12 + q11;
+    const double e13 = ig_err_add(v12, e12, q11, q11_e, v13);
+    const double v14 = v13 + q7;
+    const double e14 = ig_err_add(v13, e13, q7, q7_e, v14);
+    const double v15 = v14 + q9;
+    const double e15 = ig_err_add(v14, e14, q9, q9_e, v15);
+    const double v16 = 5.0 * w0;
+    const double e16 = ig_err_mul(5.0, 0.0, w0, w0_e, v16);
+    const double v17 = v15 - v16;
+    const double e17 = ig_err_add(v15, e15, v16, e16, v17);
+    const double v18 = 5.0 * w1;
+    const double e18 = ig_err_mul(5.0, 0.0, w1, w1_e, v18);
+    const double v19 = v17 - v18;
+    const double e19 = ig_err_add(v17, e17, v18, e18, v19);
+    const double v20 = 5.0 * w2;
+    const double e20 = ig_err_mul(5.0, 0.0, w2, w2_e, v20);
+    const double v21 = v19 - v20;
+    const double e21 = ig_err_add(v19, e19, v20, e20, v21);
+    c[0] = v21;
+    e[0] = e21;
+    const double v22 = 10.0 * d[0];
+    const double e22 = ig_err_mul(10.0, 0.0, d[0], ed[0], v22);
+    const double v23 = v22 * o[0];
+    const double e23 = ig_err_mul(v22, e22, o[0], eo[0], v23);
+    const double v24 = -v23;
+    const double e24 = e23;
+    const double v25 = 10.0 * d[1];
+    const double e25 = ig_err_mul(10.0, 0.0, d[1], ed[1], v25);
+    const double v26 = v25 * o[1];
+    const double e26 = ig_err_mul(v25, e25, o[1], eo[1], v26);
+    const double v27 = v24 - v26;
+    const double e27 = ig_err_add(v24, e24, v26, e26, v27);
+    const double v28 = 10.0 * d[2];
+    const double e28 = ig_err_mul(10.0, 0.0, d[2], ed[2], v28);
+    const double v29 = v28 * o[2];
+    const double e29 = ig_err_mul(v28, e28, o[2], eo[2], v29);
+    const double v30 = v27 - v29;
+    const double e30 = ig_err_add(v27, e27, v29, e29, v30);
+    const double v31 = 4.0 * d[0];
+    const double e31 = ig_err_mul(4.0, 0.0, d[0], ed[0], v31);
+    const double v32 = v31 * o[0];
+    const double e32 = ig_err_mul(v31, e31, o[0], eo[0], v32);
+    const double v33 = v32 * q6;
+    const double e33 = ig_err_mul(v32, e32, q6, q6_e, v33);
+    const double v34 = v30 + v33;
+    const double e34 = ig_err_add(v30, e30, v33, e33, v34);
+    const double v35 = 4.0 * d[1];
+    const double e35 = ig_err_mul(4.0, 0.0, d[1], ed[1], v35);
+    const double v36 = v35 * o[1];
+    const double e36 = ig_err_mul(v35, e35, o[1], eo[1], v36);
+    const double v37 = v36 * q8;
+    const double e37 = ig_err_mul(v36, e36, q8, q8_e, v37);
+    const double v38 = v34 + v37;
+    const double e38 = ig_err_add(v34, e34, v37, e37, v38);
+    const double v39 = 4.0 * d[2];
+    const double e39 = ig_err_mul(4.0, 0.0, d[2], ed[2], v39);
+    const double v40 = v39 * o[2];
+    const double e40 = ig_err_mul(v39, e39, o[2], eo[2], v40);
+    const double v41 = v40 * q10;
+    const double e41 = ig_err_mul(v40, e40, q10, q10_e, v41);
+    const double v42 = v38 + v41;
+    const double e42 = ig_err_add(v38, e38, v41, e41, v42);
+    c[1] = v42;
+    e[1] = e42;
+    const double v43 = 5.0 * w3;
+    const double e43 = ig_err_mul(5.0, 0.0, w3, w3_e, v43);
+    const double v44 = -v43;
+    const double e44 = e43;
+    const double v45 = 5.0 * w4;
+    const double e45 = ig_err_mul(5.0, 0.0, w4, w4_e, v45);
+    const double v46 = v44 - v45;
+    const double e46 = ig_err_add(v44, e44, v45, e45, v46);
+    const double v47 = 5.0 * w5;
+    const double e47 = ig_err_mul(5.0, 0.0, w5, w5_e, v47);
+    const double v48 = v46 - v47;
+    const double e48 = ig_err_add(v46, e46, v47, e47, v48);
+    const double v49 = 6.0 * w0;
+    const double e49 = ig_err_mul(6.0, 0.0, w0, w0_e, v49);
+    const double v50 = v49 * w3;
+    const double e50 = ig_err_mul(v49, e49, w3, w3_e, v50);
+    const double v51 = v48 + v50;
+    const double e51 = ig_err_add(v48, e48, v50, e50, v51);
+    const double v52 = 6.0 * w1;
+    const double e52 = ig_err_mul(6.0, 0.0, w1, w1_e, v52);
+    const double v53 = v52 * w4;
+    const double e53 = ig_err_mul(v52, e52, w4, w4_e, v53);
+    const double v54 = v51 + v53;
+    const double e54 = ig_err_add(v51, e51, v53, e53, v54);
+    const double v55 = 6.0 * w2;
+    const double e55 = ig_err_mul(6.0, 0.0, w2, w2_e, v55);
+    const double v56 = v55 * w5;
+    const double e56 = ig_err_mul(v55, e55, w5, w5_e, v56);
+    const double v57 = v54 + v56;
+    const double e57 = ig_err_add(v54, e54, v56, e56, v57);
+    c[2] = v57;
+    e[2] = e57;
+    const double v58 = 4.0 * d[0];
+    const double e58 = ig_err_mul(4.0, 0.0, d[0], ed[0], v58);
+    const double v59 = v58 * o[0];
+    const double e59 = ig_err_mul(v58, e58, o[0], eo[0], v59);
+    const double v60 = v59 * q0;
+    const double e60 = ig_err_mul(v59, e59, q0, q0_e, v60);
+    const double v61 = 4.0 * d[1];
+    const double e61 = ig_err_mul(4.0, 0.0, d[1], ed[1], v61);
+    const double v62 = v61 * o[1];
+    const double e62 = ig_err_mul(v61, e61, o[1], eo[1], v62);
+    const double v63 = v62 * q2;
+    const double e63 = ig_err_mul(v62, e62, q2, q2_e, v63);
+    const double v64 = v60 + v63;
+    const double e64 = ig_err_add(v60, e60, v63, e63, v64);
+    const double v65 = 4.0 * d[2];
+    const double e65 = ig_err_mul(4.0, 0.0, d[2], ed[2], v65);
+    const double v66 = v65 * o[2];
+    const double e66 = ig_err_mul(v65, e65, o[2], eo[2], v66);
+    const double v67 = v66 * q4;
+    const double e67 = ig_err_mul(v66, e66, q4, q4_e, v67);
+    const double v68 = v64 + v67;
+    const double e68 = ig_err_add(v64, e64, v67, e67, v68);
+    c[3] = v68;
+    e[3] = e68;
+    const double v69 = q1 + q3;
+    const double e69 = ig_err_add(q1, q1_e, q3, q3_e, v69);
+    const double v70 = v69 + q5;
+    const double e70 = ig_err_add(v69, e69, q5, q5_e, v70);
+    c[4] = v70;
+    e[4] = e70;
+    return 1;
 }
 
 double tanglecube_value(const double p[3], const double *params)
@@ -90,7 +288,7 @@ int tanglecube_bounds(const double *params, double box[6])
 
 const ig_shape tanglecube_shape = {
     "tanglecube", TANGLECUBE_DEGREE, TANGLECUBE_NPARAMS,
-    tanglecube_coeffs, tanglecube_value, tanglecube_gradient, tanglecube_bounds
+    tanglecube_coeffs, tanglecube_value, tanglecube_gradient, tanglecube_bounds, tanglecube_coeffs_err
 };
 
 int tanglecube_intersect(const double o[3], const double d[3], double tmin, double tmax,

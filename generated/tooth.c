@@ -5,6 +5,7 @@
  *   arithmetic operations: coeffs 61, value 11, gradient 15
  */
 #include "tooth.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -42,6 +43,187 @@ void tooth_coeffs(const double o[3], const double d[3], const double *params, do
     c[2] = 6*w0*w3 + 6*w1*w4 + 6*w2*w5 - w3 - w4 - w5;
     c[3] = 4*dx*ox*q0 + 4*dy*oy*q2 + 4*dz*oz*q4;
     c[4] = q1 + q3 + q5;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int tooth_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                     const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double v0 = d[0] * d[0];
+    const double e0 = ig_err_mul(d[0], ed[0], d[0], ed[0], v0);
+    const double q0 = v0;
+    const double q0_e = e0;
+    const double v1 = q0 * q0;
+    const double e1 = ig_err_mul(q0, q0_e, q0, q0_e, v1);
+    const double q1 = v1;
+    const double q1_e = e1;
+    const double v2 = d[1] * d[1];
+    const double e2 = ig_err_mul(d[1], ed[1], d[1], ed[1], v2);
+    const double q2 = v2;
+    const double q2_e = e2;
+    const double v3 = q2 * q2;
+    const double e3 = ig_err_mul(q2, q2_e, q2, q2_e, v3);
+    const double q3 = v3;
+    const double q3_e = e3;
+    const double v4 = d[2] * d[2];
+    const double e4 = ig_err_mul(d[2], ed[2], d[2], ed[2], v4);
+    const double q4 = v4;
+    const double q4_e = e4;
+    const double v5 = q4 * q4;
+    const double e5 = ig_err_mul(q4, q4_e, q4, q4_e, v5);
+    const double q5 = v5;
+    const double q5_e = e5;
+    const double v6 = o[0] * o[0];
+    const double e6 = ig_err_mul(o[0], eo[0], o[0], eo[0], v6);
+    const double q6 = v6;
+    const double q6_e = e6;
+    const double v7 = q6 * q6;
+    const double e7 = ig_err_mul(q6, q6_e, q6, q6_e, v7);
+    const double q7 = v7;
+    const double q7_e = e7;
+    const double v8 = o[1] * o[1];
+    const double e8 = ig_err_mul(o[1], eo[1], o[1], eo[1], v8);
+    const double q8 = v8;
+    const double q8_e = e8;
+    const double v9 = q8 * q8;
+    const double e9 = ig_err_mul(q8, q8_e, q8, q8_e, v9);
+    const double q9 = v9;
+    const double q9_e = e9;
+    const double v10 = o[2] * o[2];
+    const double e10 = ig_err_mul(o[2], eo[2], o[2], eo[2], v10);
+    const double q10 = v10;
+    const double q10_e = e10;
+    const double v11 = q10 * q10;
+    const double e11 = ig_err_mul(q10, q10_e, q10, q10_e, v11);
+    const double q11 = v11;
+    const double q11_e = e11;
+    const double w0 = q6;
+    const double w0_e = q6_e;
+    const double w1 = q8;
+    const double w1_e = q8_e;
+    const double w2 = q10;
+    const double w2_e = q10_e;
+    const double w3 = q0;
+    const double w3_e = q0_e;
+    const double w4 = q2;
+    const double w4_e = q2_e;
+    const double w5 = q4;
+    const double w5_e = q4_e;
+    const double v12 = q11 + q7;
+    const double e12 = ig_err_add(q11, q11_e, q7, q7_e, v12);
+    const double v13 = v12 + q9;
+    const double e13 = ig_err_add(v12, e12, q9, q9_e, v13);
+    const double v14 = v13 - w0;
+    const double e14 = ig_err_add(v13, e13, w0, w0_e, v14);
+    const double v15 = v14 - w1;
+    const double e15 = ig_err_add(v14, e14, w1, w1_e, v15);
+    const double v16 = v15 - w2;
+    const double e16 = ig_err_add(v15, e15, w2, w2_e, v16);
+    c[0] = v16;
+    e[0] = e16;
+    const double v17 = 2.0 * d[0];
+    const double e17 = ig_err_mul(2.0, 0.0, d[0], ed[0], v17);
+    const double v18 = v17 * o[0];
+    const double e18 = ig_err_mul(v17, e17, o[0], eo[0], v18);
+    const double v19 = -v18;
+    const double e19 = e18;
+    const double v20 = 2.0 * d[1];
+    const double e20 = ig_err_mul(2.0, 0.0, d[1], ed[1], v20);
+    const double v21 = v20 * o[1];
+    const double e21 = ig_err_mul(v20, e20, o[1], eo[1], v21);
+    const double v22 = v19 - v21;
+    const double e22 = ig_err_add(v19, e19, v21, e21, v22);
+    const double v23 = 2.0 * d[2];
+    const double e23 = ig_err_mul(2.0, 0.0, d[2], ed[2], v23);
+    const double v24 = v23 * o[2];
+    const double e24 = ig_err_mul(v23, e23, o[2], eo[2], v24);
+    const double v25 = v22 - v24;
+    const double e25 = ig_err_add(v22, e22, v24, e24, v25);
+    const double v26 = 4.0 * d[0];
+    const double e26 = ig_err_mul(4.0, 0.0, d[0], ed[0], v26);
+    const double v27 = v26 * o[0];
+    const double e27 = ig_err_mul(v26, e26, o[0], eo[0], v27);
+    const double v28 = v27 * q6;
+    const double e28 = ig_err_mul(v27, e27, q6, q6_e, v28);
+    const double v29 = v25 + v28;
+    const double e29 = ig_err_add(v25, e25, v28, e28, v29);
+    const double v30 = 4.0 * d[1];
+    const double e30 = ig_err_mul(4.0, 0.0, d[1], ed[1], v30);
+    const double v31 = v30 * o[1];
+    const double e31 = ig_err_mul(v30, e30, o[1], eo[1], v31);
+    const double v32 = v31 * q8;
+    const double e32 = ig_err_mul(v31, e31, q8, q8_e, v32);
+    const double v33 = v29 + v32;
+    const double e33 = ig_err_add(v29, e29, v32, e32, v33);
+    const double v34 = 4.0 * d[2];
+    const double e34 = ig_err_mul(4.0, 0.0, d[2], ed[2], v34);
+    const double v35 = v34 * o[2];
+    const double e35 = ig_err_mul(v34, e34, o[2], eo[2], v35);
+    const double v36 = v35 * q10;
+    const double e36 = ig_err_mul(v35, e35, q10, q10_e, v36);
+    const double v37 = v33 + v36;
+    const double e37 = ig_err_add(v33, e33, v36, e36, v37);
+    c[1] = v37;
+    e[1] = e37;
+    const double v38 = -w3;
+    const double e38 = w3_e;
+    const double v39 = v38 - w4;
+    const double e39 = ig_err_add(v38, e38, w4, w4_e, v39);
+    const double v40 = v39 - w5;
+    const double e40 = ig_err_add(v39, e39, w5, w5_e, v40);
+    const double v41 = 6.0 * w0;
+    const double e41 = ig_err_mul(6.0, 0.0, w0, w0_e, v41);
+    const double v42 = v41 * w3;
+    const double e42 = ig_err_mul(v41, e41, w3, w3_e, v42);
+    const double v43 = v40 + v42;
+    const double e43 = ig_err_add(v40, e40, v42, e42, v43);
+    const double v44 = 6.0 * w1;
+    const double e44 = ig_err_mul(6.0, 0.0, w1, w1_e, v44);
+    const double v45 = v44 * w4;
+    const double e45 = ig_err_mul(v44, e44, w4, w4_e, v45);
+    const double v46 = v43 + v45;
+    const double e46 = ig_err_add(v43, e43, v45, e45, v46);
+    const double v47 = 6.0 * w2;
+    const double e47 = ig_err_mul(6.0, 0.0, w2, w2_e, v47);
+    const double v48 = v47 * w5;
+    const double e48 = ig_err_mul(v47, e47, w5, w5_e, v48);
+    const double v49 = v46 + v48;
+    const double e49 = ig_err_add(v46, e46, v48, e48, v49);
+    c[2] = v49;
+    e[2] = e49;
+    const double v50 = 4.0 * d[0];
+    const double e50 = ig_err_mul(4.0, 0.0, d[0], ed[0], v50);
+    const double v51 = v50 * o[0];
+    const double e51 = ig_err_mul(v50, e50, o[0], eo[0], v51);
+    const double v52 = v51 * q0;
+    const double e52 = ig_err_mul(v51, e51, q0, q0_e, v52);
+    const double v53 = 4.0 * d[1];
+    const double e53 = ig_err_mul(4.0, 0.0, d[1], ed[1], v53);
+    const double v54 = v53 * o[1];
+    const double e54 = ig_err_mul(v53, e53, o[1], eo[1], v54);
+    const double v55 = v54 * q2;
+    const double e55 = ig_err_mul(v54, e54, q2, q2_e, v55);
+    const double v56 = v52 + v55;
+    const double e56 = ig_err_add(v52, e52, v55, e55, v56);
+    const double v57 = 4.0 * d[2];
+    const double e57 = ig_err_mul(4.0, 0.0, d[2], ed[2], v57);
+    const double v58 = v57 * o[2];
+    const double e58 = ig_err_mul(v57, e57, o[2], eo[2], v58);
+    const double v59 = v58 * q4;
+    const double e59 = ig_err_mul(v58, e58, q4, q4_e, v59);
+    const double v60 = v56 + v59;
+    const double e60 = ig_err_add(v56, e56, v59, e59, v60);
+    c[3] = v60;
+    e[3] = e60;
+    const double v61 = q1 + q3;
+    const double e61 = ig_err_add(q1, q1_e, q3, q3_e, v61);
+    const double v62 = v61 + q5;
+    const double e62 = ig_err_add(v61, e61, q5, q5_e, v62);
+    c[4] = v62;
+    e[4] = e62;
+    return 1;
 }
 
 double tooth_value(const double p[3], const double *params)
@@ -90,7 +272,7 @@ int tooth_bounds(const double *params, double box[6])
 
 const ig_shape tooth_shape = {
     "tooth", TOOTH_DEGREE, TOOTH_NPARAMS,
-    tooth_coeffs, tooth_value, tooth_gradient, tooth_bounds
+    tooth_coeffs, tooth_value, tooth_gradient, tooth_bounds, tooth_coeffs_err
 };
 
 int tooth_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -6,6 +6,7 @@
  *   arithmetic operations: coeffs 50, value 19, gradient 26
  */
 #include "torus_y.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -41,6 +42,155 @@ void torus_y_coeffs(const double o[3], const double d[3], const double *params, 
     c[2] = w10*w13 + w12*w7 + w13*w6 + w9*w9;
     c[3] = 2*w13*w9;
     c[4] = w13*w13;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int torus_y_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                       const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double k_a = params[0];
+    const double k_b = params[1];
+    const double v0 = k_a * k_a;
+    const double e0 = ig_err_mul(k_a, 0.0, k_a, 0.0, v0);
+    const double w0 = v0;
+    const double w0_e = e0;
+    const double v1 = k_b * k_b;
+    const double e1 = ig_err_mul(k_b, 0.0, k_b, 0.0, v1);
+    const double w1 = v1;
+    const double w1_e = e1;
+    const double v2 = w0 - w1;
+    const double e2 = ig_err_add(w0, w0_e, w1, w1_e, v2);
+    const double v3 = v2 * v2;
+    const double e3 = ig_err_mul(v2, e2, v2, e2, v3);
+    const double w2 = v3;
+    const double w2_e = e3;
+    const double v4 = o[1] * o[1];
+    const double e4 = ig_err_mul(o[1], eo[1], o[1], eo[1], v4);
+    const double w3 = v4;
+    const double w3_e = e4;
+    const double v5 = o[0] * o[0];
+    const double e5 = ig_err_mul(o[0], eo[0], o[0], eo[0], v5);
+    const double v6 = w3 + v5;
+    const double e6 = ig_err_add(w3, w3_e, v5, e5, v6);
+    const double v7 = o[2] * o[2];
+    const double e7 = ig_err_mul(o[2], eo[2], o[2], eo[2], v7);
+    const double v8 = v6 + v7;
+    const double e8 = ig_err_add(v6, e6, v7, e7, v8);
+    const double w4 = v8;
+    const double w4_e = e8;
+    const double v9 = 2.0 * w0;
+    const double e9 = ig_err_mul(2.0, 0.0, w0, w0_e, v9);
+    const double v10 = 2.0 * w1;
+    const double e10 = ig_err_mul(2.0, 0.0, w1, w1_e, v10);
+    const double v11 = v9 + v10;
+    const double e11 = ig_err_add(v9, e9, v10, e10, v11);
+    const double w5 = v11;
+    const double w5_e = e11;
+    const double v12 = -w5;
+    const double e12 = w5_e;
+    const double w6 = v12;
+    const double w6_e = e12;
+    const double v13 = 4.0 * w0;
+    const double e13 = ig_err_mul(4.0, 0.0, w0, w0_e, v13);
+    const double w7 = v13;
+    const double w7_e = e13;
+    const double v14 = d[1] * o[1];
+    const double e14 = ig_err_mul(d[1], ed[1], o[1], eo[1], v14);
+    const double w8 = v14;
+    const double w8_e = e14;
+    const double v15 = 2.0 * w8;
+    const double e15 = ig_err_mul(2.0, 0.0, w8, w8_e, v15);
+    const double v16 = 2.0 * d[0];
+    const double e16 = ig_err_mul(2.0, 0.0, d[0], ed[0], v16);
+    const double v17 = v16 * o[0];
+    const double e17 = ig_err_mul(v16, e16, o[0], eo[0], v17);
+    const double v18 = v15 + v17;
+    const double e18 = ig_err_add(v15, e15, v17, e17, v18);
+    const double v19 = 2.0 * d[2];
+    const double e19 = ig_err_mul(2.0, 0.0, d[2], ed[2], v19);
+    const double v20 = v19 * o[2];
+    const double e20 = ig_err_mul(v19, e19, o[2], eo[2], v20);
+    const double v21 = v18 + v20;
+    const double e21 = ig_err_add(v18, e18, v20, e20, v21);
+    const double w9 = v21;
+    const double w9_e = e21;
+    const double v22 = 2.0 * w4;
+    const double e22 = ig_err_mul(2.0, 0.0, w4, w4_e, v22);
+    const double w10 = v22;
+    const double w10_e = e22;
+    const double v23 = 8.0 * w0;
+    const double e23 = ig_err_mul(8.0, 0.0, w0, w0_e, v23);
+    const double w11 = v23;
+    const double w11_e = e23;
+    const double v24 = d[1] * d[1];
+    const double e24 = ig_err_mul(d[1], ed[1], d[1], ed[1], v24);
+    const double w12 = v24;
+    const double w12_e = e24;
+    const double v25 = d[0] * d[0];
+    const double e25 = ig_err_mul(d[0], ed[0], d[0], ed[0], v25);
+    const double v26 = w12 + v25;
+    const double e26 = ig_err_add(w12, w12_e, v25, e25, v26);
+    const double v27 = d[2] * d[2];
+    const double e27 = ig_err_mul(d[2], ed[2], d[2], ed[2], v27);
+    const double v28 = v26 + v27;
+    const double e28 = ig_err_add(v26, e26, v27, e27, v28);
+    const double w13 = v28;
+    const double w13_e = e28;
+    const double v29 = w4 * w4;
+    const double e29 = ig_err_mul(w4, w4_e, w4, w4_e, v29);
+    const double v30 = w2 + v29;
+    const double e30 = ig_err_add(w2, w2_e, v29, e29, v30);
+    const double v31 = w3 * w7;
+    const double e31 = ig_err_mul(w3, w3_e, w7, w7_e, v31);
+    const double v32 = v30 + v31;
+    const double e32 = ig_err_add(v30, e30, v31, e31, v32);
+    const double v33 = w4 * w6;
+    const double e33 = ig_err_mul(w4, w4_e, w6, w6_e, v33);
+    const double v34 = v32 + v33;
+    const double e34 = ig_err_add(v32, e32, v33, e33, v34);
+    c[0] = v34;
+    e[0] = e34;
+    const double v35 = w10 * w9;
+    const double e35 = ig_err_mul(w10, w10_e, w9, w9_e, v35);
+    const double v36 = w11 * w8;
+    const double e36 = ig_err_mul(w11, w11_e, w8, w8_e, v36);
+    const double v37 = v35 + v36;
+    const double e37 = ig_err_add(v35, e35, v36, e36, v37);
+    const double v38 = w6 * w9;
+    const double e38 = ig_err_mul(w6, w6_e, w9, w9_e, v38);
+    const double v39 = v37 + v38;
+    const double e39 = ig_err_add(v37, e37, v38, e38, v39);
+    c[1] = v39;
+    e[1] = e39;
+    const double v40 = w9 * w9;
+    const double e40 = ig_err_mul(w9, w9_e, w9, w9_e, v40);
+    const double v41 = w10 * w13;
+    const double e41 = ig_err_mul(w10, w10_e, w13, w13_e, v41);
+    const double v42 = v40 + v41;
+    const double e42 = ig_err_add(v40, e40, v41, e41, v42);
+    const double v43 = w12 * w7;
+    const double e43 = ig_err_mul(w12, w12_e, w7, w7_e, v43);
+    const double v44 = v42 + v43;
+    const double e44 = ig_err_add(v42, e42, v43, e43, v44);
+    const double v45 = w13 * w6;
+    const double e45 = ig_err_mul(w13, w13_e, w6, w6_e, v45);
+    const double v46 = v44 + v45;
+    const double e46 = ig_err_add(v44, e44, v45, e45, v46);
+    c[2] = v46;
+    e[2] = e46;
+    const double v47 = 2.0 * w13;
+    const double e47 = ig_err_mul(2.0, 0.0, w13, w13_e, v47);
+    const double v48 = v47 * w9;
+    const double e48 = ig_err_mul(v47, e47, w9, w9_e, v48);
+    c[3] = v48;
+    e[3] = e48;
+    const double v49 = w13 * w13;
+    const double e49 = ig_err_mul(w13, w13_e, w13, w13_e, v49);
+    c[4] = v49;
+    e[4] = e49;
+    return 1;
 }
 
 double torus_y_value(const double p[3], const double *params)
@@ -102,7 +252,7 @@ int torus_y_bounds(const double *params, double box[6])
 
 const ig_shape torus_y_shape = {
     "torus_y", TORUS_Y_DEGREE, TORUS_Y_NPARAMS,
-    torus_y_coeffs, torus_y_value, torus_y_gradient, torus_y_bounds
+    torus_y_coeffs, torus_y_value, torus_y_gradient, torus_y_bounds, torus_y_coeffs_err
 };
 
 int torus_y_intersect(const double o[3], const double d[3], double tmin, double tmax,

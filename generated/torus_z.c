@@ -6,6 +6,7 @@
  *   arithmetic operations: coeffs 41, value 15, gradient 17
  */
 #include "torus_z.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -39,6 +40,133 @@ void torus_z_coeffs(const double o[3], const double d[3], const double *params, 
     c[2] = w10*w5 + w11*w8 + w7*w7;
     c[3] = 2*w11*w7;
     c[4] = w11*w11;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int torus_z_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                       const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double k_R = params[0];
+    const double k_r = params[1];
+    const double v0 = o[2] * o[2];
+    const double e0 = ig_err_mul(o[2], eo[2], o[2], eo[2], v0);
+    const double w0 = v0;
+    const double w0_e = e0;
+    const double v1 = k_R * k_R;
+    const double e1 = ig_err_mul(k_R, 0.0, k_R, 0.0, v1);
+    const double w1 = v1;
+    const double w1_e = e1;
+    const double v2 = k_r * k_r;
+    const double e2 = ig_err_mul(k_r, 0.0, k_r, 0.0, v2);
+    const double w2 = v2;
+    const double w2_e = e2;
+    const double v3 = -w1;
+    const double e3 = w1_e;
+    const double v4 = v3 - w2;
+    const double e4 = ig_err_add(v3, e3, w2, w2_e, v4);
+    const double w3 = v4;
+    const double w3_e = e4;
+    const double v5 = w0 + w3;
+    const double e5 = ig_err_add(w0, w0_e, w3, w3_e, v5);
+    const double v6 = o[0] * o[0];
+    const double e6 = ig_err_mul(o[0], eo[0], o[0], eo[0], v6);
+    const double v7 = v5 + v6;
+    const double e7 = ig_err_add(v5, e5, v6, e6, v7);
+    const double v8 = o[1] * o[1];
+    const double e8 = ig_err_mul(o[1], eo[1], o[1], eo[1], v8);
+    const double v9 = v7 + v8;
+    const double e9 = ig_err_add(v7, e7, v8, e8, v9);
+    const double w4 = v9;
+    const double w4_e = e9;
+    const double v10 = 4.0 * w1;
+    const double e10 = ig_err_mul(4.0, 0.0, w1, w1_e, v10);
+    const double w5 = v10;
+    const double w5_e = e10;
+    const double v11 = d[2] * o[2];
+    const double e11 = ig_err_mul(d[2], ed[2], o[2], eo[2], v11);
+    const double w6 = v11;
+    const double w6_e = e11;
+    const double v12 = 2.0 * w6;
+    const double e12 = ig_err_mul(2.0, 0.0, w6, w6_e, v12);
+    const double v13 = 2.0 * d[0];
+    const double e13 = ig_err_mul(2.0, 0.0, d[0], ed[0], v13);
+    const double v14 = v13 * o[0];
+    const double e14 = ig_err_mul(v13, e13, o[0], eo[0], v14);
+    const double v15 = v12 + v14;
+    const double e15 = ig_err_add(v12, e12, v14, e14, v15);
+    const double v16 = 2.0 * d[1];
+    const double e16 = ig_err_mul(2.0, 0.0, d[1], ed[1], v16);
+    const double v17 = v16 * o[1];
+    const double e17 = ig_err_mul(v16, e16, o[1], eo[1], v17);
+    const double v18 = v15 + v17;
+    const double e18 = ig_err_add(v15, e15, v17, e17, v18);
+    const double w7 = v18;
+    const double w7_e = e18;
+    const double v19 = 2.0 * w4;
+    const double e19 = ig_err_mul(2.0, 0.0, w4, w4_e, v19);
+    const double w8 = v19;
+    const double w8_e = e19;
+    const double v20 = 8.0 * w1;
+    const double e20 = ig_err_mul(8.0, 0.0, w1, w1_e, v20);
+    const double w9 = v20;
+    const double w9_e = e20;
+    const double v21 = d[2] * d[2];
+    const double e21 = ig_err_mul(d[2], ed[2], d[2], ed[2], v21);
+    const double w10 = v21;
+    const double w10_e = e21;
+    const double v22 = d[0] * d[0];
+    const double e22 = ig_err_mul(d[0], ed[0], d[0], ed[0], v22);
+    const double v23 = w10 + v22;
+    const double e23 = ig_err_add(w10, w10_e, v22, e22, v23);
+    const double v24 = d[1] * d[1];
+    const double e24 = ig_err_mul(d[1], ed[1], d[1], ed[1], v24);
+    const double v25 = v23 + v24;
+    const double e25 = ig_err_add(v23, e23, v24, e24, v25);
+    const double w11 = v25;
+    const double w11_e = e25;
+    const double v26 = w4 * w4;
+    const double e26 = ig_err_mul(w4, w4_e, w4, w4_e, v26);
+    const double v27 = w2 - w0;
+    const double e27 = ig_err_add(w2, w2_e, w0, w0_e, v27);
+    const double v28 = w5 * v27;
+    const double e28 = ig_err_mul(w5, w5_e, v27, e27, v28);
+    const double v29 = v26 - v28;
+    const double e29 = ig_err_add(v26, e26, v28, e28, v29);
+    c[0] = v29;
+    e[0] = e29;
+    const double v30 = w6 * w9;
+    const double e30 = ig_err_mul(w6, w6_e, w9, w9_e, v30);
+    const double v31 = w7 * w8;
+    const double e31 = ig_err_mul(w7, w7_e, w8, w8_e, v31);
+    const double v32 = v30 + v31;
+    const double e32 = ig_err_add(v30, e30, v31, e31, v32);
+    c[1] = v32;
+    e[1] = e32;
+    const double v33 = w7 * w7;
+    const double e33 = ig_err_mul(w7, w7_e, w7, w7_e, v33);
+    const double v34 = w10 * w5;
+    const double e34 = ig_err_mul(w10, w10_e, w5, w5_e, v34);
+    const double v35 = v33 + v34;
+    const double e35 = ig_err_add(v33, e33, v34, e34, v35);
+    const double v36 = w11 * w8;
+    const double e36 = ig_err_mul(w11, w11_e, w8, w8_e, v36);
+    const double v37 = v35 + v36;
+    const double e37 = ig_err_add(v35, e35, v36, e36, v37);
+    c[2] = v37;
+    e[2] = e37;
+    const double v38 = 2.0 * w11;
+    const double e38 = ig_err_mul(2.0, 0.0, w11, w11_e, v38);
+    const double v39 = v38 * w7;
+    const double e39 = ig_err_mul(v38, e38, w7, w7_e, v39);
+    c[3] = v39;
+    e[3] = e39;
+    const double v40 = w11 * w11;
+    const double e40 = ig_err_mul(w11, w11_e, w11, w11_e, v40);
+    c[4] = v40;
+    e[4] = e40;
+    return 1;
 }
 
 double torus_z_value(const double p[3], const double *params)
@@ -99,7 +227,7 @@ int torus_z_bounds(const double *params, double box[6])
 
 const ig_shape torus_z_shape = {
     "torus_z", TORUS_Z_DEGREE, TORUS_Z_NPARAMS,
-    torus_z_coeffs, torus_z_value, torus_z_gradient, torus_z_bounds
+    torus_z_coeffs, torus_z_value, torus_z_gradient, torus_z_bounds, torus_z_coeffs_err
 };
 
 int torus_z_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -5,6 +5,7 @@
  *   arithmetic operations: coeffs 20, value 4, gradient 6
  */
 #include "whitney.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -26,6 +27,71 @@ void whitney_coeffs(const double o[3], const double d[3], const double *params, 
     c[1] = 2*dx*ox - dz*w0 - oz*w1;
     c[2] = -dz*w1 - oz*w2 + dx*dx;
     c[3] = -dz*w2;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int whitney_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                       const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double v0 = o[1] * o[1];
+    const double e0 = ig_err_mul(o[1], eo[1], o[1], eo[1], v0);
+    const double w0 = v0;
+    const double w0_e = e0;
+    const double v1 = 2.0 * d[1];
+    const double e1 = ig_err_mul(2.0, 0.0, d[1], ed[1], v1);
+    const double v2 = v1 * o[1];
+    const double e2 = ig_err_mul(v1, e1, o[1], eo[1], v2);
+    const double w1 = v2;
+    const double w1_e = e2;
+    const double v3 = d[1] * d[1];
+    const double e3 = ig_err_mul(d[1], ed[1], d[1], ed[1], v3);
+    const double w2 = v3;
+    const double w2_e = e3;
+    const double v4 = o[0] * o[0];
+    const double e4 = ig_err_mul(o[0], eo[0], o[0], eo[0], v4);
+    const double v5 = o[2] * w0;
+    const double e5 = ig_err_mul(o[2], eo[2], w0, w0_e, v5);
+    const double v6 = v4 - v5;
+    const double e6 = ig_err_add(v4, e4, v5, e5, v6);
+    c[0] = v6;
+    e[0] = e6;
+    const double v7 = d[2] * w0;
+    const double e7 = ig_err_mul(d[2], ed[2], w0, w0_e, v7);
+    const double v8 = -v7;
+    const double e8 = e7;
+    const double v9 = o[2] * w1;
+    const double e9 = ig_err_mul(o[2], eo[2], w1, w1_e, v9);
+    const double v10 = v8 - v9;
+    const double e10 = ig_err_add(v8, e8, v9, e9, v10);
+    const double v11 = 2.0 * d[0];
+    const double e11 = ig_err_mul(2.0, 0.0, d[0], ed[0], v11);
+    const double v12 = v11 * o[0];
+    const double e12 = ig_err_mul(v11, e11, o[0], eo[0], v12);
+    const double v13 = v10 + v12;
+    const double e13 = ig_err_add(v10, e10, v12, e12, v13);
+    c[1] = v13;
+    e[1] = e13;
+    const double v14 = d[0] * d[0];
+    const double e14 = ig_err_mul(d[0], ed[0], d[0], ed[0], v14);
+    const double v15 = d[2] * w1;
+    const double e15 = ig_err_mul(d[2], ed[2], w1, w1_e, v15);
+    const double v16 = v14 - v15;
+    const double e16 = ig_err_add(v14, e14, v15, e15, v16);
+    const double v17 = o[2] * w2;
+    const double e17 = ig_err_mul(o[2], eo[2], w2, w2_e, v17);
+    const double v18 = v16 - v17;
+    const double e18 = ig_err_add(v16, e16, v17, e17, v18);
+    c[2] = v18;
+    e[2] = e18;
+    const double v19 = d[2] * w2;
+    const double e19 = ig_err_mul(d[2], ed[2], w2, w2_e, v19);
+    const double v20 = -v19;
+    const double e20 = e19;
+    c[3] = v20;
+    e[3] = e20;
+    return 1;
 }
 
 double whitney_value(const double p[3], const double *params)
@@ -67,7 +133,7 @@ int whitney_bounds(const double *params, double box[6])
 
 const ig_shape whitney_shape = {
     "whitney", WHITNEY_DEGREE, WHITNEY_NPARAMS,
-    whitney_coeffs, whitney_value, whitney_gradient, whitney_bounds
+    whitney_coeffs, whitney_value, whitney_gradient, whitney_bounds, whitney_coeffs_err
 };
 
 int whitney_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -5,6 +5,7 @@
  *   arithmetic operations: coeffs 64, value 10, gradient 14
  */
 #include "zitrus.h"
+#include "errarith.h"
 
 #include <math.h>
 #include <string.h>
@@ -42,6 +43,189 @@ void zitrus_coeffs(const double o[3], const double d[3], const double *params, d
     c[4] = -w1*w10*w11 + w12*w3 + w12*w5;
     c[5] = oy*w13 - w1*w13;
     c[6] = q0*q1;
+}
+
+/* The same coefficients, each with a bound on its error (docs/certify.md): o and d are known to within eo and
+ * ed, componentwise. Returns 1, or 0 when no bound could be printed for an operation. */
+int zitrus_coeffs_err(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                      const double *params, double *c, double *e)
+{
+    (void)o; (void)eo; (void)d; (void)ed; (void)params;
+    const double v0 = d[1] * d[1];
+    const double e0 = ig_err_mul(d[1], ed[1], d[1], ed[1], v0);
+    const double q0 = v0;
+    const double q0_e = e0;
+    const double v1 = q0 * q0;
+    const double e1 = ig_err_mul(q0, q0_e, q0, q0_e, v1);
+    const double q1 = v1;
+    const double q1_e = e1;
+    const double v2 = o[1] * o[1];
+    const double e2 = ig_err_mul(o[1], eo[1], o[1], eo[1], v2);
+    const double v3 = o[1] * v2;
+    const double e3 = ig_err_mul(o[1], eo[1], v2, e2, v3);
+    const double w0 = v3;
+    const double w0_e = e3;
+    const double v4 = 1.0 - o[1];
+    const double e4 = ig_err_add(1.0, 0.0, o[1], eo[1], v4);
+    const double w1 = v4;
+    const double w1_e = e4;
+    const double v5 = w1 * w1;
+    const double e5 = ig_err_mul(w1, w1_e, w1, w1_e, v5);
+    const double v6 = w1 * v5;
+    const double e6 = ig_err_mul(w1, w1_e, v5, e5, v6);
+    const double w2 = v6;
+    const double w2_e = e6;
+    const double v7 = o[1] * o[1];
+    const double e7 = ig_err_mul(o[1], eo[1], o[1], eo[1], v7);
+    const double w3 = v7;
+    const double w3_e = e7;
+    const double v8 = 3.0 * d[1];
+    const double e8 = ig_err_mul(3.0, 0.0, d[1], ed[1], v8);
+    const double w4 = v8;
+    const double w4_e = e8;
+    const double v9 = w1 * w1;
+    const double e9 = ig_err_mul(w1, w1_e, w1, w1_e, v9);
+    const double w5 = v9;
+    const double w5_e = e9;
+    const double w6 = q0;
+    const double w6_e = q0_e;
+    const double v10 = 3.0 * w6;
+    const double e10 = ig_err_mul(3.0, 0.0, w6, w6_e, v10);
+    const double w7 = v10;
+    const double w7_e = e10;
+    const double v11 = 9.0 * w3;
+    const double e11 = ig_err_mul(9.0, 0.0, w3, w3_e, v11);
+    const double w8 = v11;
+    const double w8_e = e11;
+    const double v12 = d[1] * q0;
+    const double e12 = ig_err_mul(d[1], ed[1], q0, q0_e, v12);
+    const double w9 = v12;
+    const double w9_e = e12;
+    const double v13 = 9.0 * o[1];
+    const double e13 = ig_err_mul(9.0, 0.0, o[1], eo[1], v13);
+    const double w10 = v13;
+    const double w10_e = e13;
+    const double w11 = q1;
+    const double w11_e = q1_e;
+    const double v14 = 3.0 * w11;
+    const double e14 = ig_err_mul(3.0, 0.0, w11, w11_e, v14);
+    const double w12 = v14;
+    const double w12_e = e14;
+    const double v15 = 3.0 * d[1];
+    const double e15 = ig_err_mul(3.0, 0.0, d[1], ed[1], v15);
+    const double v16 = v15 * q1;
+    const double e16 = ig_err_mul(v15, e15, q1, q1_e, v16);
+    const double w13 = v16;
+    const double w13_e = e16;
+    const double v17 = o[0] * o[0];
+    const double e17 = ig_err_mul(o[0], eo[0], o[0], eo[0], v17);
+    const double v18 = o[2] * o[2];
+    const double e18 = ig_err_mul(o[2], eo[2], o[2], eo[2], v18);
+    const double v19 = v17 + v18;
+    const double e19 = ig_err_add(v17, e17, v18, e18, v19);
+    const double v20 = w0 * w2;
+    const double e20 = ig_err_mul(w0, w0_e, w2, w2_e, v20);
+    const double v21 = v19 - v20;
+    const double e21 = ig_err_add(v19, e19, v20, e20, v21);
+    c[0] = v21;
+    e[0] = e21;
+    const double v22 = 2.0 * d[0];
+    const double e22 = ig_err_mul(2.0, 0.0, d[0], ed[0], v22);
+    const double v23 = v22 * o[0];
+    const double e23 = ig_err_mul(v22, e22, o[0], eo[0], v23);
+    const double v24 = 2.0 * d[2];
+    const double e24 = ig_err_mul(2.0, 0.0, d[2], ed[2], v24);
+    const double v25 = v24 * o[2];
+    const double e25 = ig_err_mul(v24, e24, o[2], eo[2], v25);
+    const double v26 = v23 + v25;
+    const double e26 = ig_err_add(v23, e23, v25, e25, v26);
+    const double v27 = w0 * w4;
+    const double e27 = ig_err_mul(w0, w0_e, w4, w4_e, v27);
+    const double v28 = v27 * w5;
+    const double e28 = ig_err_mul(v27, e27, w5, w5_e, v28);
+    const double v29 = v26 + v28;
+    const double e29 = ig_err_add(v26, e26, v28, e28, v29);
+    const double v30 = w2 * w3;
+    const double e30 = ig_err_mul(w2, w2_e, w3, w3_e, v30);
+    const double v31 = v30 * w4;
+    const double e31 = ig_err_mul(v30, e30, w4, w4_e, v31);
+    const double v32 = v29 - v31;
+    const double e32 = ig_err_add(v29, e29, v31, e31, v32);
+    c[1] = v32;
+    e[1] = e32;
+    const double v33 = d[0] * d[0];
+    const double e33 = ig_err_mul(d[0], ed[0], d[0], ed[0], v33);
+    const double v34 = d[2] * d[2];
+    const double e34 = ig_err_mul(d[2], ed[2], d[2], ed[2], v34);
+    const double v35 = v33 + v34;
+    const double e35 = ig_err_add(v33, e33, v34, e34, v35);
+    const double v36 = w5 * w6;
+    const double e36 = ig_err_mul(w5, w5_e, w6, w6_e, v36);
+    const double v37 = v36 * w8;
+    const double e37 = ig_err_mul(v36, e36, w8, w8_e, v37);
+    const double v38 = v35 + v37;
+    const double e38 = ig_err_add(v35, e35, v37, e37, v38);
+    const double v39 = o[1] * w2;
+    const double e39 = ig_err_mul(o[1], eo[1], w2, w2_e, v39);
+    const double v40 = v39 * w7;
+    const double e40 = ig_err_mul(v39, e39, w7, w7_e, v40);
+    const double v41 = v38 - v40;
+    const double e41 = ig_err_add(v38, e38, v40, e40, v41);
+    const double v42 = w0 * w1;
+    const double e42 = ig_err_mul(w0, w0_e, w1, w1_e, v42);
+    const double v43 = v42 * w7;
+    const double e43 = ig_err_mul(v42, e42, w7, w7_e, v43);
+    const double v44 = v41 - v43;
+    const double e44 = ig_err_add(v41, e41, v43, e43, v44);
+    c[2] = v44;
+    e[2] = e44;
+    const double v45 = w0 * w9;
+    const double e45 = ig_err_mul(w0, w0_e, w9, w9_e, v45);
+    const double v46 = w2 * w9;
+    const double e46 = ig_err_mul(w2, w2_e, w9, w9_e, v46);
+    const double v47 = v45 - v46;
+    const double e47 = ig_err_add(v45, e45, v46, e46, v47);
+    const double v48 = w10 * w5;
+    const double e48 = ig_err_mul(w10, w10_e, w5, w5_e, v48);
+    const double v49 = v48 * w9;
+    const double e49 = ig_err_mul(v48, e48, w9, w9_e, v49);
+    const double v50 = v47 + v49;
+    const double e50 = ig_err_add(v47, e47, v49, e49, v50);
+    const double v51 = w1 * w8;
+    const double e51 = ig_err_mul(w1, w1_e, w8, w8_e, v51);
+    const double v52 = v51 * w9;
+    const double e52 = ig_err_mul(v51, e51, w9, w9_e, v52);
+    const double v53 = v50 - v52;
+    const double e53 = ig_err_add(v50, e50, v52, e52, v53);
+    c[3] = v53;
+    e[3] = e53;
+    const double v54 = w12 * w3;
+    const double e54 = ig_err_mul(w12, w12_e, w3, w3_e, v54);
+    const double v55 = w12 * w5;
+    const double e55 = ig_err_mul(w12, w12_e, w5, w5_e, v55);
+    const double v56 = v54 + v55;
+    const double e56 = ig_err_add(v54, e54, v55, e55, v56);
+    const double v57 = w1 * w10;
+    const double e57 = ig_err_mul(w1, w1_e, w10, w10_e, v57);
+    const double v58 = v57 * w11;
+    const double e58 = ig_err_mul(v57, e57, w11, w11_e, v58);
+    const double v59 = v56 - v58;
+    const double e59 = ig_err_add(v56, e56, v58, e58, v59);
+    c[4] = v59;
+    e[4] = e59;
+    const double v60 = o[1] * w13;
+    const double e60 = ig_err_mul(o[1], eo[1], w13, w13_e, v60);
+    const double v61 = w1 * w13;
+    const double e61 = ig_err_mul(w1, w1_e, w13, w13_e, v61);
+    const double v62 = v60 - v61;
+    const double e62 = ig_err_add(v60, e60, v61, e61, v62);
+    c[5] = v62;
+    e[5] = e62;
+    const double v63 = q0 * q1;
+    const double e63 = ig_err_mul(q0, q0_e, q1, q1_e, v63);
+    c[6] = v63;
+    e[6] = e63;
+    return 1;
 }
 
 double zitrus_value(const double p[3], const double *params)
@@ -87,7 +271,7 @@ int zitrus_bounds(const double *params, double box[6])
 
 const ig_shape zitrus_shape = {
     "zitrus", ZITRUS_DEGREE, ZITRUS_NPARAMS,
-    zitrus_coeffs, zitrus_value, zitrus_gradient, zitrus_bounds
+    zitrus_coeffs, zitrus_value, zitrus_gradient, zitrus_bounds, zitrus_coeffs_err
 };
 
 int zitrus_intersect(const double o[3], const double d[3], double tmin, double tmax,

@@ -20,6 +20,11 @@ typedef struct ig_shape {
     /* Object-space box {xmin, ymin, zmin, xmax, ymax, zmax}; an axis the spec leaves open is +-INFINITY.
      * Returns 1 when the spec gives bounds, 0 when the shape is unbounded (box then all +-INFINITY). */
     int (*bounds)(const double *params, double box[6]);
+    /* The coefficients again, each with a rigorous bound e[k] on its error, for an origin and a direction known
+     * within eo and ed componentwise (docs/certify.md); returns 0 when it has no bound. NULL in a hand-made
+     * shape: its rays are never certified. */
+    int (*coeffs_err)(const double o[3], const double eo[3], const double d[3], const double ed[3],
+                      const double *params, double *c, double *e);
 } ig_shape;
 
 /* All distinct roots of f(o + t d) in [tmin, tmax], ascending; returns the count (<= shape->degree).

@@ -21,6 +21,7 @@
 #if defined(__linux__) && !defined(_GNU_SOURCE)
 #define _GNU_SOURCE /* sched_getaffinity, sched_setaffinity: one thread per core when all cores render */
 #endif
+#include "certify.h"
 #include "tracer_internal.h"
 
 #include <math.h>
@@ -408,4 +409,47 @@ void rt_render_stats(rt_render *r, double out[RT_NSTATS])
     pthread_mutex_lock(&r->lock);
     memcpy(out, r->stats, sizeof r->stats);
     pthread_mutex_unlock(&r->lock);
+}
+
+/* ---- for the certify pass (certify.c): the primary rays exactly as render_row makes them ---- */
+
+const rt_scene *rt_render_scene(const rt_render *r) { return r->s; }
+
+void rt_render_shape(const rt_render *r, int *y0, int *y1, int *width, int *spp, int *threads)
+{
+    *y0 = r->y0;
+    *y1 = r->y1;
+    *width = r->width;
+    *spp = r->spp;
+    *threads = r->threads;
+}
+
+int rt_render_primary_rays(const rt_render *r, int x, int y, double o[3], double *dirs)
+{
+    int k, a, *perm = NULL, stack_perm[64];
+    uint64_t rng = 0;
+    memcpy(o, r->eye, sizeof r->eye);
+    if (r->spp > 1) {
+        perm = r->spp <= 64 ? stack_perm : malloc((size_t)r->spp * sizeof(int));
+        if (!perm)
+            return 0;
+        rng = pixel_stream(r, x, y, perm);
+    }
+    for (k = 0; k < r->spp; ++k) {
+        double px, py;
+        if (r->spp == 1) {
+            px = (2.0 * (x + 0.5) / r->width - 1.0) * r->tan_half * r->aspect;
+            py = (1.0 - 2.0 * (y + 0.5) / r->height) * r->tan_half;
+        } else {
+            double sx = (k + uniform01(&rng)) / r->spp;
+            double sy = (perm[k] + uniform01(&rng)) / r->spp;
+            px = (2.0 * (x + sx) / r->width - 1.0) * r->tan_half * r->aspect;
+            py = (1.0 - 2.0 * (y + sy) / r->height) * r->tan_half;
+        }
+        for (a = 0; a < 3; ++a)
+            dirs[3 * k + a] = px * r->u[a] + py * r->v[a] - r->w[a];
+    }
+    if (perm && perm != stack_perm)
+        free(perm);
+    return r->spp;
 }

@@ -118,7 +118,7 @@ def test_grown_box_is_the_box_ig_shape_prepare_clips_to(tmp_path):
         "static void coeffs(const double o[3], const double d[3], const double *p, double *c)\n{\n"
         "    (void)p;\n    c[0] = o[0];\n    c[1] = d[0];\n}\n"
         "int main(void)\n{\n"
-        '    const ig_shape shape = {"probe", 1, 1, coeffs, NULL, NULL, bounds};\n'
+        '    const ig_shape shape = {"probe", 1, 1, coeffs, NULL, NULL, bounds, NULL};\n'
         f"    for (int k = 0; k < {len(boxes)}; ++k) {{\n"
         "        const double params[1] = {k};\n        ig_shape_prep prep;\n"
         "        ig_shape_prepare(&shape, params, &prep);\n"

@@ -397,6 +397,26 @@ CASES += [
         names="-o v.mp4",
     ),
     Case("no-output", ["render", "s.yaml"], "arguments are required: -o/--output", {"s.yaml": OBJ}, names="render"),
+    render("certify-jpg", ["--certify", "m.jpg"], "the output must end in .png", "--certify m.jpg"),
+    render("certify-same-as-out", ["--certify", "out.png"], "is the same file as -o", "--certify out.png"),
+    render("certify-in-proc", ["--certify", "/proc/m.png"], "cannot write in /proc", "--certify /proc/m.png"),
+    render("report-alone", ["--report", "r.json"], "needs --certify MAP.png", "--report r.json"),
+    render("report-txt", ["--certify", "m.png", "--report", "r.txt"], "must end in .json", "--report r.txt"),
+    render("certify-tiles", ["--certify", "m.png", "--tiles", "2"], "only a still image", "--certify"),
+    Case(
+        "certify-animation",
+        ["render", "a.yaml", "-o", "f_%d.png", "--certify", "m.png"],
+        "only a still image",
+        {"a.yaml": "animation: {frames: 3}\n" + OBJ},
+        names="--certify",
+    ),
+    Case(
+        "certify-folder",
+        ["render", "s.yaml", "-o", "o.png", "--certify", "d"],
+        "is a folder",
+        {"s.yaml": OBJ, "d": FOLDER},
+        names="--certify d",
+    ),
 ]
 
 

@@ -57,3 +57,14 @@ def write_png(img: np.ndarray, path: str | Path) -> None:
     half-written."""
     data = encode_png(to_uint8(img))
     atomic_write(Path(path), lambda fh: fh.write(data))
+
+
+def write_grey_png(values: np.ndarray, path: str | Path) -> None:
+    """An 8-bit grey image (height, width) of uint8 values to a PNG file as they are (the certify map: codes,
+    not brightness), written atomically."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(np.ascontiguousarray(values, dtype=np.uint8), mode="L").save(buf, format="PNG")
+    data = buf.getvalue()
+    atomic_write(Path(path), lambda fh: fh.write(data))

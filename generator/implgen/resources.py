@@ -32,6 +32,8 @@ TRACER_SOURCES = (
     "tracer_shade.c",
     "tracer_render.c",
     "tracer_floor.c",
+    "certify.c",  # the certify pass (docs/certify.md): runs only when asked for
+    "certify_poly.c",
 )
 # The Embree 3 adapter (docs/embree.md): in no library implgen builds, so nothing here needs Embree; compiled by
 # whoever links Embree (examples/embree/, tests/test_embree.py, bench/embree.py)

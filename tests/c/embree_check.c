@@ -54,7 +54,7 @@ static int plane_bounds(const double *p, double box[6])
     box[4] = 1.0;
     return 1;
 }
-static const ig_shape plane_shape = {"ground", 1, 1, plane_y_coeffs, plane_y_value, plane_y_gradient, plane_bounds};
+static const ig_shape plane_shape = {"ground", 1, 1, plane_y_coeffs, plane_y_value, plane_y_gradient, plane_bounds, 0};
 
 typedef struct scene_in {
     double eye[3], look[3], up[3], fov, light[3], ground;

@@ -43,4 +43,5 @@ static int torus_bounds(const double *params, double box[6])
     return 1;
 }
 
-const ig_shape shape_torus_fixture = {"torus_fixture", 4, 2, torus_coeffs, torus_value, torus_gradient, torus_bounds};
+const ig_shape shape_torus_fixture = {"torus_fixture", 4, 2, torus_coeffs, torus_value, torus_gradient,
+                                      torus_bounds,    0};

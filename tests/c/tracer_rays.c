@@ -140,7 +140,7 @@ static int cyl_bounds(const double *p, double box[6])
     box[5] = 1.0;
     return 1;
 }
-static const ig_shape capped_cylinder = {"capped_cylinder", 2, 0, cyl_coeffs, cyl_value, cyl_gradient, cyl_bounds};
+static const ig_shape capped_cylinder = {"capped_cylinder", 2, 0, cyl_coeffs, cyl_value, cyl_gradient, cyl_bounds, 0};
 
 /* The CSG scene and its nodes: unit spheres A at 0 and B at (1, 0, 0), their union U, intersection I and
  * difference D (the one object of the three); the torus (R = 1, r = 0.25) minus the unit sphere S, TD; and, away

@@ -251,7 +251,7 @@ static int plane_bounds(const double *p, double box[6])
     box[3] = box[4] = box[5] = INFINITY;
     return 0;
 }
-static const ig_shape plane_y = {"plane_y", 1, 0, plane_y_coeffs, plane_y_value, plane_y_gradient, plane_bounds};
+static const ig_shape plane_y = {"plane_y", 1, 0, plane_y_coeffs, plane_y_value, plane_y_gradient, plane_bounds, 0};
 
 /* A tilted plane, a transformed torus, an opaque sphere and a glass sphere: the scene and two of its objects. */
 typedef struct {

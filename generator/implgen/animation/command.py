@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -20,7 +21,8 @@ from implgen.animation.frameout import FrameOutput, plan_output
 from implgen.animation.frames import FrameOptions, Frames, load_frames, parse_range
 from implgen.args import ArgumentParser
 from implgen.errors import UserError, printable
-from implgen.imagefile import write_png
+from implgen.imagefile import write_grey_png, write_png
+from implgen.outputs import atomic_write, check_output_file
 from implgen.scene.keys import MAX_FRAMES
 from implgen.scene.render import DEFAULT_FOLD, RenderInfo, image_options, render
 
@@ -84,13 +86,28 @@ def _parser() -> ArgumentParser:
     ap.add_argument("--tiles", type=_positive, metavar="K", help="render each frame as K bands of rows (K tasks)")
     ap.add_argument("--retries", type=int, default=3, help="reruns of a failed task (default 3)")
     ap.add_argument("--keep-frames", action="store_true", help="keep a video's or GIF's frame PNGs")
+    ap.add_argument("--certify", type=Path, metavar="MAP.png", help="a still only: its primary rays' certify map")
+    ap.add_argument("--report", type=Path, metavar="R.json", help="with --certify: counts per reason and per object")
     ap.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     return ap
+
+
+def _check_certify(args: argparse.Namespace) -> None:
+    """--certify MAP.png and --report R.json: checked before the scene is read."""
+    if args.report is not None and args.certify is None:
+        raise UserError(f"--report {args.report}", "needs --certify MAP.png")
+    if args.certify is not None:
+        check_output_file(args.certify, "--certify", (".png",))
+        if args.certify.resolve() == args.output.resolve():
+            raise UserError(f"--certify {args.certify}", "is the same file as -o")
+    if args.report is not None:
+        check_output_file(args.report, "--report", (".json",))
 
 
 def main(argv: Sequence[str]) -> int:
     args = _parser().parse_args(list(argv))
     validate.whole("--retries", "", args.retries, 0, MAX_RETRIES)
+    _check_certify(args)
     address = _check_dask(args)
     plan_output(args.output, 1, MAX_FRAMES - 1, 2, 2)  # the path alone, before reading the scene
     frames = load_frames(args.scene)
@@ -103,7 +120,10 @@ def main(argv: Sequence[str]) -> int:
     if args.tiles is not None:
         validate.whole("--tiles", "", args.tiles, 1, opts.height)
     distributed = args.local_workers is not None or address is not None
-    if out.kind == "still" and args.tiles is None and not distributed:
+    still = out.kind == "still" and args.tiles is None and not distributed
+    if args.certify is not None and not still:
+        raise UserError("--certify", "only a still image rendered here is certified (no animation, --tiles or Dask)")
+    if still:
         return _still(args, frames, todo[0], opts, out)
     return _many(args, frames, todo, opts, out, address)
 
@@ -146,7 +166,7 @@ def _options(args: argparse.Namespace, frames: Frames) -> FrameOptions:
 def _still(args: argparse.Namespace, frames: Frames, frame: int, opts: FrameOptions, out: FrameOutput) -> int:
     """One image in this process, with a progress bar over rows (what `implgen render` always did)."""
     info = RenderInfo()
-    img = render(
+    got = render(
         frames.scene(frame),
         width=opts.width,
         height=opts.height,
@@ -156,17 +176,39 @@ def _still(args: argparse.Namespace, frames: Frames, frame: int, opts: FrameOpti
         progress=not args.quiet,
         fold=args.fold or DEFAULT_FOLD,
         info=info,
+        certify=args.certify is not None,
     )
+    img, cert = got if args.certify is not None else (got, None)
     try:
         write_png(img, out.target)
     except OSError as err:  # what the early check could not foresee: a full disk, a folder removed meanwhile
         raise UserError(f"-o {args.output}", f"cannot write: {err.strerror or err}") from None
+    if cert is not None:
+        _write_certificate(args, cert)
     total = sum(info.rays.values())
     print(
         f"implgen: wrote {printable(str(out.target))} ({img.shape[1]}x{img.shape[0]}, {info.seconds:.3f} s on "
         f"{info.threads} threads, {total / max(info.seconds, 1e-9) / 1e6:.2f} Mrays/s)"
     )
     return 0
+
+
+def _write_certificate(args: argparse.Namespace, cert) -> None:
+    """The certify map and its report, and one line saying how many pixels are certified."""
+    option, path = "--certify", args.certify
+    try:
+        write_grey_png(cert.codes, args.certify)
+        if args.report is not None:
+            option, path = "--report", args.report
+            text = json.dumps(cert.report(), indent=1) + "\n"
+            atomic_write(args.report, lambda fh: fh.write(text.encode()))
+    except OSError as err:
+        raise UserError(f"{option} {path}", f"cannot write: {err.strerror or err}") from None
+    rep = cert.report()
+    print(
+        f"implgen: certified {rep['certified']} of {rep['pixels']} pixels ({rep['not_certified']} not: "
+        f"{printable(str(args.certify))}; certify pass {cert.seconds:.3f} s)"
+    )
 
 
 def _run(

@@ -19,6 +19,7 @@ import numpy as np
 
 from implgen import validate
 from implgen.scene.build import BuildResult, build_scene
+from implgen.scene.certify import Certificate, object_names, reason_names
 from implgen.scene.load import MAX_DEPTH, MAX_SIZE, MAX_SPP, load_scene, parse_scene
 from implgen.scene.model import Scene
 from implgen.scene.renderjob import RenderJob
@@ -153,11 +154,13 @@ def render(
     info: RenderInfo | None = None,
     built: BuildResult | None = None,
     rows: tuple[int, int] | None = None,
-) -> np.ndarray:
+    certify: bool = False,
+) -> np.ndarray | tuple[np.ndarray, Certificate]:
     """Render a scene (a Scene, a scene file path, or a scene mapping) to a float32 array (height, width, 3),
     row 0 at the top, colours linear and not clamped. Options override the scene's `image` settings. `built`:
     the scene library when the caller has it already (the frames of one animation share one). `rows`: only
-    the band of rows [y0, y1) of the image (a tile), exactly as those rows of the whole image."""
+    the band of rows [y0, y1) of the image (a tile), exactly as those rows of the whole image. `certify`: also
+    the certify pass over the same primary rays (docs/certify.md), returned as (image, Certificate)."""
     sc = _as_scene(scene)
     s = _settings(sc, width, height, spp, threads, max_depth, seed, rows)
     if built is None:
@@ -173,6 +176,10 @@ def render(
                     bar.close()
             if info is not None:
                 _record(info, job, built, s.threads)
+            if certify:
+                codes, objects = job.certify()
+                names = object_names(sc)
+                return img, Certificate(codes, objects, reason_names(cs.lib), names, job.certify_seconds)
             return img
     finally:
         cs.close()

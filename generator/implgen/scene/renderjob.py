@@ -65,6 +65,7 @@ class RenderJob:
         self._band = rows
         self.rows = (0, height) if rows is None else rows
         self.seconds = 0.0  # wall time of rt_render_run, once run
+        self.certify_seconds = 0.0  # wall time of rt_render_certify, once run
         self.image: np.ndarray | None = None
         self._sums: np.ndarray | None = None  # the passes' running sums (run_pass)
         self._samples = {PIXELS_EVEN: 0, PIXELS_ODD: 0}  # samples a pixel the passes have added, by lattice
@@ -150,6 +151,26 @@ class RenderJob:
                 for p in lattices:
                     self._samples[p] = k1
         return self._outcome(code)
+
+    def certify(self) -> tuple[np.ndarray, np.ndarray]:
+        """The certify pass over the rows run renders (runtime_c/certify.h): the code of each pixel's primary
+        rays (uint8) and the object each code is about (int32, -1: none), timed into certify_seconds."""
+        y0, y1 = self.rows
+        width = self._args[0]
+        codes = np.zeros((y1 - y0, width), dtype=np.uint8)
+        objects = np.full((y1 - y0, width), -1, dtype=np.int32)
+        with self._running:
+            with self._guard:
+                ctx = self._ctx
+                if ctx is None:
+                    raise RuntimeError("certify runs inside the with block")
+            t0 = time.perf_counter()
+            c_codes = codes.ctypes.data_as(ctypes.POINTER(ctypes.c_uint8))
+            code = self.cs.lib.rt_render_certify(ctx, c_codes, objects.ctypes.data_as(ctypes.POINTER(ctypes.c_int)))
+            self.certify_seconds = time.perf_counter() - t0
+        if code != 0:
+            raise RuntimeError(f"certify pass failed (code {code})")
+        return codes, objects
 
     def cancel(self) -> None:
         """Ask the run to stop after its current rows (thread-safe; before the run: it will stop at once)."""

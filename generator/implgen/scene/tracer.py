@@ -60,6 +60,9 @@ def bind(lib: ctypes.CDLL) -> ctypes.CDLL:
         "rt_render_progress": (ctypes.c_int, [vp]),
         "rt_render_cancel": (None, [vp]),
         "rt_render_stats": (None, [vp, _pd]),
+        "rt_render_certify": (ctypes.c_int, [vp, ctypes.POINTER(ctypes.c_uint8), ctypes.POINTER(ctypes.c_int)]),
+        "rt_certify_ray": (ctypes.c_int, [vp, _pd, _pd, ctypes.POINTER(ctypes.c_int)]),
+        "rt_certify_reason": (ctypes.c_char_p, [ctypes.c_int]),
         "rt_trace_ray": (None, [vp, _pd, _pd, ctypes.c_int, _pd, _pd]),
         "rt_scene_intersect": (ctypes.c_int, [vp, _pd, _pd, _d, _d, ctypes.POINTER(RtHit)]),
         "rt_spawn_origin": (None, [ctypes.POINTER(RtHit), _pd, _pd]),
@@ -157,6 +160,12 @@ class CScene:
         if self.lib.rt_scene_intersect(self.ptr, darr(o), darr(d), tmin, tmax, ctypes.byref(hit)):
             return hit
         return None
+
+    def certify(self, o: Sequence[float], d: Sequence[float]) -> tuple[int, int]:
+        """The certificate of one ray o + t d, t > 0 (runtime_c/certify.h): (code, object; -1 for none)."""
+        obj = ctypes.c_int(-1)
+        code = self.lib.rt_certify_ray(self.ptr, darr(o), darr(d), ctypes.byref(obj))
+        return code, obj.value
 
     def close(self) -> None:
         if getattr(self, "ptr", None):

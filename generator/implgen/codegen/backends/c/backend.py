@@ -5,6 +5,7 @@ from __future__ import annotations
 import sympy
 from sympy.printing.c import C99CodePrinter
 
+from implgen.codegen.backends.c.errbound import c_extra
 from implgen.codegen.backends.contract import EXACT_INT, Backend, FiniteConstants, finite_double
 
 
@@ -20,4 +21,4 @@ class CPrinter(FiniteConstants, C99CodePrinter):
         return repr(finite_double(value)) if abs(value) < EXACT_INT else f"{finite_double(value):.17g}"
 
 
-BACKEND = Backend("c", (("shape.h.j2", "{name}.h"), ("shape.c.j2", "{name}.c")), CPrinter)
+BACKEND = Backend("c", (("shape.h.j2", "{name}.h"), ("shape.c.j2", "{name}.c")), CPrinter, c_extra)
