@@ -24,6 +24,7 @@ worker) and prints the instruction count:
 from __future__ import annotations
 
 import argparse
+import contextlib
 import re
 import subprocess
 import sys
@@ -33,6 +34,29 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = sorted((ROOT / "bench" / "scenes").glob("*.yaml")) + sorted((ROOT / "examples" / "scenes").glob("*.yaml"))
+
+
+@contextlib.contextmanager
+def runtime_restored():
+    """What `_use_runtime` changes, put back on leaving: a caller in a longer process (a test) must not leave
+    its compiles pointed at a runtime folder that is gone."""
+    import implgen.compile.clib as cbuild
+    import implgen.compile.library as library
+    import implgen.resources as resources
+    import implgen.scene.build as build
+
+    missing = object()
+    places = [(build, "runtime_dir"), (resources, "runtime_dir"), (library, "runtime_dir"), (cbuild, "BASE_FLAGS")]
+    saved = [getattr(module, name, missing) for module, name in places]
+    try:
+        yield
+    finally:
+        for (module, name), value in zip(places, saved):
+            if value is missing:
+                if hasattr(module, name):
+                    delattr(module, name)
+            else:
+                setattr(module, name, value)
 
 
 def _use_runtime(runtime: Path) -> None:

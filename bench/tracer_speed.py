@@ -139,7 +139,7 @@ def main(argv: list[str] | None = None) -> None:
     size = argparse.Namespace(width=args.width, height=args.height, spp=1)
     before = load_average()
     rows = []
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp, picture_diff.runtime_restored():
         runtimes = [base_copy(args.base, Path(tmp)), ROOT / "runtime_c"]
         for scene in args.scenes or DEFAULT_SCENES:
             line, ratio = row(scene.stem, time_scene(scene, runtimes, size, max(1, args.runs)))

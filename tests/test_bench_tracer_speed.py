@@ -64,3 +64,16 @@ def test_each_round_runs_base_this_and_a_control_of_the_base(tmp_path: Path, mon
     assert sorted(tuple(sides[ident] for _, ident in rnd) for rnd in rounds) == sorted(tracer_speed.ORDERS)
     line, ratio = tracer_speed.row("x", got)
     assert ratio == 2.0 and "| 2.00× (2.00–2.00) | 1.00× (1.00–1.00) |" in line
+
+
+def test_a_run_leaves_the_process_compiling_with_the_installed_runtime(tmp_path: Path) -> None:
+    """The comparison points the compiles at a copy of the base runtime in a temporary folder; after the run the
+    process builds with the installed runtime again (a later test's scene build once read the deleted copy)."""
+    import implgen.compile.library as library
+    import implgen.resources as resources
+
+    before = (resources.runtime_dir(), library.runtime_dir())
+    args = ["--base", str(ROOT / "runtime_c"), "--runs", "1", "--width", "8", "--height", "6"]
+    tracer_speed.main([*args, "-o", str(tmp_path / "speed.md"), str(ROOT / "bench" / "scenes" / "torus.yaml")])
+    assert (resources.runtime_dir(), library.runtime_dir()) == before
+    assert (resources.runtime_dir() / "roots.c").is_file()
