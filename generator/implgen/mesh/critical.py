@@ -73,13 +73,7 @@ def _estimate(mid: np.ndarray, sides: list) -> np.ndarray:
 
 
 def _hessian(lib: ShapeLib, p: np.ndarray, eps: float) -> np.ndarray:
-    hess = np.empty((len(p), 3, 3))
-    for k in range(3):
-        dp = np.zeros(3)
-        dp[k] = eps
-        _, gp = lib.value_gradient(p + dp)
-        _, gm = lib.value_gradient(p - dp)
-        hess[:, :, k] = (gp - gm) / (2 * eps)
+    hess = lib.gradient_jacobian(p, eps)
     return 0.5 * (hess + hess.transpose(0, 2, 1))
 
 

@@ -141,6 +141,18 @@ class ShapeLib:
             )
         return f, g
 
+    def gradient_jacobian(self, p: np.ndarray, eps: float) -> np.ndarray:
+        """The Jacobian of grad f at each point (p: (n, 3)) by central differences of step `eps`: (n, 3, 3),
+        column k the change of the gradient along axis k (f's Hessian, up to the differences' error)."""
+        jac = np.empty((len(p), 3, 3))
+        for k in range(3):
+            dp = np.zeros(3)
+            dp[k] = eps
+            _, gp = self.value_gradient(p + dp)
+            _, gm = self.value_gradient(p - dp)
+            jac[:, :, k] = (gp - gm) / (2 * eps)
+        return jac
+
     def values_grid(self, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
         """f at every (x[i], y[j], z[k]), shape (len(x), len(y), len(z))."""
         x, y, z = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, y, z))

@@ -69,13 +69,7 @@ def _newton(lib: ShapeLib, p: np.ndarray, size: float, steps: int = 60) -> np.nd
             break
         q = p[live]
         f, g = lib.value_gradient(q)
-        hess = np.empty((len(q), 3, 3))
-        for k in range(3):
-            dp = np.zeros(3)
-            dp[k] = eps
-            _, gp = lib.value_gradient(q + dp)
-            _, gm = lib.value_gradient(q - dp)
-            hess[:, :, k] = (gp - gm) / (2 * eps)
+        hess = lib.gradient_jacobian(q, eps)
         jac = np.concatenate([g[:, None, :] / size, hess], axis=1)  # (n, 4, 3)
         res = np.concatenate([f[:, None] / size, g], axis=1)
         jtj = np.einsum("nki,nkj->nij", jac, jac)
