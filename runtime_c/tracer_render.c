@@ -177,12 +177,30 @@ static uint64_t pixel_stream(const rt_render *r, int x, int y, int *perm)
     return rng;
 }
 
+/* Sample k's primary direction through pixel (x, y): the pixel's centre at one sample a pixel (no random
+ * numbers), else its N-rooks stratum jittered by two numbers drawn from the pixel's stream. */
+static void sample_dir(const rt_render *r, int x, int y, int k, uint64_t *rng, const int *perm, double d[3])
+{
+    double px, py;
+    int a;
+    if (r->spp == 1) {
+        px = (2.0 * (x + 0.5) / r->width - 1.0) * r->tan_half * r->aspect;
+        py = (1.0 - 2.0 * (y + 0.5) / r->height) * r->tan_half;
+    } else {
+        const double sx = (k + uniform01(rng)) / r->spp;
+        const double sy = (perm[k] + uniform01(rng)) / r->spp;
+        px = (2.0 * (x + sx) / r->width - 1.0) * r->tan_half * r->aspect;
+        py = (1.0 - 2.0 * (y + sy) / r->height) * r->tan_half;
+    }
+    for (a = 0; a < 3; ++a)
+        d[a] = px * r->u[a] + py * r->v[a] - r->w[a];
+}
+
 /* A pass's row (rt_render_set_pass): its pixels' samples [k0, k1) added to their sums. The samples are
  * render_row's, drawn from the same stream in the same order (a test holds the two to the same image). */
 static void render_row_pass(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
 {
     int x, k, a, x0 = 0, step = 1;
-    const double py_centre = (1.0 - 2.0 * (y + 0.5) / r->height) * r->tan_half;
     if (r->pixels != RT_PIXELS_ALL && y % 2 == 0) { /* even pixels: even x of an even row; the others: odd x */
         x0 = r->pixels == RT_PIXELS_ODD;
         step = 2;
@@ -200,18 +218,8 @@ static void render_row_pass(rt_render *r, int y, double stats[RT_NSTATS], int *p
         if (r->k0 > 0)
             memcpy(acc, r->sums + at, sizeof acc);
         for (k = r->k0; k < r->k1; ++k) {
-            double sx, sy, px, py, d[3], c[3];
-            if (r->spp == 1) {
-                px = (2.0 * (x + 0.5) / r->width - 1.0) * r->tan_half * r->aspect;
-                py = py_centre;
-            } else {
-                sx = (k + uniform01(&rng)) / r->spp;
-                sy = (perm[k] + uniform01(&rng)) / r->spp;
-                px = (2.0 * (x + sx) / r->width - 1.0) * r->tan_half * r->aspect;
-                py = (1.0 - 2.0 * (y + sy) / r->height) * r->tan_half;
-            }
-            for (a = 0; a < 3; ++a)
-                d[a] = px * r->u[a] + py * r->v[a] - r->w[a];
+            double d[3], c[3];
+            sample_dir(r, x, y, k, &rng, perm, d);
             rt_trace_ray(r->s, r->eye, d, r->max_depth, c, stats);
             if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {
                 stats[RT_NONFINITE] += 1.0;
@@ -231,36 +239,12 @@ static void render_row_pass(rt_render *r, int y, double stats[RT_NSTATS], int *p
 static void render_row(rt_render *r, int y, double stats[RT_NSTATS], int *perm)
 {
     int x, k, a;
-    /* one sample per pixel: at the pixel's centre, the same for the whole row in y, and no random numbers */
-    const double py_centre = (1.0 - 2.0 * (y + 0.5) / r->height) * r->tan_half;
     for (x = 0; x < r->width; ++x) {
-        uint64_t rng = 0;
+        uint64_t rng = r->spp > 1 ? pixel_stream(r, x, y, perm) : 0;
         double acc[3] = {0.0, 0.0, 0.0};
-        if (r->spp > 1) {
-            rng = (uint64_t)r->seed * 0x100000001B3ULL ^ ((uint64_t)y * (uint64_t)r->width + (uint64_t)x);
-            splitmix64(&rng);
-            /* N-rooks stratification: sample k sits in column stratum k and row stratum perm[k]. */
-            for (k = 0; k < r->spp; ++k)
-                perm[k] = k;
-            for (k = r->spp - 1; k > 0; --k) {
-                int j = (int)(splitmix64(&rng) % (uint64_t)(k + 1)), t = perm[k];
-                perm[k] = perm[j];
-                perm[j] = t;
-            }
-        }
         for (k = 0; k < r->spp; ++k) {
-            double sx, sy, px, py, d[3], c[3];
-            if (r->spp == 1) {
-                px = (2.0 * (x + 0.5) / r->width - 1.0) * r->tan_half * r->aspect;
-                py = py_centre;
-            } else {
-                sx = (k + uniform01(&rng)) / r->spp;
-                sy = (perm[k] + uniform01(&rng)) / r->spp;
-                px = (2.0 * (x + sx) / r->width - 1.0) * r->tan_half * r->aspect;
-                py = (1.0 - 2.0 * (y + sy) / r->height) * r->tan_half;
-            }
-            for (a = 0; a < 3; ++a)
-                d[a] = px * r->u[a] + py * r->v[a] - r->w[a];
+            double d[3], c[3];
+            sample_dir(r, x, y, k, &rng, perm, d);
             rt_trace_ray(r->s, r->eye, d, r->max_depth, c, stats);
             if (!isfinite(c[0]) || !isfinite(c[1]) || !isfinite(c[2])) {
                 stats[RT_NONFINITE] += 1.0;
@@ -426,7 +410,7 @@ void rt_render_shape(const rt_render *r, int *y0, int *y1, int *width, int *spp,
 
 int rt_render_primary_rays(const rt_render *r, int x, int y, double o[3], double *dirs)
 {
-    int k, a, *perm = NULL, stack_perm[64];
+    int k, *perm = NULL, stack_perm[64];
     uint64_t rng = 0;
     memcpy(o, r->eye, sizeof r->eye);
     if (r->spp > 1) {
@@ -435,20 +419,8 @@ int rt_render_primary_rays(const rt_render *r, int x, int y, double o[3], double
             return 0;
         rng = pixel_stream(r, x, y, perm);
     }
-    for (k = 0; k < r->spp; ++k) {
-        double px, py;
-        if (r->spp == 1) {
-            px = (2.0 * (x + 0.5) / r->width - 1.0) * r->tan_half * r->aspect;
-            py = (1.0 - 2.0 * (y + 0.5) / r->height) * r->tan_half;
-        } else {
-            double sx = (k + uniform01(&rng)) / r->spp;
-            double sy = (perm[k] + uniform01(&rng)) / r->spp;
-            px = (2.0 * (x + sx) / r->width - 1.0) * r->tan_half * r->aspect;
-            py = (1.0 - 2.0 * (y + sy) / r->height) * r->tan_half;
-        }
-        for (a = 0; a < 3; ++a)
-            dirs[3 * k + a] = px * r->u[a] + py * r->v[a] - r->w[a];
-    }
+    for (k = 0; k < r->spp; ++k)
+        sample_dir(r, x, y, k, &rng, perm, dirs + 3 * k);
     if (perm && perm != stack_perm)
         free(perm);
     return r->spp;
